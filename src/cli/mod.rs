@@ -1,0 +1,34 @@
+//! Command-line interface: one file per subcommand.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod info;
+mod validate;
+
+/// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
+/// INRIA PLY).
+#[derive(Parser, Debug)]
+#[command(name = "splatgl", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print what a splat file holds: format, count, SH degree, colour space, bounds, warnings.
+    Info(info::Args),
+    /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
+    /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
+    Validate(validate::Args),
+}
+
+/// Parses the arguments and runs the subcommand.
+pub fn run() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Info(a) => info::run(a),
+        Command::Validate(a) => validate::run(a),
+    }
+}

@@ -1,0 +1,18 @@
+//! # splatgl
+//!
+//! A renderer for 3D Gaussian splats and the reference implementation of the glTF extension
+//! `KHR_gaussian_splatting` (Release Candidate).
+//!
+//! Data flow, one module per stage:
+//! `load` (glTF / PLY → [`SplatCloud`]) → `sort` → `gl` (draw) with the CPU `reference`
+//! rasterizer beside it, and `compare` for image comparison.
+#![warn(missing_docs)]
+
+pub mod cloud;
+pub mod covariance;
+pub mod load;
+pub mod sh;
+pub mod validate;
+pub mod write;
+
+pub use cloud::SplatCloud;

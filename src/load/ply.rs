@@ -1,0 +1,719 @@
+//! INRIA 3DGS PLY: `x y z [nx ny nz] f_dc_0..2 f_rest_* opacity scale_0..2 rot_0..3`
+//! (binary little/big endian or ASCII), or `red green blue` instead of `f_dc_*`.
+//!
+//! Conversions to [`SplatCloud`] conventions: logit opacity → sigmoid (±inf → 1/0), log scale
+//! → exp, `(w, x, y, z)` → `[x, y, z, w]` normalised (counted when not unit), `f_rest`
+//! channel-major → degree-major RGB triples, `red/green/blue` (u8 → /255, floats as they are)
+//! → DC coefficient `(c − 0.5) / Y₀₀`. Extra properties are ignored.
+//!
+//! Binary rows are decoded in parallel (rayon, blocks of rows) with property offsets resolved
+//! once from the header: no per-property lookups in the inner loop.
+
+use super::{Format, LoadReport, Loaded};
+use crate::cloud::{SplatCloud, sh_coeff_count};
+use rayon::prelude::*;
+
+/// What is wrong with a PLY file.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PlyError {
+    /// The header is malformed.
+    #[error("header line {line}: {message}")]
+    Header {
+        /// 1-based header line.
+        line: usize,
+        /// What was expected.
+        message: String,
+    },
+    /// No `vertex` element.
+    #[error("no 'vertex' element in the header")]
+    NoVertexElement,
+    /// A required property is missing.
+    #[error("element 'vertex': missing property '{property}' (required for a 3DGS PLY)")]
+    MissingProperty {
+        /// Its name.
+        property: String,
+    },
+    /// A layout splatgl does not read yet.
+    #[error("unsupported PLY layout: {0}")]
+    Unsupported(String),
+    /// `f_rest_*` count is not one of 0, 9, 24, 45.
+    #[error("element 'vertex': {count} f_rest_* properties; expected 0, 9, 24 or 45 (SH degree 0-3)")]
+    BadShCount {
+        /// How many there are.
+        count: usize,
+    },
+    /// The header claims more data than the file holds.
+    #[error(
+        "element '{element}': header claims {count} rows ({needed} bytes) but only {available} bytes follow"
+    )]
+    Truncated {
+        /// Element name.
+        element: String,
+        /// Rows claimed.
+        count: u64,
+        /// Bytes needed (or a lower bound, for ASCII and list rows).
+        needed: u64,
+        /// Bytes present.
+        available: u64,
+    },
+    /// A value that cannot be used.
+    #[error("element 'vertex' index {index}: property '{property}': {message}")]
+    Value {
+        /// Row.
+        index: usize,
+        /// Property.
+        property: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An ASCII body token that is not a number.
+    #[error("ASCII body line {line}: {message}")]
+    Ascii {
+        /// 1-based line in the file.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Encoding {
+    Ascii,
+    Le,
+    Be,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(s: &str) -> Option<Scalar> {
+        Some(match s {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+    /// Reads one value at the start of `b` (which holds at least `size()` bytes).
+    #[inline(always)]
+    fn read(self, b: &[u8], be: bool) -> f64 {
+        macro_rules! rd {
+            ($t:ty, $n:expr) => {{
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                if be {
+                    <$t>::from_be_bytes(a) as f64
+                } else {
+                    <$t>::from_le_bytes(a) as f64
+                }
+            }};
+        }
+        match self {
+            Scalar::I8 => b[0] as i8 as f64,
+            Scalar::U8 => b[0] as f64,
+            Scalar::I16 => rd!(i16, 2),
+            Scalar::U16 => rd!(u16, 2),
+            Scalar::I32 => rd!(i32, 4),
+            Scalar::U32 => rd!(u32, 4),
+            Scalar::F32 => rd!(f32, 4),
+            Scalar::F64 => rd!(f64, 8),
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Property {
+    name: String,
+    ty: Scalar,
+    /// `Some(count type)` for list properties.
+    list: Option<Scalar>,
+}
+
+#[derive(Debug, Clone)]
+struct Element {
+    name: String,
+    count: u64,
+    props: Vec<Property>,
+}
+
+#[derive(Debug)]
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    /// Byte offset of the body.
+    body: usize,
+    /// Number of header lines (for ASCII body line numbers).
+    lines: usize,
+}
+
+const MAX_HEADER: usize = 1 << 20;
+
+fn parse_header(bytes: &[u8]) -> Result<Header, PlyError> {
+    let err = |line: usize, message: String| PlyError::Header { line, message };
+    let mut pos = 0;
+    let mut line_no = 0;
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    loop {
+        if pos >= bytes.len() || pos > MAX_HEADER {
+            return Err(err(line_no + 1, "no 'end_header' line".into()));
+        }
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map(|e| pos + e)
+            .ok_or_else(|| err(line_no + 1, "no 'end_header' line".into()))?;
+        let raw = &bytes[pos..end];
+        pos = end + 1;
+        line_no += 1;
+        let line = std::str::from_utf8(raw)
+            .map_err(|_| err(line_no, "header is not ASCII text".into()))?
+            .trim_end_matches('\r');
+        let words: Vec<&str> = line.split_ascii_whitespace().collect();
+        if line_no == 1 {
+            if words != ["ply"] {
+                return Err(err(1, format!("expected 'ply', found {line:?}")));
+            }
+            continue;
+        }
+        match words.first().copied() {
+            None | Some("comment") | Some("obj_info") => {}
+            Some("format") => {
+                encoding = Some(match words.get(1).copied() {
+                    Some("ascii") => Encoding::Ascii,
+                    Some("binary_little_endian") => Encoding::Le,
+                    Some("binary_big_endian") => Encoding::Be,
+                    other => {
+                        return Err(err(
+                            line_no,
+                            format!(
+                                "format {other:?}: expected ascii, binary_little_endian or binary_big_endian"
+                            ),
+                        ));
+                    }
+                });
+            }
+            Some("element") => {
+                let (Some(name), Some(count), None) = (words.get(1), words.get(2), words.get(3))
+                else {
+                    return Err(err(line_no, "expected 'element NAME COUNT'".into()));
+                };
+                let count = count.parse::<u64>().map_err(|_| {
+                    err(line_no, format!("element count {count:?} is not a number"))
+                })?;
+                elements.push(Element {
+                    name: (*name).to_owned(),
+                    count,
+                    props: Vec::new(),
+                });
+            }
+            Some("property") => {
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| err(line_no, "property before any element".into()))?;
+                let prop = match words.as_slice() {
+                    ["property", "list", ct, it, name] => Property {
+                        name: (*name).to_owned(),
+                        list: Some(Scalar::parse(ct).ok_or_else(|| {
+                            err(line_no, format!("unknown list count type {ct:?}"))
+                        })?),
+                        ty: Scalar::parse(it)
+                            .ok_or_else(|| err(line_no, format!("unknown type {it:?}")))?,
+                    },
+                    ["property", ty, name] => Property {
+                        name: (*name).to_owned(),
+                        list: None,
+                        ty: Scalar::parse(ty)
+                            .ok_or_else(|| err(line_no, format!("unknown type {ty:?}")))?,
+                    },
+                    _ => {
+                        return Err(err(
+                            line_no,
+                            "expected 'property TYPE NAME' or 'property list CTYPE TYPE NAME'"
+                                .into(),
+                        ));
+                    }
+                };
+                el.props.push(prop);
+            }
+            Some("end_header") => break,
+            Some(w) => return Err(err(line_no, format!("unknown header keyword {w:?}"))),
+        }
+    }
+    let encoding = encoding.ok_or_else(|| err(line_no, "no 'format' line".into()))?;
+    Ok(Header {
+        encoding,
+        elements,
+        body: pos,
+        lines: line_no,
+    })
+}
+
+/// Which columns feed which output: offsets (binary) or column indices (ASCII) per field.
+struct Layout {
+    pos: [usize; 3],
+    /// DC source: f_dc (SH) or red/green/blue (colour, with a divisor: 255 for u8).
+    dc: [usize; 3],
+    dc_is_color: Option<f64>,
+    rest: Vec<usize>,
+    opacity: usize,
+    scale: [usize; 3],
+    rot: [usize; 4],
+    /// (offset, type) per column, binary.
+    cols: Vec<(usize, Scalar)>,
+    stride: usize,
+    sh_degree: u8,
+}
+
+fn layout(vertex: &Element) -> Result<Layout, PlyError> {
+    if vertex.props.iter().any(|p| p.name == "packed_position") {
+        return Err(PlyError::Unsupported(
+            "PlayCanvas compressed PLY (packed_* properties) is not supported yet".into(),
+        ));
+    }
+    if let Some(p) = vertex.props.iter().find(|p| p.list.is_some()) {
+        return Err(PlyError::Unsupported(format!(
+            "list property '{}' in element 'vertex'",
+            p.name
+        )));
+    }
+    let find = |name: &str| vertex.props.iter().position(|p| p.name == name);
+    let need = |name: &str| {
+        find(name).ok_or_else(|| PlyError::MissingProperty {
+            property: name.to_owned(),
+        })
+    };
+    let mut cols = Vec::with_capacity(vertex.props.len());
+    let mut off = 0;
+    for p in &vertex.props {
+        cols.push((off, p.ty));
+        off += p.ty.size();
+    }
+    let (dc, dc_is_color) = match find("f_dc_0") {
+        Some(_) => ([need("f_dc_0")?, need("f_dc_1")?, need("f_dc_2")?], None),
+        None if find("red").is_some() => {
+            let r = need("red")?;
+            let div = match vertex.props[r].ty {
+                Scalar::F32 | Scalar::F64 => 1.0,
+                Scalar::U8 => 255.0,
+                Scalar::U16 => 65535.0,
+                t => {
+                    return Err(PlyError::Unsupported(format!(
+                        "colour property 'red' of type {t:?}"
+                    )));
+                }
+            };
+            ([r, need("green")?, need("blue")?], Some(div))
+        }
+        None => return Err(need("f_dc_0").unwrap_err()),
+    };
+    let n_rest = vertex
+        .props
+        .iter()
+        .filter(|p| p.name.starts_with("f_rest_"))
+        .count();
+    let sh_degree = match n_rest {
+        0 => 0,
+        9 => 1,
+        24 => 2,
+        45 => 3,
+        count => return Err(PlyError::BadShCount { count }),
+    };
+    let rest = (0..n_rest)
+        .map(|i| need(&format!("f_rest_{i}")))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Layout {
+        pos: [need("x")?, need("y")?, need("z")?],
+        dc,
+        dc_is_color,
+        rest,
+        opacity: need("opacity")?,
+        scale: [need("scale_0")?, need("scale_1")?, need("scale_2")?],
+        rot: [need("rot_0")?, need("rot_1")?, need("rot_2")?, need("rot_3")?],
+        cols,
+        stride: off,
+        sh_degree,
+    })
+}
+
+fn sigmoid(x: f64) -> f64 {
+    if x >= 0.0 {
+        1.0 / (1.0 + (-x).exp())
+    } else {
+        let e = x.exp();
+        e / (1.0 + e)
+    }
+}
+
+/// Converts one row (read through `get(column)`) into the outputs of splat `index`.
+/// Returns whether the quaternion was not unit length.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn convert_row(
+    l: &Layout,
+    names: &[Property],
+    index: usize,
+    get: impl Fn(usize) -> f64,
+    pos: &mut [f32; 3],
+    scale: &mut [f32; 3],
+    rot: &mut [f32; 4],
+    opacity: &mut f32,
+    sh: &mut [[f32; 3]],
+) -> Result<bool, PlyError> {
+    let bad = |col: usize, message: &str| PlyError::Value {
+        index,
+        property: names[col].name.clone(),
+        message: message.to_owned(),
+    };
+    for k in 0..3 {
+        let v = get(l.pos[k]);
+        if !v.is_finite() {
+            return Err(bad(l.pos[k], "position is not finite"));
+        }
+        pos[k] = v as f32;
+        let s = get(l.scale[k]);
+        if s.is_nan() {
+            return Err(bad(l.scale[k], "log scale is NaN"));
+        }
+        scale[k] = s.exp() as f32;
+        if !scale[k].is_finite() {
+            return Err(bad(l.scale[k], "exp(log scale) overflows f32"));
+        }
+        let d = get(l.dc[k]);
+        if !d.is_finite() {
+            return Err(bad(l.dc[k], "colour coefficient is not finite"));
+        }
+        sh[0][k] = match l.dc_is_color {
+            None => d as f32,
+            Some(div) => ((d / div - 0.5) / crate::sh::SH_C0) as f32,
+        };
+    }
+    let k_rest = l.rest.len() / 3;
+    for (j, &col) in l.rest.iter().enumerate() {
+        let v = get(col);
+        if !v.is_finite() {
+            return Err(bad(col, "SH coefficient is not finite"));
+        }
+        let (ch, coef) = (j / k_rest, j % k_rest);
+        sh[1 + coef][ch] = v as f32;
+    }
+    let o = get(l.opacity);
+    if o.is_nan() {
+        return Err(bad(l.opacity, "opacity logit is NaN"));
+    }
+    *opacity = sigmoid(o) as f32;
+    let q = [get(l.rot[1]), get(l.rot[2]), get(l.rot[3]), get(l.rot[0])].map(|v| v as f32);
+    match super::normalize_quat(q) {
+        Some((q, off)) => {
+            *rot = q;
+            Ok(off)
+        }
+        None => Err(bad(l.rot[0], "quaternion is zero or not finite")),
+    }
+}
+
+/// Parses a PLY file from memory.
+pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
+    let header = parse_header(bytes)?;
+    let vi = header
+        .elements
+        .iter()
+        .position(|e| e.name == "vertex")
+        .ok_or(PlyError::NoVertexElement)?;
+    let vertex = &header.elements[vi];
+    let l = layout(vertex)?;
+    let body = &bytes[header.body..];
+    let mut report = LoadReport::new(Format::Ply);
+    report.scale_space = Some(super::ScaleSeen::Log);
+
+    let (cloud, non_unit) = match header.encoding {
+        Encoding::Ascii => load_ascii(&header, vi, &l, body)?,
+        enc => {
+            let start = skip_binary(&header.elements[..vi], body, enc == Encoding::Be)?;
+            let rows = &body[start..];
+            let n = vertex.count;
+            let needed = n.checked_mul(l.stride as u64).unwrap_or(u64::MAX);
+            if needed > rows.len() as u64 || (n > 0 && l.stride == 0) {
+                return Err(PlyError::Truncated {
+                    element: "vertex".into(),
+                    count: n,
+                    needed,
+                    available: rows.len() as u64,
+                });
+            }
+            decode_binary(&l, &vertex.props, &rows[..needed as usize], enc == Encoding::Be)?
+        }
+    };
+    if non_unit > 0 {
+        report.warn(
+            "vertex.rot_0..3",
+            format!("{non_unit} quaternions were not unit length and were normalised"),
+        );
+    }
+    report.non_unit_quaternions = non_unit;
+    Ok(Loaded { cloud, report })
+}
+
+/// Byte offset just past the elements before `vertex` (binary).
+fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyError> {
+    let mut pos = 0usize;
+    for el in before {
+        let truncated = |pos: usize| PlyError::Truncated {
+            element: el.name.clone(),
+            count: el.count,
+            needed: el.count,
+            available: (body.len() - pos.min(body.len())) as u64,
+        };
+        if el.props.is_empty() {
+            if el.count > 0 {
+                return Err(PlyError::Unsupported(format!(
+                    "element '{}' has rows but no properties",
+                    el.name
+                )));
+            }
+            continue;
+        }
+        if el.props.iter().all(|p| p.list.is_none()) {
+            let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
+            let needed = el.count.checked_mul(row as u64).unwrap_or(u64::MAX);
+            if needed > (body.len() - pos) as u64 {
+                return Err(truncated(pos));
+            }
+            pos += needed as usize;
+            continue;
+        }
+        // Rows with lists: walk them (each row takes at least one byte, so the count is
+        // bounded by the data before the walk starts).
+        if el.count > (body.len() - pos) as u64 {
+            return Err(truncated(pos));
+        }
+        for _ in 0..el.count {
+            for p in &el.props {
+                let n = match p.list {
+                    Some(ct) => {
+                        if pos + ct.size() > body.len() {
+                            return Err(truncated(pos));
+                        }
+                        let n = ct.read(&body[pos..], be);
+                        pos += ct.size();
+                        if !(0.0..=u32::MAX as f64).contains(&n) {
+                            return Err(PlyError::Unsupported(format!(
+                                "element '{}': negative list length",
+                                el.name
+                            )));
+                        }
+                        n as usize
+                    }
+                    None => 1,
+                };
+                let len = n.saturating_mul(p.ty.size());
+                if len > body.len() - pos {
+                    return Err(truncated(pos));
+                }
+                pos += len;
+            }
+        }
+    }
+    Ok(pos)
+}
+
+const BLOCK: usize = 4096;
+
+fn decode_binary(
+    l: &Layout,
+    props: &[Property],
+    rows: &[u8],
+    be: bool,
+) -> Result<(SplatCloud, usize), PlyError> {
+    let n = rows.len().checked_div(l.stride).unwrap_or(0);
+    let k = sh_coeff_count(l.sh_degree);
+    let mut cloud = SplatCloud::new(l.sh_degree);
+    cloud.positions = vec![[0.0; 3]; n];
+    cloud.scales = vec![[0.0; 3]; n];
+    cloud.rotations = vec![[0.0; 4]; n];
+    cloud.opacities = vec![0.0; n];
+    cloud.sh = vec![[0.0; 3]; n * k];
+    let results: Vec<Result<usize, PlyError>> = cloud
+        .positions
+        .par_chunks_mut(BLOCK)
+        .zip(cloud.scales.par_chunks_mut(BLOCK))
+        .zip(cloud.rotations.par_chunks_mut(BLOCK))
+        .zip(cloud.opacities.par_chunks_mut(BLOCK))
+        .zip(cloud.sh.par_chunks_mut(BLOCK * k))
+        .zip(rows.par_chunks(BLOCK * l.stride))
+        .enumerate()
+        .map(|(b, (((((p, s), r), o), sh), raw))| {
+            let mut non_unit = 0;
+            for i in 0..p.len() {
+                let row = &raw[i * l.stride..(i + 1) * l.stride];
+                let get = |c: usize| {
+                    let (off, ty) = l.cols[c];
+                    ty.read(&row[off..], be)
+                };
+                let off = convert_row(
+                    l,
+                    props,
+                    b * BLOCK + i,
+                    get,
+                    &mut p[i],
+                    &mut s[i],
+                    &mut r[i],
+                    &mut o[i],
+                    &mut sh[i * k..(i + 1) * k],
+                )?;
+                non_unit += off as usize;
+            }
+            Ok(non_unit)
+        })
+        .collect();
+    let mut non_unit = 0;
+    for r in results {
+        non_unit += r?;
+    }
+    Ok((cloud, non_unit))
+}
+
+fn load_ascii(
+    header: &Header,
+    vi: usize,
+    l: &Layout,
+    body: &[u8],
+) -> Result<(SplatCloud, usize), PlyError> {
+    let vertex = &header.elements[vi];
+    let text = std::str::from_utf8(body).map_err(|e| PlyError::Ascii {
+        line: header.lines + 1,
+        message: format!("body is not text ({e})"),
+    })?;
+    let mut lines = text.lines().enumerate();
+    for el in &header.elements[..vi] {
+        for _ in 0..el.count {
+            if lines.next().is_none() {
+                return Err(PlyError::Truncated {
+                    element: el.name.clone(),
+                    count: el.count,
+                    needed: el.count,
+                    available: body.len() as u64,
+                });
+            }
+        }
+    }
+    let ncols = vertex.props.len();
+    // Each value needs at least one digit and one separator.
+    let min_bytes = vertex.count.saturating_mul(2 * ncols as u64);
+    if min_bytes > body.len() as u64 {
+        return Err(PlyError::Truncated {
+            element: "vertex".into(),
+            count: vertex.count,
+            needed: min_bytes,
+            available: body.len() as u64,
+        });
+    }
+    let n = vertex.count as usize;
+    let k = sh_coeff_count(l.sh_degree);
+    let mut cloud = SplatCloud::with_capacity(l.sh_degree, n);
+    let mut vals = vec![0.0f64; ncols];
+    let mut sh = vec![[0.0f32; 3]; k];
+    let mut non_unit = 0;
+    for i in 0..n {
+        let (ln, line) = lines.next().ok_or_else(|| PlyError::Truncated {
+            element: "vertex".into(),
+            count: vertex.count,
+            needed: vertex.count,
+            available: i as u64,
+        })?;
+        let line_no = header.lines + ln + 1;
+        let mut it = line.split_ascii_whitespace();
+        for (c, v) in vals.iter_mut().enumerate() {
+            let tok = it.next().ok_or_else(|| PlyError::Ascii {
+                line: line_no,
+                message: format!("expected {ncols} values, found {c}"),
+            })?;
+            *v = tok.parse::<f64>().map_err(|_| PlyError::Ascii {
+                line: line_no,
+                message: format!(
+                    "value {tok:?} of property '{}' is not a number",
+                    vertex.props[c].name
+                ),
+            })?;
+        }
+        let (mut p, mut s, mut r, mut o) = ([0.0; 3], [0.0; 3], [0.0; 4], 0.0);
+        let off = convert_row(
+            l,
+            &vertex.props,
+            i,
+            |c| vals[c],
+            &mut p,
+            &mut s,
+            &mut r,
+            &mut o,
+            &mut sh,
+        )?;
+        non_unit += off as usize;
+        cloud.push(p, s, r, o, &sh);
+    }
+    Ok((cloud, non_unit))
+}
+
+/// Writes a cloud as INRIA binary little-endian PLY (log scale, logit opacity, w-first
+/// quaternion, channel-major `f_rest`) — the inverse of [`load`], used by tests and benches.
+pub fn write_inria(cloud: &SplatCloud) -> Vec<u8> {
+    let k = cloud.coeffs_per_splat();
+    let mut out = Vec::new();
+    let mut h = String::from("ply\nformat binary_little_endian 1.0\n");
+    h += &format!("element vertex {}\n", cloud.len());
+    for p in ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2"] {
+        h += &format!("property float {p}\n");
+    }
+    for i in 0..3 * (k - 1) {
+        h += &format!("property float f_rest_{i}\n");
+    }
+    for p in [
+        "opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3",
+    ] {
+        h += &format!("property float {p}\n");
+    }
+    h += "end_header\n";
+    out.extend_from_slice(h.as_bytes());
+    out.reserve(cloud.len() * (14 + 3 * k) * 4);
+    for i in 0..cloud.len() {
+        let sh = cloud.sh_of(i);
+        let mut row: Vec<f32> = Vec::with_capacity(14 + 3 * k);
+        row.extend_from_slice(&cloud.positions[i]);
+        row.extend_from_slice(&sh[0]);
+        for ch in 0..3 {
+            for c in &sh[1..] {
+                row.push(c[ch]);
+            }
+        }
+        let o = cloud.opacities[i] as f64;
+        row.push((o / (1.0 - o)).ln() as f32);
+        row.extend(cloud.scales[i].map(f32::ln));
+        let q = cloud.rotations[i];
+        row.extend_from_slice(&[q[3], q[0], q[1], q[2]]);
+        out.extend_from_slice(bytemuck::cast_slice(&row));
+    }
+    out
+}

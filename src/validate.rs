@@ -1,0 +1,1 @@
+//! `splatgl validate` (in progress).
