@@ -8,6 +8,7 @@
 //! rasterizer beside it, and `compare` for image comparison.
 #![warn(missing_docs)]
 
+pub mod camera;
 pub mod cloud;
 pub mod covariance;
 pub mod load;
