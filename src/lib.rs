@@ -11,6 +11,7 @@
 pub mod camera;
 pub mod cloud;
 pub mod covariance;
+pub mod image;
 pub mod load;
 pub mod sh;
 pub mod validate;
