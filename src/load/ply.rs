@@ -301,6 +301,18 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
         )));
     }
     let find = |name: &str| vertex.props.iter().position(|p| p.name == name);
+    let n_rest = vertex
+        .props
+        .iter()
+        .filter(|p| p.name.starts_with("f_rest_"))
+        .count();
+    let sh_degree = match n_rest {
+        0 => 0,
+        9 => 1,
+        24 => 2,
+        45 => 3,
+        count => return Err(PlyError::BadShCount { count }),
+    };
     let need = |name: &str| {
         find(name).ok_or_else(|| PlyError::MissingProperty {
             property: name.to_owned(),
@@ -329,18 +341,6 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
             ([r, need("green")?, need("blue")?], Some(div))
         }
         None => return Err(need("f_dc_0").unwrap_err()),
-    };
-    let n_rest = vertex
-        .props
-        .iter()
-        .filter(|p| p.name.starts_with("f_rest_"))
-        .count();
-    let sh_degree = match n_rest {
-        0 => 0,
-        9 => 1,
-        24 => 2,
-        45 => 3,
-        count => return Err(PlyError::BadShCount { count }),
     };
     let rest = (0..n_rest)
         .map(|i| need(&format!("f_rest_{i}")))
