@@ -10,7 +10,11 @@ fn main() {
             for i in 0..c.len() {
                 println!(
                     "{i}: pos {:?} scale {:?} rot {:?} opacity {} dc {:?}",
-                    c.positions[i], c.scales[i], c.rotations[i], c.opacities[i], c.sh_of(i)[0]
+                    c.positions[i],
+                    c.scales[i],
+                    c.rotations[i],
+                    c.opacities[i],
+                    c.sh_of(i)[0]
                 );
             }
         }

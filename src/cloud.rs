@@ -319,10 +319,8 @@ impl SplatCloud {
             max: first,
         };
         for p in it {
-            for i in 0..3 {
-                b.min[i] = b.min[i].min(p[i]);
-                b.max[i] = b.max[i].max(p[i]);
-            }
+            b.min = std::array::from_fn(|i| b.min[i].min(p[i]));
+            b.max = std::array::from_fn(|i| b.max[i].max(p[i]));
         }
         Some(b)
     }
@@ -409,9 +407,21 @@ mod tests {
     #[test]
     fn append_unifies_degree() {
         let mut a = SplatCloud::new(3);
-        a.push([0.0; 3], [1.0; 3], [0.0, 0.0, 0.0, 1.0], 0.5, &[[1.0; 3]; 16]);
+        a.push(
+            [0.0; 3],
+            [1.0; 3],
+            [0.0, 0.0, 0.0, 1.0],
+            0.5,
+            &[[1.0; 3]; 16],
+        );
         let mut b = SplatCloud::new(1);
-        b.push([1.0; 3], [1.0; 3], [0.0, 0.0, 0.0, 1.0], 0.5, &[[2.0; 3]; 4]);
+        b.push(
+            [1.0; 3],
+            [1.0; 3],
+            [0.0, 0.0, 0.0, 1.0],
+            0.5,
+            &[[2.0; 3]; 4],
+        );
         assert!(a.append(b));
         assert_eq!(a.sh_degree, 3);
         assert_eq!(a.sh.len(), 32);

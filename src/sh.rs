@@ -18,7 +18,7 @@ pub const SH_C1: f64 = 0.488_602_511_902_919_9;
 pub const SH_C2: [f64; 5] = [
     1.092_548_430_592_079,
     -1.092_548_430_592_079,
-    0.315_391_565_252_520_0,
+    0.315_391_565_252_52,
     -1.092_548_430_592_079,
     0.546_274_215_296_039_5,
 ];
@@ -185,7 +185,13 @@ mod tests {
     fn rotated_sh_equals_sh_at_inverse_rotated_direction() {
         let q = DMat3::from_euler(glam::EulerRot::ZYX, 0.7, -0.4, 2.1);
         let coeffs: Vec<[f32; 3]> = (0..16)
-            .map(|k| [k as f32 * 0.1 - 0.7, (k * k) as f32 * 0.01, -(k as f32) * 0.05])
+            .map(|k| {
+                [
+                    k as f32 * 0.1 - 0.7,
+                    (k * k) as f32 * 0.01,
+                    -(k as f32) * 0.05,
+                ]
+            })
             .collect();
         let mut rotated = coeffs.clone();
         ShRotation::new(q).apply(&mut rotated);

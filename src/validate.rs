@@ -84,7 +84,10 @@ pub fn validate_path(path: &Path, opts: &LoadOptions) -> Report {
         Ok(bytes) => validate_bytes(&bytes, Some(path), opts),
         Err(e) => Report {
             format: None,
-            findings: vec![Finding::fatal("", format!("cannot read {}: {e}", path.display()))],
+            findings: vec![Finding::fatal(
+                "",
+                format!("cannot read {}: {e}", path.display()),
+            )],
             readable: false,
             splat_count: None,
         },
@@ -112,7 +115,9 @@ pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> 
             Ok(l) => {
                 report.splat_count = Some(l.cloud.len());
                 for w in l.report.warnings {
-                    report.findings.push(Finding::warning(w.location, w.message));
+                    report
+                        .findings
+                        .push(Finding::warning(w.location, w.message));
                 }
             }
             Err(e) => {

@@ -121,7 +121,13 @@ impl Builder {
         }
     }
     /// Adds an accessor over `n` elements of `dims` components from `get(i, k)`.
-    fn add(&mut self, n: usize, dims: usize, comp: Comp, get: impl Fn(usize, usize) -> f32) -> usize {
+    fn add(
+        &mut self,
+        n: usize,
+        dims: usize,
+        comp: Comp,
+        get: impl Fn(usize, usize) -> f32,
+    ) -> usize {
         self.align();
         let esize = dims * comp.size();
         let stride = if self.padding > 0 {
@@ -139,7 +145,8 @@ impl Builder {
                 self.bin.resize(e0 + stride, 0xAB);
             }
         }
-        let mut view = json!({"buffer": 0, "byteOffset": start, "byteLength": self.bin.len() - start});
+        let mut view =
+            json!({"buffer": 0, "byteOffset": start, "byteLength": self.bin.len() - start});
         if stride > 0 {
             view["byteStride"] = json!(stride);
         }
@@ -190,7 +197,9 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
     let sc = b.add(n, 3, o.scale, |i, k| cloud.scales[i][k]);
     attrs.insert(format!("{p}SCALE"), json!(sc));
     let op = if o.sparse_opacity {
-        let idx: Vec<u32> = (0..n as u32).filter(|&i| cloud.opacities[i as usize] != 0.0).collect();
+        let idx: Vec<u32> = (0..n as u32)
+            .filter(|&i| cloud.opacities[i as usize] != 0.0)
+            .collect();
         let mut vals = Vec::new();
         for &i in &idx {
             o.opacity.encode(cloud.opacities[i as usize], &mut vals);

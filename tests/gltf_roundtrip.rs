@@ -21,10 +21,20 @@ fn quantizable(seed: u64, degree: u8) -> SplatCloud {
 
 fn max_err(a: &[f32], b: &[f32]) -> f32 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f32::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f32::max)
 }
 
-fn check(orig: &SplatCloud, got: &SplatCloud, tol_pos: f32, tol_rot: f32, tol_scale: f32, tol_op: f32) {
+fn check(
+    orig: &SplatCloud,
+    got: &SplatCloud,
+    tol_pos: f32,
+    tol_rot: f32,
+    tol_scale: f32,
+    tol_op: f32,
+) {
     assert_eq!(got.len(), orig.len());
     assert_eq!(got.sh_degree, orig.sh_degree);
     let flat3 = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<_>>();
@@ -46,7 +56,14 @@ fn roundtrip(c: &SplatCloud, o: &GltfWriteOptions) -> Vec<SplatCloud> {
         let v = validate_bytes(&bytes, Some(p), &LoadOptions::default());
         assert_eq!(v.status(), Status::Valid, "{o:?}: {:#?}", v.findings);
         let l = load_bytes(&bytes, Some(p), &LoadOptions::default()).expect("loads");
-        assert_eq!(l.report.format, if name.ends_with("glb") { Format::Glb } else { Format::Gltf });
+        assert_eq!(
+            l.report.format,
+            if name.ends_with("glb") {
+                Format::Glb
+            } else {
+                Format::Gltf
+            }
+        );
         out.push(l.cloud);
     }
     out
@@ -68,7 +85,12 @@ fn every_rc_component_type() {
     for rotation in [Comp::F32, Comp::I8N, Comp::I16N] {
         for scale in [Comp::F32, Comp::U8N, Comp::U16N] {
             for opacity in [Comp::F32, Comp::U8N, Comp::U16N] {
-                let o = GltfWriteOptions { rotation, scale, opacity, ..Default::default() };
+                let o = GltfWriteOptions {
+                    rotation,
+                    scale,
+                    opacity,
+                    ..Default::default()
+                };
                 let step = |t: Comp| match t {
                     Comp::U8N => 0.5 / 255.0 + 1e-6,
                     Comp::U16N => 0.5 / 65535.0 + 1e-6,
@@ -90,7 +112,10 @@ fn integer_scales_unnormalized() {
         *s = [(i % 5) as f32, 1.0, 2.0];
     }
     for scale in [Comp::U8, Comp::U16] {
-        let o = GltfWriteOptions { scale, ..Default::default() };
+        let o = GltfWriteOptions {
+            scale,
+            ..Default::default()
+        };
         for got in roundtrip(&c, &o) {
             check(&c, &got, 0.0, 1e-6, 0.0, 0.0);
         }
@@ -136,8 +161,13 @@ fn external_buffer_file() {
     let l = load_path(&gltf, &LoadOptions::default()).expect("external buffer");
     check(&c, &l.cloud, 0.0, 1e-6, 0.0, 0.0);
     std::fs::remove_file(dir.join("data file.bin")).unwrap();
-    let e = load_path(&gltf, &LoadOptions::default()).unwrap_err().to_string();
-    assert!(e.contains("buffers[0]") && e.contains("data file.bin"), "{e}");
+    let e = load_path(&gltf, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("buffers[0]") && e.contains("data file.bin"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -156,9 +186,14 @@ fn ply_roundtrip_all_degrees() {
 #[test]
 fn color0_fallback_inverts_the_rc_formula() {
     let c = quantizable(9, 0);
-    let o = GltfWriteOptions { color0: true, ..Default::default() };
+    let o = GltfWriteOptions {
+        color0: true,
+        ..Default::default()
+    };
     let (mut doc, bin) = splatgl::write::build(&c, &o);
-    let attrs = doc["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap();
+    let attrs = doc["meshes"][0]["primitives"][0]["attributes"]
+        .as_object_mut()
+        .unwrap();
     attrs.remove("KHR_gaussian_splatting:SH_DEGREE_0_COEF_0");
     doc["buffers"][0]["uri"] = serde_json::json!(format!(
         "data:application/octet-stream;base64,{}",

@@ -37,7 +37,11 @@ fn good_ply() -> Vec<u8> {
 
 /// Overwrites float property `prop` (column index in the INRIA layout of degree 1) of row `row`.
 fn poke_ply(mut bytes: Vec<u8>, row: usize, col: usize, v: f32) -> Vec<u8> {
-    let body = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let body = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
     let stride = (14 + 9) * 4;
     let off = body + row * stride + col * 4;
     bytes[off..off + 4].copy_from_slice(&v.to_le_bytes());
@@ -128,7 +132,9 @@ fn gltf_with(edit: impl FnOnce(&mut Value, &mut Vec<u8>)) -> Vec<u8> {
 }
 
 fn attr(doc: &Value, name: &str) -> usize {
-    doc["meshes"][0]["primitives"][0]["attributes"][name].as_u64().unwrap() as usize
+    doc["meshes"][0]["primitives"][0]["attributes"][name]
+        .as_u64()
+        .unwrap() as usize
 }
 
 const P: &str = "KHR_gaussian_splatting:";
@@ -148,26 +154,125 @@ fn gltf_corpus() {
     let cases: Vec<(Vec<u8>, Vec<&str>)> = vec![
         (b"{\"asset\": {\"version\": ".to_vec(), vec!["JSON"]),
         (b"[1, 2, 3]".to_vec(), vec!["not an object"]),
-        (gltf_with(|d, _| d["accessors"][0]["count"] = json!(2147483648u64)), vec!["accessors[0]", "count 2147483648"]),
-        (gltf_with(|d, _| d["meshes"][0]["primitives"][0]["attributes"][&sc] = json!(999)), vec!["index out of bounds"]),
-        (gltf_with(|d, _| d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(999)), vec!["POSITION", "out of range"]),
-        (gltf_with(|d, _| d["buffers"][0]["uri"] = json!("missing.bin")), vec!["buffers[0]", "missing.bin"]),
-        (gltf_with(|d, b| { d["buffers"][0]["byteLength"] = json!(b.len() + 100); }), vec!["buffers[0]", "bytes are present"]),
-        (gltf_with(|d, _| d["buffers"][0]["uri"] = json!("data:application/octet-stream;base64,@@@@")), vec!["invalid base64"]),
-        (gltf_with(|d, _| { d["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap().remove(&sc); }), vec!["SCALE", "required attribute is missing"]),
-        (gltf_with(|d, b| { let o = elem_offset(d, &op, 5, 4); b[o..o + 4].copy_from_slice(&1.5f32.to_le_bytes()); }), vec!["OPACITY", "index 5", "outside [0, 1]"]),
-        (gltf_with(|d, b| { let o = elem_offset(d, "POSITION", 3, 12); b[o..o + 4].copy_from_slice(&f32::NAN.to_le_bytes()); }), vec!["POSITION", "index 3", "not finite"]),
-        (gltf_with(|d, _| { let a = attr(d, &op); d["accessors"][a]["count"] = json!(7); }), vec!["OPACITY", "differs from POSITION's count"]),
-        (gltf_with(|d, _| { let a = attr(d, &rot); d["accessors"][a]["type"] = json!("VEC3"); }), vec!["ROTATION", "expected 4 components"]),
-        (gltf_with(|d, _| { d["extensionsUsed"] = json!(["KHR_gaussian_splatting", "EXT_fancy"]); d["extensionsRequired"] = json!(["EXT_fancy"]); }), vec!["extensionsRequired[0]", "EXT_fancy"]),
-        (gltf_with(|d, _| d["nodes"] = json!([{"children": [1]}, {"children": [0], "mesh": 0}])), vec!["cycle"]),
-        (gltf_with(|d, _| d["nodes"] = json!([{"children": [1, 1], "mesh": 0}, {}])), vec!["more than one parent"]),
-        (gltf_with(|d, _| d["bufferViews"][0]["byteStride"] = json!(8)), vec!["byteStride 8"]),
-        (gltf_with(|d, _| { let a = attr(d, &op); d["accessors"][a]["componentType"] = json!(1234); }), vec!["componentType", "invalid value"]),
-        (gltf_with(|d, _| { d["meshes"][0]["primitives"][0]["extensions"] = json!({}); }), vec!["no primitive with KHR_gaussian_splatting"]),
-        (gltf_with(|d, b| { let o = elem_offset(d, &rot, 4, 16); b[o..o + 16].copy_from_slice(&[0u8; 16]); }), vec!["ROTATION", "index 4", "quaternion is zero"]),
-        (gltf_with(|d, _| { d["meshes"][0]["primitives"][0]["extensions"]["KHR_gaussian_splatting"]["extensions"] = json!({"KHR_gaussian_splatting_compression_spz_2": {"bufferView": 0}}); }), vec!["compression_spz_2"]),
-        (gltf_with(|d, _| { d["bufferViews"][0]["byteOffset"] = json!(1u64 << 40); }), vec!["bufferViews[0]", "exceeds buffers[0]"]),
+        (
+            gltf_with(|d, _| d["accessors"][0]["count"] = json!(2147483648u64)),
+            vec!["accessors[0]", "count 2147483648"],
+        ),
+        (
+            gltf_with(|d, _| d["meshes"][0]["primitives"][0]["attributes"][&sc] = json!(999)),
+            vec!["index out of bounds"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(999)
+            }),
+            vec!["POSITION", "out of range"],
+        ),
+        (
+            gltf_with(|d, _| d["buffers"][0]["uri"] = json!("missing.bin")),
+            vec!["buffers[0]", "missing.bin"],
+        ),
+        (
+            gltf_with(|d, b| {
+                d["buffers"][0]["byteLength"] = json!(b.len() + 100);
+            }),
+            vec!["buffers[0]", "bytes are present"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["buffers"][0]["uri"] = json!("data:application/octet-stream;base64,@@@@")
+            }),
+            vec!["invalid base64"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["meshes"][0]["primitives"][0]["attributes"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove(&sc);
+            }),
+            vec!["SCALE", "required attribute is missing"],
+        ),
+        (
+            gltf_with(|d, b| {
+                let o = elem_offset(d, &op, 5, 4);
+                b[o..o + 4].copy_from_slice(&1.5f32.to_le_bytes());
+            }),
+            vec!["OPACITY", "index 5", "outside [0, 1]"],
+        ),
+        (
+            gltf_with(|d, b| {
+                let o = elem_offset(d, "POSITION", 3, 12);
+                b[o..o + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+            }),
+            vec!["POSITION", "index 3", "not finite"],
+        ),
+        (
+            gltf_with(|d, _| {
+                let a = attr(d, &op);
+                d["accessors"][a]["count"] = json!(7);
+            }),
+            vec!["OPACITY", "differs from POSITION's count"],
+        ),
+        (
+            gltf_with(|d, _| {
+                let a = attr(d, &rot);
+                d["accessors"][a]["type"] = json!("VEC3");
+            }),
+            vec!["ROTATION", "expected 4 components"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["extensionsUsed"] = json!(["KHR_gaussian_splatting", "EXT_fancy"]);
+                d["extensionsRequired"] = json!(["EXT_fancy"]);
+            }),
+            vec!["extensionsRequired[0]", "EXT_fancy"],
+        ),
+        (
+            gltf_with(|d, _| d["nodes"] = json!([{"children": [1]}, {"children": [0], "mesh": 0}])),
+            vec!["cycle"],
+        ),
+        (
+            gltf_with(|d, _| d["nodes"] = json!([{"children": [1, 1], "mesh": 0}, {}])),
+            vec!["more than one parent"],
+        ),
+        (
+            gltf_with(|d, _| d["bufferViews"][0]["byteStride"] = json!(8)),
+            vec!["byteStride 8"],
+        ),
+        (
+            gltf_with(|d, _| {
+                let a = attr(d, &op);
+                d["accessors"][a]["componentType"] = json!(1234);
+            }),
+            vec!["componentType", "invalid value"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["meshes"][0]["primitives"][0]["extensions"] = json!({});
+            }),
+            vec!["no primitive with KHR_gaussian_splatting"],
+        ),
+        (
+            gltf_with(|d, b| {
+                let o = elem_offset(d, &rot, 4, 16);
+                b[o..o + 16].copy_from_slice(&[0u8; 16]);
+            }),
+            vec!["ROTATION", "index 4", "quaternion is zero"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["meshes"][0]["primitives"][0]["extensions"]["KHR_gaussian_splatting"]["extensions"] =
+                    json!({"KHR_gaussian_splatting_compression_spz_2": {"bufferView": 0}});
+            }),
+            vec!["compression_spz_2"],
+        ),
+        (
+            gltf_with(|d, _| {
+                d["bufferViews"][0]["byteOffset"] = json!(1u64 << 40);
+            }),
+            vec!["bufferViews[0]", "exceeds buffers[0]"],
+        ),
         (
             gltf_with(|d, b| {
                 let a = attr(d, &op);
@@ -175,8 +280,14 @@ fn gltf_corpus() {
                 b.extend_from_slice(&100u32.to_le_bytes());
                 b.extend_from_slice(&0.5f32.to_le_bytes());
                 d["buffers"][0]["byteLength"] = json!(b.len());
-                d["bufferViews"].as_array_mut().unwrap().push(json!({"buffer": 0, "byteOffset": start, "byteLength": 4}));
-                d["bufferViews"].as_array_mut().unwrap().push(json!({"buffer": 0, "byteOffset": start + 4, "byteLength": 4}));
+                d["bufferViews"]
+                    .as_array_mut()
+                    .unwrap()
+                    .push(json!({"buffer": 0, "byteOffset": start, "byteLength": 4}));
+                d["bufferViews"]
+                    .as_array_mut()
+                    .unwrap()
+                    .push(json!({"buffer": 0, "byteOffset": start + 4, "byteLength": 4}));
                 let n = d["bufferViews"].as_array().unwrap().len();
                 d["accessors"][a]["sparse"] = json!({"count": 1, "indices": {"bufferView": n - 2, "componentType": 5125}, "values": {"bufferView": n - 1}});
             }),
@@ -207,28 +318,49 @@ fn glb_framing() {
     chunk[12] = 0xFF; // JSON chunk length far past the end
     chunk[13] = 0xFF;
     expect(&chunk, "t.glb", &["GLB"]);
-    let v = validate_bytes(&truncated, Some(Path::new("t.glb")), &LoadOptions::default());
+    let v = validate_bytes(
+        &truncated,
+        Some(Path::new("t.glb")),
+        &LoadOptions::default(),
+    );
     assert_eq!(v.status(), Status::Unreadable);
 }
 
 #[test]
 fn spec_violations_the_loader_survives_are_validation_errors() {
-    let validate = |bytes: &[u8]| validate_bytes(bytes, Some(Path::new("v.gltf")), &LoadOptions::default());
+    let validate =
+        |bytes: &[u8]| validate_bytes(bytes, Some(Path::new("v.gltf")), &LoadOptions::default());
     let msgs = |bytes: &[u8]| -> Vec<String> {
-        validate(bytes).findings.iter().map(|f| f.to_string()).collect()
+        validate(bytes)
+            .findings
+            .iter()
+            .map(|f| f.to_string())
+            .collect()
     };
     // Partial SH degree: degree 1 with one coefficient missing → degree 0 + error.
     let partial = gltf_with(|d, _| {
-        d["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap().remove(&format!("{P}SH_DEGREE_1_COEF_2"));
+        d["meshes"][0]["primitives"][0]["attributes"]
+            .as_object_mut()
+            .unwrap()
+            .remove(&format!("{P}SH_DEGREE_1_COEF_2"));
     });
-    assert!(msgs(&partial).iter().any(|m| m.contains("partially defined")));
+    assert!(
+        msgs(&partial)
+            .iter()
+            .any(|m| m.contains("partially defined"))
+    );
     let l = load_bytes(&partial, Some(Path::new("v.gltf")), &LoadOptions::default()).unwrap();
     assert_eq!(l.cloud.sh_degree, 0);
     // Mode not POINTS.
     let tri = gltf_with(|d, _| d["meshes"][0]["primitives"][0]["mode"] = json!(4));
     assert!(msgs(&tri).iter().any(|m| m.contains("POINTS")));
     // Missing kernel.
-    let nok = gltf_with(|d, _| { d["meshes"][0]["primitives"][0]["extensions"]["KHR_gaussian_splatting"].as_object_mut().unwrap().remove("kernel"); });
+    let nok = gltf_with(|d, _| {
+        d["meshes"][0]["primitives"][0]["extensions"]["KHR_gaussian_splatting"]
+            .as_object_mut()
+            .unwrap()
+            .remove("kernel");
+    });
     assert!(msgs(&nok).iter().any(|m| m.contains("'kernel' is missing")));
     // Non-unit quaternion: normalised by the loader, an error for validate, first index given.
     let nonunit = gltf_with(|d, b| {
@@ -238,9 +370,18 @@ fn spec_violations_the_loader_survives_are_validation_errors() {
         b[o..o + 16].copy_from_slice(bytemuck::cast_slice(&[0.0f32, 0.0, 0.0, 2.0]));
     });
     let v = validate(&nonunit);
-    let f = v.findings.iter().find(|f| f.message.contains("not unit length")).expect("finding");
+    let f = v
+        .findings
+        .iter()
+        .find(|f| f.message.contains("not unit length"))
+        .expect("finding");
     assert_eq!(f.index, Some(2));
-    assert!(f.path.ends_with("attributes[\"KHR_gaussian_splatting:ROTATION\"]"), "{}", f.path);
+    assert!(
+        f.path
+            .ends_with("attributes[\"KHR_gaussian_splatting:ROTATION\"]"),
+        "{}",
+        f.path
+    );
     // Negative scale: log space under auto, an error under --scale-space linear.
     let neg = gltf_with(|d, b| {
         let a = attr(d, &format!("{P}SCALE"));
@@ -248,11 +389,24 @@ fn spec_violations_the_loader_survives_are_validation_errors() {
         let o = d["bufferViews"][v]["byteOffset"].as_u64().unwrap() as usize + 12;
         b[o..o + 4].copy_from_slice(&(-1.0f32).to_le_bytes());
     });
-    assert!(msgs(&neg).iter().any(|m| m.contains("legacy draft: log-space scale")));
-    let e = load_bytes(&neg, Some(Path::new("v.gltf")), &LoadOptions { scale_space: ScaleSpace::Linear })
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("MUST NOT be negative") && e.contains("index 1"), "{e}");
+    assert!(
+        msgs(&neg)
+            .iter()
+            .any(|m| m.contains("legacy draft: log-space scale"))
+    );
+    let e = load_bytes(
+        &neg,
+        Some(Path::new("v.gltf")),
+        &LoadOptions {
+            scale_space: ScaleSpace::Linear,
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("MUST NOT be negative") && e.contains("index 1"),
+        "{e}"
+    );
     // And the file the writer produces is valid.
     assert_eq!(validate(&gltf_with(|_, _| {})).status(), Status::Valid);
 }

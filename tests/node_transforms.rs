@@ -27,14 +27,20 @@ fn assert_close(a: DMat3, b: DMat3, rel: f64) {
 
 fn check_transform(m: DMat4) {
     let local = random_cloud(42, 50, 3);
-    let o = GltfWriteOptions { node_matrix: Some(m.to_cols_array()), ..Default::default() };
+    let o = GltfWriteOptions {
+        node_matrix: Some(m.to_cols_array()),
+        ..Default::default()
+    };
     let got = load_glb(&to_glb(&local, &o)).cloud;
     let m3 = DMat3::from_mat4(m);
     for i in 0..local.len() {
         let p = local.positions[i].map(f64::from);
         let want = m.transform_point3(DVec3::from_array(p));
         let g = DVec3::from_array(got.positions[i].map(f64::from));
-        assert!((want - g).length() < 1e-5 * (1.0 + want.length()), "position {i}");
+        assert!(
+            (want - g).length() < 1e-5 * (1.0 + want.length()),
+            "position {i}"
+        );
         let want_sigma = m3 * sigma(&local, i) * m3.transpose();
         assert_close(sigma(&got, i), want_sigma, 1e-5);
     }
@@ -45,13 +51,21 @@ fn translation_rotation_uniform_scale() {
     let r = DQuat::from_euler(glam::EulerRot::YXZ, 0.4, -1.1, 2.3);
     check_transform(DMat4::from_translation(DVec3::new(1.0, -2.0, 3.5)));
     check_transform(DMat4::from_quat(r));
-    check_transform(DMat4::from_scale_rotation_translation(DVec3::splat(2.5), r, DVec3::X));
+    check_transform(DMat4::from_scale_rotation_translation(
+        DVec3::splat(2.5),
+        r,
+        DVec3::X,
+    ));
 }
 
 #[test]
 fn non_uniform_scale_and_shear_keep_exact_covariance() {
     let r = DQuat::from_rotation_z(0.8);
-    check_transform(DMat4::from_scale_rotation_translation(DVec3::new(0.5, 2.0, 3.0), r, DVec3::Y));
+    check_transform(DMat4::from_scale_rotation_translation(
+        DVec3::new(0.5, 2.0, 3.0),
+        r,
+        DVec3::Y,
+    ));
     let shear = DMat4::from_cols_array(&[
         1.0, 0.3, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.4, 0.0, 1.2, 0.0, 0.0, 0.0, 0.0, 1.0,
     ]);
@@ -63,17 +77,27 @@ fn sh_rotated_by_node_rotation() {
     let local = random_cloud(7, 20, 3);
     let r = DQuat::from_euler(glam::EulerRot::ZXY, 1.3, 0.2, -0.7);
     let m = DMat4::from_scale_rotation_translation(DVec3::splat(1.7), r, DVec3::new(0.0, 1.0, 0.0));
-    let o = GltfWriteOptions { node_matrix: Some(m.to_cols_array()), ..Default::default() };
+    let o = GltfWriteOptions {
+        node_matrix: Some(m.to_cols_array()),
+        ..Default::default()
+    };
     let got = load_glb(&to_glb(&local, &o)).cloud;
     let rm = DMat3::from_quat(r);
     for i in 0..local.len() {
-        for d in [DVec3::new(0.2, 0.9, -0.3), DVec3::new(-0.6, 0.1, 0.8), DVec3::Z] {
+        for d in [
+            DVec3::new(0.2, 0.9, -0.3),
+            DVec3::new(-0.6, 0.1, 0.8),
+            DVec3::Z,
+        ] {
             let d = d.normalize();
             let local_dir = (rm.transpose() * d).to_array().map(|v| v as f32);
             let want = splatgl::sh::eval_color(local.sh_of(i), 3, local_dir);
             let have = splatgl::sh::eval_color(got.sh_of(i), 3, d.to_array().map(|v| v as f32));
             for ch in 0..3 {
-                assert!((want[ch] - have[ch]).abs() < 1e-4, "splat {i}: {want:?} vs {have:?}");
+                assert!(
+                    (want[ch] - have[ch]).abs() < 1e-4,
+                    "splat {i}: {want:?} vs {have:?}"
+                );
             }
         }
     }
@@ -95,13 +119,11 @@ fn hierarchy_composes_and_instances_merge() {
         {"mesh": 0}
     ]);
     doc["scenes"] = serde_json::json!([{"nodes": [0, 2]}]);
-    doc["buffers"][0]["uri"] = serde_json::json!(format!(
-        "data:application/octet-stream;base64,{}",
-        {
+    doc["buffers"][0]["uri"] =
+        serde_json::json!(format!("data:application/octet-stream;base64,{}", {
             use base64::Engine;
             base64::engine::general_purpose::STANDARD.encode(&bin)
-        }
-    ));
+        }));
     let bytes = serde_json::to_vec(&doc).unwrap();
     let got = load_bytes(&bytes, Some(Path::new("h.gltf")), &LoadOptions::default())
         .unwrap()
@@ -113,7 +135,11 @@ fn hierarchy_composes_and_instances_merge() {
         let want = ab.transform_point3(p);
         let g = DVec3::from_array(got.positions[i].map(f64::from));
         assert!((want - g).length() < 1e-5 * (1.0 + want.length()));
-        assert_eq!(got.positions[10 + i], local.positions[i], "identity instance");
+        assert_eq!(
+            got.positions[10 + i],
+            local.positions[i],
+            "identity instance"
+        );
     }
 }
 
@@ -121,10 +147,16 @@ fn hierarchy_composes_and_instances_merge() {
 fn mirrored_node_is_flagged() {
     let local = random_cloud(1, 4, 0);
     let m = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
-    let o = GltfWriteOptions { node_matrix: Some(m.to_cols_array()), ..Default::default() };
+    let o = GltfWriteOptions {
+        node_matrix: Some(m.to_cols_array()),
+        ..Default::default()
+    };
     let l = load_glb(&to_glb(&local, &o));
     assert!(
-        l.report.warnings.iter().any(|w| w.message.contains("undefined")),
+        l.report
+            .warnings
+            .iter()
+            .any(|w| w.message.contains("undefined")),
         "{:?}",
         l.report.warnings
     );

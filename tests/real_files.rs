@@ -17,23 +17,35 @@ fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Loaded
         assert!((n - 1.0).abs() < 1e-5, "{name}: quaternions are normalised");
     }
     assert!(l.cloud.opacities.iter().all(|o| (0.0..=1.0).contains(o)));
-    assert!(l.cloud.scales.iter().flatten().all(|s| *s >= 0.0 && s.is_finite()));
+    assert!(
+        l.cloud
+            .scales
+            .iter()
+            .flatten()
+            .all(|s| *s >= 0.0 && s.is_finite())
+    );
     Some(l)
 }
 
 fn has_warning(l: &splatgl::load::Loaded, needle: &str) -> bool {
-    l.report.warnings.iter().any(|w| w.to_string().contains(needle))
+    l.report
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains(needle))
 }
 
 #[test]
 fn inria_ply_files() {
     if let Some(l) = load_ok("supersplat_fruit_drops_minimal_sh3.ply", 4721, 3) {
-        assert!(l.report.non_unit_quaternions > 4000, "|q| ranges 0.60..1.93");
+        assert!(
+            l.report.non_unit_quaternions > 4000,
+            "|q| ranges 0.60..1.93"
+        );
         assert!(has_warning(&l, "not unit length"));
     }
     if let Some(l) = load_ok("mujoco_warp_fox_sh0.ply", 50_000, 0) {
         // +inf logits become opacity 1.
-        assert!(l.cloud.opacities.iter().any(|&o| o == 1.0));
+        assert!(l.cloud.opacities.contains(&1.0));
     }
     if let Some(l) = load_ok("splatapult_test_16splats_sh3.ply", 16, 3) {
         // log scale -2.996 → 0.05; logit 100 → 1.
@@ -43,13 +55,19 @@ fn inria_ply_files() {
     if let Some(l) = load_ok("jsplat_unitCube-ascii.ply", 20, 0) {
         let b = l.cloud.bounds().unwrap();
         let extent: Vec<f32> = (0..3).map(|i| b.max[i] - b.min[i]).collect();
-        assert!(extent.iter().all(|e| (e - 10.0).abs() < 1e-3), "10-unit cube: {extent:?}");
+        assert!(
+            extent.iter().all(|e| (e - 10.0).abs() < 1e-3),
+            "10-unit cube: {extent:?}"
+        );
     }
 }
 
 #[test]
 fn compressed_ply_is_a_clear_unsupported_error() {
-    for name in ["playcanvas_guitar.compressed.ply", "playcanvas_biker.compressed.ply"] {
+    for name in [
+        "playcanvas_guitar.compressed.ply",
+        "playcanvas_biker.compressed.ply",
+    ] {
         let Some(p) = real(name) else { continue };
         let e = load_path(&p, &LoadOptions::default()).unwrap_err();
         assert!(matches!(e, LoadError::Ply { .. }), "{e}");
@@ -59,8 +77,13 @@ fn compressed_ply_is_a_clear_unsupported_error() {
 
 #[test]
 fn bevy_conformance_matrix_legacy_draft() {
-    for name in ["bevy_khr_conformance_matrix.glb", "bevy_khr_conformance_matrix.gltf"] {
-        let Some(l) = load_ok(name, 15, 3) else { continue };
+    for name in [
+        "bevy_khr_conformance_matrix.glb",
+        "bevy_khr_conformance_matrix.gltf",
+    ] {
+        let Some(l) = load_ok(name, 15, 3) else {
+            continue;
+        };
         assert_eq!(l.report.scale_space, Some(ScaleSeen::Log));
         assert!(has_warning(&l, "legacy draft: log-space scale"), "{name}");
         assert!(has_warning(&l, "different SH degrees"), "{name}");
@@ -78,7 +101,9 @@ fn bevy_conformance_matrix_legacy_draft() {
 
 #[test]
 fn bevy_extensible_fallback_unknown_values() {
-    let Some(l) = load_ok("bevy_khr_extensible_fallback.gltf", 1, 0) else { return };
+    let Some(l) = load_ok("bevy_khr_extensible_fallback.gltf", 1, 0) else {
+        return;
+    };
     assert!(has_warning(&l, "unknown value \"customShape\""));
     assert!(has_warning(&l, "unknown value \"custom_space_display\""));
     assert!(has_warning(&l, "derived from COLOR_0"));
@@ -91,9 +116,18 @@ fn bevy_extensible_fallback_unknown_values() {
 #[test]
 fn spz_and_legacy_compression_are_named_errors() {
     for (name, ext) in [
-        ("cesium_native_spz2_basic.glb", "KHR_gaussian_splatting_compression_spz_2"),
-        ("sharpgltf_tower_legacy_spz_v2.glb", "KHR_spz_gaussian_splats_compression"),
-        ("tiles_tools_UnitSH_legacy.glb", "KHR_spz_gaussian_splats_compression"),
+        (
+            "cesium_native_spz2_basic.glb",
+            "KHR_gaussian_splatting_compression_spz_2",
+        ),
+        (
+            "sharpgltf_tower_legacy_spz_v2.glb",
+            "KHR_spz_gaussian_splats_compression",
+        ),
+        (
+            "tiles_tools_UnitSH_legacy.glb",
+            "KHR_spz_gaussian_splats_compression",
+        ),
     ] {
         let Some(p) = real(name) else { continue };
         let e = load_path(&p, &LoadOptions::default()).unwrap_err();
@@ -103,11 +137,24 @@ fn spz_and_legacy_compression_are_named_errors() {
 
 #[test]
 fn validate_flags_cesium_profile() {
-    let Some(p) = real("cesium_native_spz2_basic.glb") else { return };
+    let Some(p) = real("cesium_native_spz2_basic.glb") else {
+        return;
+    };
     let r = validate_path(&p, &LoadOptions::default());
     assert_eq!(r.status(), Status::Invalid);
-    let msgs: Vec<String> = r.findings.iter().map(|f| format!("{} {}", f.path, f.message)).collect();
-    for needle in ["'kernel' is missing", "'colorSpace' is missing", "compression_spz_2"] {
-        assert!(msgs.iter().any(|m| m.contains(needle)), "{needle} in {msgs:#?}");
+    let msgs: Vec<String> = r
+        .findings
+        .iter()
+        .map(|f| format!("{} {}", f.path, f.message))
+        .collect();
+    for needle in [
+        "'kernel' is missing",
+        "'colorSpace' is missing",
+        "compression_spz_2",
+    ] {
+        assert!(
+            msgs.iter().any(|m| m.contains(needle)),
+            "{needle} in {msgs:#?}"
+        );
     }
 }

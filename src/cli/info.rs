@@ -57,7 +57,10 @@ pub fn run(a: Args) -> ExitCode {
     println!("format:         {}", r.format.name());
     println!("splats:         {}", c.len());
     println!("SH degree:      {}", c.sh_degree);
-    println!("colour space:   {}", info["color_space"].as_str().unwrap_or("?"));
+    println!(
+        "colour space:   {}",
+        info["color_space"].as_str().unwrap_or("?")
+    );
     println!("kernel:         {}", info["kernel"].as_str().unwrap_or("?"));
     match b {
         Some(b) => println!("bounds:         {:?} .. {:?}", b.min, b.max),
@@ -67,7 +70,10 @@ pub fn run(a: Args) -> ExitCode {
         "scale space:    {}",
         r.scale_space.map_or("-", |s| s.name())
     );
-    println!("memory:         {:.1} MiB", c.memory_bytes() as f64 / 1048576.0);
+    println!(
+        "memory:         {:.1} MiB",
+        c.memory_bytes() as f64 / 1048576.0
+    );
     for w in &warnings {
         println!("warning: {w}");
     }

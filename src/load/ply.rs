@@ -37,7 +37,9 @@ pub enum PlyError {
     #[error("unsupported PLY layout: {0}")]
     Unsupported(String),
     /// `f_rest_*` count is not one of 0, 9, 24, 45.
-    #[error("element 'vertex': {count} f_rest_* properties; expected 0, 9, 24 or 45 (SH degree 0-3)")]
+    #[error(
+        "element 'vertex': {count} f_rest_* properties; expected 0, 9, 24 or 45 (SH degree 0-3)"
+    )]
     BadShCount {
         /// How many there are.
         count: usize,
@@ -352,7 +354,12 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
         rest,
         opacity: need("opacity")?,
         scale: [need("scale_0")?, need("scale_1")?, need("scale_2")?],
-        rot: [need("rot_0")?, need("rot_1")?, need("rot_2")?, need("rot_3")?],
+        rot: [
+            need("rot_0")?,
+            need("rot_1")?,
+            need("rot_2")?,
+            need("rot_3")?,
+        ],
         cols,
         stride: off,
         sh_degree,
@@ -455,7 +462,7 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
             let start = skip_binary(&header.elements[..vi], body, enc == Encoding::Be)?;
             let rows = &body[start..];
             let n = vertex.count;
-            let needed = n.checked_mul(l.stride as u64).unwrap_or(u64::MAX);
+            let needed = n.saturating_mul(l.stride as u64);
             if needed > rows.len() as u64 || (n > 0 && l.stride == 0) {
                 return Err(PlyError::Truncated {
                     element: "vertex".into(),
@@ -464,7 +471,12 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
                     available: rows.len() as u64,
                 });
             }
-            decode_binary(&l, &vertex.props, &rows[..needed as usize], enc == Encoding::Be)?
+            decode_binary(
+                &l,
+                &vertex.props,
+                &rows[..needed as usize],
+                enc == Encoding::Be,
+            )?
         }
     };
     if non_unit > 0 {
@@ -498,7 +510,7 @@ fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyEr
         }
         if el.props.iter().all(|p| p.list.is_none()) {
             let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
-            let needed = el.count.checked_mul(row as u64).unwrap_or(u64::MAX);
+            let needed = el.count.saturating_mul(row as u64);
             if needed > (body.len() - pos) as u64 {
                 return Err(truncated(pos));
             }

@@ -126,8 +126,12 @@ pub fn decode(
     alloc_limit: usize,
 ) -> Result<Decoded, Finding> {
     let fail = |msg: String| Finding::fatal(path, format!("accessors[{}]: {msg}", acc.index()));
-    let dims = dims_of(acc.dimensions())
-        .ok_or_else(|| fail(format!("type {:?} is not SCALAR/VEC2/VEC3/VEC4", acc.dimensions())))?;
+    let dims = dims_of(acc.dimensions()).ok_or_else(|| {
+        fail(format!(
+            "type {:?} is not SCALAR/VEC2/VEC3/VEC4",
+            acc.dimensions()
+        ))
+    })?;
     let (t, norm) = (acc.data_type(), acc.normalized());
     let csize = t.size();
     let esize = dims * csize;
@@ -229,7 +233,9 @@ fn apply_sparse(
             _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
         };
         if i >= count {
-            return Err(format!("index {i} (entry {s}) is out of range (count {count})"));
+            return Err(format!(
+                "index {i} (entry {s}) is out of range (count {count})"
+            ));
         }
         if prev.is_some_and(|p| i <= p) {
             return Err(format!("indices are not strictly increasing at entry {s}"));

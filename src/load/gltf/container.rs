@@ -43,13 +43,14 @@ pub fn parse(
 ) -> Result<Parsed, GltfError> {
     let (json_bytes, bin): (std::borrow::Cow<[u8]>, Option<Vec<u8>>) = match format {
         Format::Glb => {
-            let glb = gltf::binary::Glb::from_slice(bytes)
-                .map_err(|e| container(format!("GLB: {e}")))?;
+            let glb =
+                gltf::binary::Glb::from_slice(bytes).map_err(|e| container(format!("GLB: {e}")))?;
             (glb.json, glb.bin.map(|b| b.into_owned()))
         }
         _ => (std::borrow::Cow::Borrowed(bytes), None),
     };
-    let json: Value = serde_json::from_slice(&json_bytes).map_err(|e| container(format!("JSON: {e}")))?;
+    let json: Value =
+        serde_json::from_slice(&json_bytes).map_err(|e| container(format!("JSON: {e}")))?;
     if !json.is_object() {
         return Err(container("JSON: the top level is not an object"));
     }
@@ -89,12 +90,13 @@ fn check_required_extensions(json: &Value, findings: &mut Vec<Finding>) {
                     ));
                 }
             }
-            Some(n) if n.starts_with("KHR_materials_") || n.starts_with("KHR_texture_") => {
-                findings.push(Finding::warning(
+            Some(n) if n.starts_with("KHR_materials_") || n.starts_with("KHR_texture_") => findings
+                .push(Finding::warning(
                     path,
-                    format!("required extension {n:?} concerns materials, which splat rendering ignores"),
-                ))
-            }
+                    format!(
+                        "required extension {n:?} concerns materials, which splat rendering ignores"
+                    ),
+                )),
             Some(n) => findings.push(Finding::fatal(
                 path,
                 format!("required extension {n:?} is not supported by splatgl"),
@@ -280,7 +282,9 @@ fn read_uri(uri: &str, path: Option<&Path>) -> Result<Vec<u8>, String> {
             .map_err(|e| format!("data URI: invalid base64 ({e})"));
     }
     if uri.contains("://") {
-        return Err(format!("URI {uri:?}: only relative file paths and data URIs are read"));
+        return Err(format!(
+            "URI {uri:?}: only relative file paths and data URIs are read"
+        ));
     }
     let base = path
         .and_then(Path::parent)

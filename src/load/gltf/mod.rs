@@ -82,15 +82,24 @@ pub fn walk(
 
     // Pass 1: every splat primitive of every mesh, decoded and checked once.
     let mut decoded: HashMap<(usize, usize), primitive::LocalSplats> = HashMap::new();
-    let meshes = json.get("meshes").and_then(Value::as_array).cloned().unwrap_or_default();
+    let meshes = json
+        .get("meshes")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     let mut blocked = false;
     for (mi, mesh) in meshes.iter().enumerate() {
-        let prims = mesh.get("primitives").and_then(Value::as_array).cloned().unwrap_or_default();
+        let prims = mesh
+            .get("primitives")
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default();
         for (pi, prim) in prims.iter().enumerate() {
             let ppath = format!("meshes[{mi}].primitives[{pi}]");
             let exts = prim.get("extensions").and_then(Value::as_object);
             if let Some(legacy) = exts.and_then(|e| {
-                e.keys().find(|k| k.as_str() != EXT && k.contains("gaussian_splats"))
+                e.keys()
+                    .find(|k| k.as_str() != EXT && k.contains("gaussian_splats"))
             }) {
                 w.findings.push(Finding::fatal(
                     format!("{ppath}.extensions.{legacy}"),
@@ -103,7 +112,10 @@ pub fn walk(
                 continue;
             };
             let Some(ext) = ext.as_object() else {
-                w.findings.push(Finding::fatal(format!("{ppath}.extensions.{EXT}"), "must be an object"));
+                w.findings.push(Finding::fatal(
+                    format!("{ppath}.extensions.{EXT}"),
+                    "must be an object",
+                ));
                 blocked = true;
                 continue;
             };
@@ -137,10 +149,17 @@ pub fn walk(
     let mut instances = Vec::new();
     scene_meshes(doc, json, &mut w.findings, &mut instances);
     for (node, mesh, m) in instances {
-        let Some(mesh_json) = meshes.get(mesh) else { continue };
-        let n_prims = mesh_json.get("primitives").and_then(Value::as_array).map_or(0, Vec::len);
+        let Some(mesh_json) = meshes.get(mesh) else {
+            continue;
+        };
+        let n_prims = mesh_json
+            .get("primitives")
+            .and_then(Value::as_array)
+            .map_or(0, Vec::len);
         for pi in 0..n_prims {
-            let Some(ls) = decoded.get(&(mesh, pi)) else { continue };
+            let Some(ls) = decoded.get(&(mesh, pi)) else {
+                continue;
+            };
             let global = transform::apply(&ls.cloud, m, node, &mut w.findings);
             w.scale_seen = Some(ScaleSeen::merge(w.scale_seen, ls.scale_seen));
             w.non_unit += ls.non_unit;
@@ -227,7 +246,10 @@ fn scene_meshes(
                 }
             }
             if n > 0 && json.get("scenes").is_none() {
-                findings.push(Finding::warning("scenes", "no scene; rendering every root node"));
+                findings.push(Finding::warning(
+                    "scenes",
+                    "no scene; rendering every root node",
+                ));
             }
             for node in doc.nodes() {
                 if !is_child[node.index()] {
@@ -255,7 +277,10 @@ pub fn load(
     report.non_unit_quaternions = w.non_unit;
     for f in w.findings {
         let msg = match f.severity {
-            Severity::Error => format!("invalid per KHR_gaussian_splatting RC / glTF 2.0: {}", f.message),
+            Severity::Error => format!(
+                "invalid per KHR_gaussian_splatting RC / glTF 2.0: {}",
+                f.message
+            ),
             Severity::Warning => f.message,
         };
         let loc = match f.index {

@@ -75,9 +75,17 @@ pub fn read_meta(ext: &Map<String, Value>, path: &str, f: &mut Vec<Finding>) -> 
     }
     let unknown = [
         ("kernel", unknown_of(&meta.kernel), "ellipse"),
-        ("colorSpace", unknown_of(&meta.color_space), "srgb_rec709_display"),
+        (
+            "colorSpace",
+            unknown_of(&meta.color_space),
+            "srgb_rec709_display",
+        ),
         ("projection", unknown_of(&meta.projection), "perspective"),
-        ("sortingMethod", unknown_of(&meta.sorting_method), "cameraDistance"),
+        (
+            "sortingMethod",
+            unknown_of(&meta.sorting_method),
+            "cameraDistance",
+        ),
     ];
     for (key, val, fallback) in unknown {
         if let Some(v) = val {
@@ -120,7 +128,13 @@ fn allowed(name: &str) -> (usize, &'static [(DataType, bool)]) {
         "ROTATION" => (4, &[(F32, false), (I8, true), (I16, true)]),
         "SCALE" => (
             3,
-            &[(F32, false), (U8, false), (U8, true), (U16, false), (U16, true)],
+            &[
+                (F32, false),
+                (U8, false),
+                (U8, true),
+                (U16, false),
+                (U16, true),
+            ],
         ),
         "OPACITY" => (1, &[(F32, false), (U8, true), (U16, true)]),
         _ => (3, &[(F32, false)]), // SH
@@ -128,7 +142,12 @@ fn allowed(name: &str) -> (usize, &'static [(DataType, bool)]) {
 }
 
 /// Reads and checks one primitive. Returns `None` after a blocking finding.
-pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> Option<LocalSplats> {
+pub fn read(
+    ctx: &Ctx,
+    prim: &Value,
+    meta: &SplatMeta,
+    f: &mut Vec<Finding>,
+) -> Option<LocalSplats> {
     let path = &ctx.path;
     let empty = Map::new();
     let attrs = prim
@@ -161,7 +180,10 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
             .as_u64()
             .and_then(|i| ctx.doc.accessors().nth(i as usize));
         let Some(acc) = acc else {
-            f.push(Finding::fatal(ap, format!("accessor index {idx} out of range")));
+            f.push(Finding::fatal(
+                ap,
+                format!("accessor index {idx} out of range"),
+            ));
             return None;
         };
         match decode(&acc, ctx.buffers, &ap, ctx.alloc_limit) {
@@ -186,7 +208,6 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
         }
         higher.push(coefs);
     }
-    drop(get);
 
     let mut missing = false;
     for (name, a) in [
@@ -196,7 +217,11 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
         ("OPACITY", &opacity),
     ] {
         if a.is_none() {
-            let full = if name == "POSITION" { name.to_owned() } else { format!("{PREFIX}{name}") };
+            let full = if name == "POSITION" {
+                name.to_owned()
+            } else {
+                format!("{PREFIX}{name}")
+            };
             f.push(Finding::fatal(
                 attr_path(path, &full),
                 "required attribute is missing",
@@ -226,11 +251,27 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
 
     // Types and counts.
     let n = position.count();
-    let mut typed: Vec<(String, &Decoded, usize, &[(DataType, bool)])> = vec![
+    type Check<'d> = (String, &'d Decoded, usize, &'static [(DataType, bool)]);
+    let mut typed: Vec<Check> = vec![
         (attr_path(path, "POSITION"), &position, 3, &[]),
-        (attr_path(path, &format!("{PREFIX}ROTATION")), &rotation, 4, allowed("ROTATION").1),
-        (attr_path(path, &format!("{PREFIX}SCALE")), &scale, 3, allowed("SCALE").1),
-        (attr_path(path, &format!("{PREFIX}OPACITY")), &opacity, 1, allowed("OPACITY").1),
+        (
+            attr_path(path, &format!("{PREFIX}ROTATION")),
+            &rotation,
+            4,
+            allowed("ROTATION").1,
+        ),
+        (
+            attr_path(path, &format!("{PREFIX}SCALE")),
+            &scale,
+            3,
+            allowed("SCALE").1,
+        ),
+        (
+            attr_path(path, &format!("{PREFIX}OPACITY")),
+            &opacity,
+            1,
+            allowed("OPACITY").1,
+        ),
     ];
     if let Some(s) = &sh0 {
         typed.push((sh0_path.clone(), s, 3, allowed("SH").1));
@@ -246,7 +287,10 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
     let mut blocked = false;
     for (p, d, dims, ok) in &typed {
         if d.dims != *dims {
-            f.push(Finding::fatal(p.clone(), format!("expected {dims} components, found {}", d.dims)));
+            f.push(Finding::fatal(
+                p.clone(),
+                format!("expected {dims} components, found {}", d.dims),
+            ));
             blocked = true;
         } else if d.count() != n {
             f.push(Finding::fatal(
@@ -255,8 +299,8 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
             ));
             blocked = true;
         } else if !ok.is_empty() && !ok.contains(&(d.component, d.normalized)) {
-            let is_legacy_scale = p.ends_with("SCALE\"]")
-                && matches!(d.component, DataType::I8 | DataType::I16);
+            let is_legacy_scale =
+                p.ends_with("SCALE\"]") && matches!(d.component, DataType::I8 | DataType::I16);
             if !is_legacy_scale {
                 f.push(Finding::error(
                     p.clone(),
@@ -274,7 +318,10 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
     }
     if let Some(c) = &color0 {
         if c.count() != n || !(c.dims == 3 || c.dims == 4) {
-            f.push(Finding::fatal(attr_path(path, "COLOR_0"), "COLOR_0 must be VEC3/VEC4 with POSITION's count"));
+            f.push(Finding::fatal(
+                attr_path(path, "COLOR_0"),
+                "COLOR_0 must be VEC3/VEC4 with POSITION's count",
+            ));
             blocked = true;
         }
     }
@@ -306,7 +353,10 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
         if coefs.iter().any(Option::is_some) && l > degree as usize {
             f.push(Finding::error(
                 format!("{path}.attributes"),
-                format!("SH degree {} is present but a lower degree is incomplete", l + 1),
+                format!(
+                    "SH degree {} is present but a lower degree is incomplete",
+                    l + 1
+                ),
             ));
         }
     }
@@ -314,7 +364,11 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
     // Scale space.
     let scale_path = attr_path(path, &format!("{PREFIX}SCALE"));
     let signed = matches!(scale.component, DataType::I8 | DataType::I16);
-    let first_negative = scale.data.iter().position(|v| *v < 0.0).map(|i| (i / 3) as u64);
+    let first_negative = scale
+        .data
+        .iter()
+        .position(|v| *v < 0.0)
+        .map(|i| (i / 3) as u64);
     let log = match ctx.scale_space {
         ScaleSpace::Log => true,
         ScaleSpace::Linear => {
@@ -328,13 +382,18 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
     };
     if log && ctx.scale_space == ScaleSpace::Auto {
         let why = if signed {
-            format!("signed component type ({})", component_name(scale.component, scale.normalized))
+            format!(
+                "signed component type ({})",
+                component_name(scale.component, scale.normalized)
+            )
         } else {
             "negative values".to_owned()
         };
         let mut fd = Finding::error(
             &scale_path,
-            format!("legacy draft: log-space scale ({why}); read as exp(v). RC scales are linear and MUST NOT be negative"),
+            format!(
+                "legacy draft: log-space scale ({why}); read as exp(v). RC scales are linear and MUST NOT be negative"
+            ),
         );
         if let (false, Some(i)) = (signed, first_negative) {
             fd = fd.at(i);
@@ -344,10 +403,17 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
 
     // Opacity.
     let op_path = attr_path(path, &format!("{PREFIX}OPACITY"));
-    if let Some(i) = opacity.data.iter().position(|v| !(-1e-6..=1.0 + 1e-6).contains(v)) {
+    if let Some(i) = opacity
+        .data
+        .iter()
+        .position(|v| !(-1e-6..=1.0 + 1e-6).contains(v))
+    {
         f.push(
-            Finding::fatal(&op_path, format!("opacity {} is outside [0, 1]", opacity.data[i]))
-                .at(i as u64),
+            Finding::fatal(
+                &op_path,
+                format!("opacity {} is outside [0, 1]", opacity.data[i]),
+            )
+            .at(i as u64),
         );
         return None;
     }
@@ -378,7 +444,11 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
         }
         let q = q.map(|v| (v as f64 / norm) as f32);
         let s: [f32; 3] = scale.get(i);
-        let s = if log { s.map(f32::exp) } else { s.map(|v| v.max(0.0)) };
+        let s = if log {
+            s.map(f32::exp)
+        } else {
+            s.map(|v| v.max(0.0))
+        };
         sh[0] = match (&sh0, &color0) {
             (Some(d), _) => d.get(i),
             (None, Some(c)) => dc_from_color0(c.get::<3>(i), srgb),
@@ -402,7 +472,11 @@ pub fn read(ctx: &Ctx, prim: &Value, meta: &SplatMeta, f: &mut Vec<Finding>) -> 
             .at(i as u64),
         );
     }
-    let scale_seen = if log { ScaleSeen::Log } else { ScaleSeen::Linear };
+    let scale_seen = if log {
+        ScaleSeen::Log
+    } else {
+        ScaleSeen::Linear
+    };
     Some(LocalSplats {
         cloud,
         scale_seen,

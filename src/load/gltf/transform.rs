@@ -1,7 +1,9 @@
 //! Applying a node's global transform to a local-space cloud (RC §Splat Reconstruction).
 
 use crate::cloud::SplatCloud;
-use crate::covariance::{as_similarity, polar_rotation, scale_rotation_from_covariance, transformed_covariance};
+use crate::covariance::{
+    as_similarity, polar_rotation, scale_rotation_from_covariance, transformed_covariance,
+};
 use crate::load::finding::Finding;
 use crate::sh::ShRotation;
 use glam::{DMat3, DMat4, DQuat, DVec3};
