@@ -663,7 +663,12 @@ fn load_ascii(
                 line: line_no,
                 message: format!("expected {ncols} values, found {c}"),
             })?;
-            *v = tok.parse::<f64>().map_err(|_| PlyError::Ascii {
+            // Parse at the declared precision so ASCII equals the binary encoding exactly.
+            let parsed = match vertex.props[c].ty {
+                Scalar::F32 => tok.parse::<f32>().map(f64::from).ok(),
+                _ => tok.parse::<f64>().ok(),
+            };
+            *v = parsed.ok_or_else(|| PlyError::Ascii {
                 line: line_no,
                 message: format!(
                     "value {tok:?} of property '{}' is not a number",
