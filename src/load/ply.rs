@@ -562,6 +562,7 @@ fn decode_binary(
 ) -> Result<(SplatCloud, usize), PlyError> {
     let n = rows.len().checked_div(l.stride).unwrap_or(0);
     let k = sh_coeff_count(l.sh_degree);
+    let all_f32_le = !be && l.cols.iter().all(|&(_, t)| t == Scalar::F32);
     let mut cloud = SplatCloud::new(l.sh_degree);
     cloud.positions = vec![[0.0; 3]; n];
     cloud.scales = vec![[0.0; 3]; n];
@@ -581,21 +582,24 @@ fn decode_binary(
             let mut non_unit = 0;
             for i in 0..p.len() {
                 let row = &raw[i * l.stride..(i + 1) * l.stride];
-                let get = |c: usize| {
-                    let (off, ty) = l.cols[c];
-                    ty.read(&row[off..], be)
+                let out = (&mut p[i], &mut s[i], &mut r[i], &mut o[i]);
+                let sh = &mut sh[i * k..(i + 1) * k];
+                // The common case (every column f32, little endian) gets its own
+                // monomorphised copy of `convert_row` without the per-value type dispatch.
+                let off = if all_f32_le {
+                    let get = |c: usize| {
+                        let off = l.cols[c].0;
+                        f32::from_le_bytes([row[off], row[off + 1], row[off + 2], row[off + 3]])
+                            as f64
+                    };
+                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
+                } else {
+                    let get = |c: usize| {
+                        let (off, ty) = l.cols[c];
+                        ty.read(&row[off..], be)
+                    };
+                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
                 };
-                let off = convert_row(
-                    l,
-                    props,
-                    b * BLOCK + i,
-                    get,
-                    &mut p[i],
-                    &mut s[i],
-                    &mut r[i],
-                    &mut o[i],
-                    &mut sh[i * k..(i + 1) * k],
-                )?;
                 non_unit += off as usize;
             }
             Ok(non_unit)
