@@ -13,6 +13,7 @@ pub mod cloud;
 pub mod covariance;
 pub mod image;
 pub mod load;
+pub mod reference;
 pub mod sh;
 pub mod validate;
 pub mod write;
