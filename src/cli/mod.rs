@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod info;
+mod render;
 mod validate;
 
 /// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
@@ -22,6 +23,8 @@ enum Command {
     /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
     Validate(validate::Args),
+    /// Render an image (without a scene: the bundled default scene).
+    Render(render::Args),
 }
 
 /// Parses the arguments and runs the subcommand.
@@ -30,5 +33,6 @@ pub fn run() -> ExitCode {
     match cli.command {
         Command::Info(a) => info::run(a),
         Command::Validate(a) => validate::run(a),
+        Command::Render(a) => render::run(a),
     }
 }

@@ -177,7 +177,9 @@ impl Image {
         let (w, h) = dim(tokens[1])
             .zip(dim(tokens[2]))
             .ok_or_else(|| bad("width/height must be integers in 1..=65536"))?;
-        let scale: f32 = tokens[3].parse().map_err(|_| bad("scale is not a number"))?;
+        let scale: f32 = tokens[3]
+            .parse()
+            .map_err(|_| bad("scale is not a number"))?;
         let little = scale < 0.0;
         let n = w as usize * h as usize * channels;
         let data = bytes
@@ -185,7 +187,12 @@ impl Image {
             .filter(|d| d.len() >= n * 4)
             .ok_or_else(|| bad("fewer samples than width × height"))?;
         let sample = |k: usize| {
-            let b = [data[4 * k], data[4 * k + 1], data[4 * k + 2], data[4 * k + 3]];
+            let b = [
+                data[4 * k],
+                data[4 * k + 1],
+                data[4 * k + 2],
+                data[4 * k + 3],
+            ];
             if little {
                 f32::from_le_bytes(b)
             } else {
