@@ -10,6 +10,7 @@
 
 pub mod camera;
 pub mod cloud;
+pub mod compare;
 pub mod covariance;
 pub mod image;
 pub mod load;

@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod compare;
 mod info;
 mod render;
 mod validate;
@@ -25,6 +26,9 @@ enum Command {
     Validate(validate::Args),
     /// Render an image (without a scene: the bundled default scene).
     Render(render::Args),
+    /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
+    /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
+    Compare(compare::Args),
 }
 
 /// Parses the arguments and runs the subcommand.
@@ -34,5 +38,6 @@ pub fn run() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Render(a) => render::run(a),
+        Command::Compare(a) => compare::run(a),
     }
 }
