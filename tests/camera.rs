@@ -15,7 +15,11 @@ fn project_3dgs(r: [[f64; 3]; 3], c: [f64; 3], f: [f64; 2], pp: [f64; 2], p: DVe
 
 fn rows(m: DMat3) -> [[f64; 3]; 3] {
     let t = m.transpose(); // columns of the transpose are rows
-    [t.x_axis.to_array(), t.y_axis.to_array(), t.z_axis.to_array()]
+    [
+        t.x_axis.to_array(),
+        t.y_axis.to_array(),
+        t.z_axis.to_array(),
+    ]
 }
 
 const POINTS: [[f64; 3]; 4] = [
@@ -75,7 +79,10 @@ fn cameras_json_errors_name_the_entry_and_key() {
     let mirror = r#"[{"width":10,"height":10,"position":[0,0,0],
                      "rotation":[[1,0,0],[0,1,0],[0,0,-1]],"fx":1,"fy":1}]"#;
     let e = &parse_cameras_json(mirror).unwrap()[0];
-    assert!(matches!(Camera::from_3dgs(e), Err(CameraError::Degenerate(_))));
+    assert!(matches!(
+        Camera::from_3dgs(e),
+        Err(CameraError::Degenerate(_))
+    ));
 }
 
 fn gltf(node: Mat4, aspect: Option<f32>) -> GltfPerspective {
@@ -100,7 +107,10 @@ fn gltf_camera_looks_down_minus_z_with_y_up() {
     // No aspectRatio: the viewport's (2), square pixels → right edge at x = 5·2·tan.
     let (right, _) = cam.project(Vec3::new(10.0 * t, 0.0, -5.0)).unwrap();
     assert!((right.x - 200.0).abs() < 1e-3, "{right}");
-    assert!(cam.project(Vec3::new(0.0, 0.0, 5.0)).is_none(), "+Z is behind");
+    assert!(
+        cam.project(Vec3::new(0.0, 0.0, 5.0)).is_none(),
+        "+Z is behind"
+    );
     // aspectRatio 1.5 on a 200×100 viewport: x edge at 5·1.5·tan maps to the right border.
     let cam = Camera::from_gltf(&gltf(Mat4::IDENTITY, Some(1.5)), 200, 100).unwrap();
     let (right, _) = cam.project(Vec3::new(7.5 * t, 0.0, -5.0)).unwrap();
@@ -157,7 +167,11 @@ fn framing_keeps_the_bulk_of_the_points_in_view() {
     let mut pts: Vec<[f32; 3]> = (0..1000)
         .map(|i| {
             let t = i as f32 * 0.37;
-            [t.sin() * 3.0 + 10.0, (t * 1.3).cos() - 5.0, (t * 0.7).sin() * 2.0]
+            [
+                t.sin() * 3.0 + 10.0,
+                (t * 1.3).cos() - 5.0,
+                (t * 0.7).sin() * 2.0,
+            ]
         })
         .collect();
     pts.push([1e6, 0.0, 0.0]); // a stray splat must not shrink the view
