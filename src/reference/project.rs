@@ -32,6 +32,9 @@ pub struct Projected {
     pub conic: [f32; 3],
     /// Opacity attribute.
     pub opacity: f32,
+    /// A pure optimisation: beyond this m² no pixel can reach α ≥ 1/255, so the exponential
+    /// is skipped: `min(9, 2·ln(255·opacity) + 1e-3)` (the margin covers f32 rounding).
+    pub m2_max: f32,
     /// SH colour (negatives clamped to 0).
     pub color: [f32; 3],
     /// `[x0, x1, y0, y1]`: the pixels `x0..x1` × `y0..y1` (exclusive ends) whose centres lie in
@@ -130,6 +133,7 @@ impl ViewContext {
             cov: [a as f32, b as f32, c as f32],
             conic: [(c / det) as f32, (-b / det) as f32, (a / det) as f32],
             opacity,
+            m2_max: (2.0 * (255.0 * opacity as f64).ln() + 1e-3).min(CUTOFF_M2 as f64) as f32,
             color,
             bbox: [bbox.0.0, bbox.0.1, bbox.1.0, bbox.1.1],
         })

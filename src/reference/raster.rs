@@ -29,7 +29,7 @@ pub fn bin(splats: &[Projected], width: u32, height: u32) -> Vec<Vec<u32>> {
 pub fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
     let [a, b, c] = s.conic;
     let m2 = a * dx * dx + 2.0 * b * dx * dy + c * dy * dy;
-    if m2 > CUTOFF_M2 {
+    if m2 > CUTOFF_M2 || m2 > s.m2_max {
         return;
     }
     let alpha = (s.opacity * (-0.5 * m2).exp()).min(ALPHA_MAX);
