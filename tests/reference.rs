@@ -127,14 +127,13 @@ fn solve6(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> [f64; 6] {
             .unwrap();
         a.swap(c, p);
         b.swap(c, p);
-        for r in 0..6 {
-            if r != c {
-                let f = a[r][c] / a[c][c];
-                for k in 0..6 {
-                    a[r][k] -= f * a[c][k];
-                }
-                b[r] -= f * b[c];
+        let (pivot, pb) = (a[c], b[c]);
+        for r in (0..6).filter(|&r| r != c) {
+            let f = a[r][c] / pivot[c];
+            for (x, p) in a[r].iter_mut().zip(pivot) {
+                *x -= f * p;
             }
+            b[r] -= f * pb;
         }
     }
     std::array::from_fn(|i| b[i] / a[i][i])

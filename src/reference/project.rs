@@ -98,12 +98,13 @@ impl ViewContext {
     /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
     pub fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
         let opacity = cloud.opacities[i];
-        if !(opacity.min(ALPHA_MAX) >= ALPHA_MIN) {
-            return None; // no pixel can reach α ≥ 1/255 (also NaN)
+        let best_alpha = opacity.min(ALPHA_MAX);
+        if best_alpha.is_nan() || best_alpha < ALPHA_MIN {
+            return None; // no pixel can reach α ≥ 1/255
         }
         let mean = DVec3::from_array(cloud.positions[i].map(f64::from));
         let t = self.w2c.transform_point3(mean);
-        if !(t.z > self.cull_z) || !t.is_finite() {
+        if !t.is_finite() || t.z <= self.cull_z {
             return None;
         }
         let sigma = unpack_sym(covariance_from_scale_rotation(

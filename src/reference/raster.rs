@@ -37,8 +37,8 @@ pub fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
         return;
     }
     let keep = 1.0 - alpha;
-    for ch in 0..3 {
-        px[ch] = s.color[ch] * alpha + px[ch] * keep;
+    for (p, c) in px[..3].iter_mut().zip(s.color) {
+        *p = c * alpha + *p * keep;
     }
     px[3] = alpha + px[3] * keep;
 }
