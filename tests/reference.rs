@@ -598,3 +598,84 @@ fn renders_every_real_ply_that_loads() {
         dir.display()
     );
 }
+
+/// The `splatgl` binary with `args`; (exit code, stderr).
+fn splatgl(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_splatgl"))
+        .args(args)
+        .output()
+        .expect("run splatgl");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (
+        out.status.code().unwrap_or(-1),
+        text(&out.stdout),
+        text(&out.stderr),
+    )
+}
+
+#[test]
+fn cli_renders_the_default_scene_and_compares() {
+    let dir = std::env::temp_dir().join(format!("splatgl-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, pfm, png16) = (dir.join("a.png"), dir.join("a.pfm"), dir.join("b.png"));
+    let p = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    let size = ["--width", "64", "--height", "48"];
+    for (out, extra) in [(&png, None), (&pfm, None), (&png16, Some("--depth16"))] {
+        let mut args = vec!["render", "-o"];
+        let out = p(out);
+        args.push(&out);
+        args.extend(size);
+        args.extend(extra);
+        let (code, _, err) = splatgl(&args);
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            err.contains("splats") && err.contains("ms"),
+            "progress line: {err}"
+        );
+    }
+    let a = Image::read(&png).unwrap();
+    let f = Image::read(&pfm).unwrap();
+    assert_eq!((a.width, a.height), (64, 48));
+    // The 8-bit PNG is the float image quantised.
+    for (q, x) in a.pixels.iter().zip(&f.pixels) {
+        for c in 0..3 {
+            assert!((q[c] - x[c].clamp(0.0, 1.0)).abs() <= 0.5 / 255.0 + 1e-6);
+        }
+    }
+    let (code, out, _) = splatgl(&["compare", &p(&pfm), &p(&pfm), "--json", "--max-abs", "0"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["identical"], true);
+    let diff = p(&dir.join("d.png"));
+    let (code, out, _) = splatgl(&[
+        "compare",
+        &p(&png),
+        &p(&png16),
+        "--diff",
+        &diff,
+        "--max-abs",
+        "0",
+    ]);
+    assert_eq!(code, 1, "8- and 16-bit quantisations differ: {out}");
+    assert!(Image::read(&diff).is_ok());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn cli_errors_are_reported_not_panics() {
+    let cases: [&[&str]; 5] = [
+        &["render", "--look-at", "1,2,3", "-o", "x.png"],
+        &["render", "--gltf-camera", "0", "-o", "x.png"],
+        &["render", "-o", "x.jpg", "--width", "8", "--height", "8"],
+        &["render", "/nonexistent/scene.ply"],
+        &["compare", "/nonexistent/a.png", "/nonexistent/b.png"],
+    ];
+    for args in cases {
+        let (code, _, err) = splatgl(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}
