@@ -50,10 +50,10 @@ pub struct Args {
     #[arg(long, value_name = "N")]
     pub gltf_camera: Option<usize>,
     /// Image width (default 640, or the cameras.json view's, scaled).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: Option<u32>,
     /// Image height (default 480, or the cameras.json view's, scaled).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: Option<u32>,
     /// Vertical field of view in degrees (look-at and automatic framing).
     #[arg(long, default_value_t = 50.0, value_name = "DEG")]
