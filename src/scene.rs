@@ -174,3 +174,23 @@ pub fn default_camera(width: u32, height: u32) -> Camera {
         height,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scenes_are_deterministic_and_well_formed() {
+        let a = default_scene();
+        assert_eq!(a, default_scene());
+        assert!(a.check_lengths().is_ok() && a.sh_degree == 1 && a.len() > 3000);
+        let r = random_cloud(100, 3, 2.0, 5);
+        assert_eq!(r, random_cloud(100, 3, 2.0, 5));
+        assert_ne!(r, random_cloud(100, 3, 2.0, 6));
+        assert!(r.check_lengths().is_ok());
+        assert!(r.rotations.iter().all(|q| {
+            let n: f32 = q.iter().map(|v| v * v).sum();
+            (n - 1.0).abs() < 1e-5
+        }));
+    }
+}

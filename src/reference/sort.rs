@@ -46,3 +46,23 @@ pub fn back_to_front(positions: &[[f32; 3]], camera: &Camera, mode: SortMode) ->
     order.sort_by(|&a, &b| keys[b as usize].total_cmp(&keys[a as usize]));
     order
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn farthest_first_ties_by_index() {
+        let cam = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 1.0, 8, 8);
+        // Distances 2, 5, 2, 1 (indices 0 and 2 tie); view depths 2, 3, 0, 1.
+        let p = [
+            [0.0, 0.0, 2.0],
+            [4.0, 0.0, 3.0],
+            [0.0, 2.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        assert_eq!(back_to_front(&p, &cam, SortMode::Distance), [1, 0, 2, 3]);
+        assert_eq!(back_to_front(&p, &cam, SortMode::ViewDepth), [1, 0, 3, 2]);
+    }
+}
