@@ -10,9 +10,12 @@
 
 pub mod camera;
 pub mod cloud;
+pub mod compare;
 pub mod covariance;
 pub mod image;
 pub mod load;
+pub mod reference;
+pub mod scene;
 pub mod sh;
 pub mod validate;
 pub mod write;
