@@ -158,3 +158,22 @@ fn validate_flags_cesium_profile() {
         );
     }
 }
+
+#[test]
+fn bevy_camera_node() {
+    let Some(p) = real("bevy_khr_conformance_matrix.gltf") else {
+        return;
+    };
+    let bytes = std::fs::read(&p).unwrap();
+    let cams = splatgl::load::gltf::cameras(&bytes, splatgl::load::Format::Gltf, Some(&p)).unwrap();
+    assert_eq!(cams.len(), 1);
+    assert_eq!(
+        cams[0].node_to_world.w_axis.truncate(),
+        glam::Vec3::new(4.0, 5.0, 6.0)
+    );
+    let cam = splatgl::camera::Camera::from_gltf(&cams[0], 64, 48).unwrap();
+    assert!((cam.eye() - glam::Vec3::new(4.0, 5.0, 6.0)).length() < 1e-5);
+    // glTF cameras look down −Z: a point straight ahead projects to the centre.
+    let (px, _) = cam.project(glam::Vec3::new(4.0, 5.0, 0.0)).unwrap();
+    assert!((px - glam::Vec2::new(32.0, 24.0)).length() < 1e-3, "{px}");
+}

@@ -74,7 +74,7 @@ pub fn run(a: Args) -> ExitCode {
         "memory:         {:.1} MiB",
         c.memory_bytes() as f64 / 1048576.0
     );
-    for w in &warnings {
+    for w in r.summarized_warnings() {
         println!("warning: {w}");
     }
     ExitCode::SUCCESS

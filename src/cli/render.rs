@@ -79,6 +79,10 @@ pub struct Args {
     /// Keep alpha (1 − T): RGBA PNG; for .pfm also writes NAME.alpha.pfm.
     #[arg(long)]
     pub alpha: bool,
+    /// How glTF SCALE values are read: auto (signed types or negatives mean the review
+    /// draft's log space), linear (RC) or log.
+    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
+    pub scale_space: splatgl::load::ScaleSpace,
 }
 
 fn floats(s: &str, what: &str, counts: &[usize]) -> Result<Vec<f32>, String> {
@@ -130,12 +134,32 @@ fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, St
         let (w, h) = size_or(a, cam.width, cam.height);
         return Ok(cam.resized(w, h));
     }
-    if a.gltf_camera.is_some() {
-        return Err(
-            "--gltf-camera: not available yet (glTF camera loading lands with the \
-                    glTF loader); use --look-at or --camera"
-                .into(),
-        );
+    if let Some(n) = a.gltf_camera {
+        let Some(path) = &a.scene else {
+            return Err("--gltf-camera needs a glTF scene file".into());
+        };
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let format = splatgl::load::detect_format(&bytes, Some(path));
+        let format = match format {
+            Some(f @ (splatgl::load::Format::Gltf | splatgl::load::Format::Glb)) => f,
+            _ => return Err("--gltf-camera needs a .gltf or .glb scene".into()),
+        };
+        let cams = splatgl::load::gltf::cameras(&bytes, format, Some(path))
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let g = cams.get(n).ok_or_else(|| {
+            format!(
+                "--gltf-camera {n}: {} has {} perspective camera node(s)",
+                path.display(),
+                cams.len()
+            )
+        })?;
+        // Keep the camera's aspect ratio when no size is given.
+        let h = a.height.unwrap_or(480);
+        let w = a.width.unwrap_or_else(|| {
+            g.aspect_ratio
+                .map_or(640, |r| ((h as f32 * r).round() as u32).clamp(1, 16384))
+        });
+        return Camera::from_gltf(g, w, h).map_err(|e| e.to_string());
     }
     let (w, h) = size_or(a, 640, 480);
     if let Some(s) = &a.look_at {
@@ -196,7 +220,7 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
     let (cloud, ply) = match &a.scene {
-        Some(p) => load(p)?,
+        Some(p) => load(p, a.scale_space)?,
         None => (splatgl::scene::default_scene(), false),
     };
     let cam = camera(a, &cloud, ply)?;
@@ -231,9 +255,13 @@ fn go(a: &Args) -> Result<(), String> {
 }
 
 /// The cloud and whether it came from a PLY (COLMAP axes) rather than glTF (+Y up).
-fn load(p: &Path) -> Result<(splatgl::SplatCloud, bool), String> {
-    let l = splatgl::load::load_path(p, &Default::default()).map_err(|e| e.to_string())?;
-    for w in &l.report.warnings {
+fn load(
+    p: &Path,
+    scale_space: splatgl::load::ScaleSpace,
+) -> Result<(splatgl::SplatCloud, bool), String> {
+    let opts = splatgl::load::LoadOptions { scale_space };
+    let l = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
+    for w in l.report.summarized_warnings() {
         eprintln!("warning: {w}");
     }
     Ok((l.cloud, l.report.format == splatgl::load::Format::Ply))

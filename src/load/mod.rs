@@ -138,6 +138,25 @@ impl LoadReport {
             warnings: Vec::new(),
         }
     }
+    /// The warnings for people: identical messages merged into one line naming the first
+    /// location and how many more there are, in first-seen order.
+    pub fn summarized_warnings(&self) -> Vec<String> {
+        let mut groups: Vec<(&Warning, usize)> = Vec::new();
+        for w in &self.warnings {
+            match groups.iter_mut().find(|(g, _)| g.message == w.message) {
+                Some((_, n)) => *n += 1,
+                None => groups.push((w, 1)),
+            }
+        }
+        groups
+            .into_iter()
+            .map(|(w, n)| match n {
+                1 => w.to_string(),
+                n => format!("{w} (and {} more like it)", n - 1),
+            })
+            .collect()
+    }
+
     pub(crate) fn warn(&mut self, location: impl Into<String>, message: impl Into<String>) {
         self.warnings.push(Warning {
             location: location.into(),

@@ -219,21 +219,35 @@ fn scene_meshes(
     findings: &mut Vec<Finding>,
     out: &mut Vec<(usize, usize, DMat4)>,
 ) {
-    fn visit(node: gltf::Node, parent: DMat4, out: &mut Vec<(usize, usize, DMat4)>) {
-        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-        let m = parent * local;
+    for (node, m) in scene_nodes(doc, json, findings) {
         if let Some(mesh) = node.mesh() {
             out.push((node.index(), mesh.index(), m));
         }
-        for c in node.children() {
+    }
+}
+
+/// Every node of the default scene (or scene 0; without scenes, every root's tree) with its
+/// global matrix, depth first in document order.
+fn scene_nodes<'d>(
+    doc: &'d gltf::Document,
+    json: &Value,
+    findings: &mut Vec<Finding>,
+) -> Vec<(gltf::Node<'d>, DMat4)> {
+    fn visit<'d>(node: gltf::Node<'d>, parent: DMat4, out: &mut Vec<(gltf::Node<'d>, DMat4)>) {
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let m = parent * local;
+        let children: Vec<_> = node.children().collect();
+        out.push((node, m));
+        for c in children {
             visit(c, m, out);
         }
     }
+    let mut out = Vec::new();
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
     match scene {
         Some(s) => {
             for n in s.nodes() {
-                visit(n, DMat4::IDENTITY, out);
+                visit(n, DMat4::IDENTITY, &mut out);
             }
         }
         None => {
@@ -253,11 +267,42 @@ fn scene_meshes(
             }
             for node in doc.nodes() {
                 if !is_child[node.index()] {
-                    visit(node, DMat4::IDENTITY, out);
+                    visit(node, DMat4::IDENTITY, &mut out);
                 }
             }
         }
     }
+    out
+}
+
+/// The perspective camera nodes of the scene, in scene traversal order (depth first), with
+/// their global transforms. Orthographic cameras are skipped (splat rendering with them is
+/// undefined per the RC).
+pub fn cameras(
+    bytes: &[u8],
+    format: Format,
+    path: Option<&Path>,
+) -> Result<Vec<crate::camera::GltfPerspective>, GltfError> {
+    let mut findings = Vec::new();
+    let parsed = container::parse(bytes, format, path, &mut findings)?;
+    let Some(doc) = &parsed.doc else {
+        let f = findings.into_iter().find(|f| f.blocks_loading);
+        return Err(f.map_or(GltfError::NoSplats, GltfError::Invalid));
+    };
+    let mut out = Vec::new();
+    for (node, m) in scene_nodes(doc, &parsed.json, &mut findings) {
+        let Some(cam) = node.camera() else { continue };
+        if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+            out.push(crate::camera::GltfPerspective {
+                yfov: p.yfov(),
+                aspect_ratio: p.aspect_ratio(),
+                znear: p.znear(),
+                zfar: p.zfar(),
+                node_to_world: m.as_mat4(),
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Loads a glTF or GLB file from memory (`path` resolves external buffers).
