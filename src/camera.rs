@@ -272,7 +272,10 @@ impl Camera {
         }
         let (lo, hi) = (Vec3::from_array(lo), Vec3::from_array(hi));
         let centre = 0.5 * (lo + hi);
-        let radius = (0.5 * (hi - lo).length()).max(1e-3);
+        // A single point (or coincident ones) has no extent: frame a unit sphere around it, so
+        // the camera stays outside the near cull.
+        let half = 0.5 * (hi - lo).length();
+        let radius = if half > 1e-6 { half.max(1e-3) } else { 1.0 };
         let tan_y = (0.5 * fov_y).tan();
         let tan_min = tan_y.min(tan_y * width as f32 / height.max(1) as f32);
         // The bounding sphere fits when dist · sin(half fov) ≥ radius; 10 % margin.

@@ -556,7 +556,7 @@ fn cameras_json_views_place_means_where_the_trainer_projects_them() {
 }
 
 #[test]
-fn renders_every_real_ply_that_loads() {
+fn renders_every_real_file_that_loads() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
     let Ok(entries) = std::fs::read_dir(&dir) else {
         eprintln!("skipping: {} not found", dir.display());
@@ -564,7 +564,10 @@ fn renders_every_real_ply_that_loads() {
     };
     let mut paths: Vec<_> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "ply"))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|e| e == "ply" || e == "gltf" || e == "glb")
+        })
         .collect();
     paths.sort();
     let mut rendered = 0;
@@ -594,7 +597,7 @@ fn renders_every_real_ply_that_loads() {
     }
     assert!(
         rendered > 0,
-        "at least one PLY in {} must load",
+        "at least one file in {} must load",
         dir.display()
     );
 }
