@@ -139,7 +139,10 @@ mod tests {
             let ndc = clip.truncate() / clip.w;
             let u = (ndc.x + 1.0) * 0.5 * 640.0;
             let v = (1.0 - ndc.y) * 0.5 * 480.0;
-            assert!((u - px.x).abs() < 1e-3 && (v - px.y).abs() < 1e-3, "{u},{v} vs {px}");
+            assert!(
+                (u - px.x).abs() < 1e-3 && (v - px.y).abs() < 1e-3,
+                "{u},{v} vs {px}"
+            );
         }
     }
 
@@ -149,7 +152,10 @@ mod tests {
         let (c, z) = cam.project(Vec3::ZERO).unwrap();
         assert!((c - Vec2::new(50.0, 40.0)).length() < 1e-4 && (z - 5.0).abs() < 1e-5);
         let (up, _) = cam.project(Vec3::Y).unwrap();
-        assert!(up.y < 40.0, "world +y must be above the centre (smaller row)");
+        assert!(
+            up.y < 40.0,
+            "world +y must be above the centre (smaller row)"
+        );
         assert!((cam.eye() - Vec3::new(0.0, 0.0, 5.0)).length() < 1e-5);
     }
 }

@@ -393,9 +393,21 @@ mod tests {
     #[test]
     fn append_unifies_degree() {
         let mut a = SplatCloud::new(3);
-        a.push([0.0; 3], [1.0; 3], [0.0, 0.0, 0.0, 1.0], 0.5, &[[1.0; 3]; 16]);
+        a.push(
+            [0.0; 3],
+            [1.0; 3],
+            [0.0, 0.0, 0.0, 1.0],
+            0.5,
+            &[[1.0; 3]; 16],
+        );
         let mut b = SplatCloud::new(1);
-        b.push([1.0; 3], [1.0; 3], [0.0, 0.0, 0.0, 1.0], 0.5, &[[2.0; 3]; 4]);
+        b.push(
+            [1.0; 3],
+            [1.0; 3],
+            [0.0, 0.0, 0.0, 1.0],
+            0.5,
+            &[[2.0; 3]; 4],
+        );
         assert!(a.append(b));
         assert_eq!(a.sh_degree, 1);
         assert_eq!(a.sh.len(), 8);

@@ -185,7 +185,13 @@ mod tests {
     fn rotated_sh_equals_sh_at_inverse_rotated_direction() {
         let q = DMat3::from_euler(glam::EulerRot::ZYX, 0.7, -0.4, 2.1);
         let coeffs: Vec<[f32; 3]> = (0..16)
-            .map(|k| [k as f32 * 0.1 - 0.7, (k * k) as f32 * 0.01, -(k as f32) * 0.05])
+            .map(|k| {
+                [
+                    k as f32 * 0.1 - 0.7,
+                    (k * k) as f32 * 0.01,
+                    -(k as f32) * 0.05,
+                ]
+            })
             .collect();
         let mut rotated = coeffs.clone();
         ShRotation::new(q).apply(&mut rotated);

@@ -37,7 +37,9 @@ pub enum PlyError {
     #[error("unsupported PLY layout: {0}")]
     Unsupported(String),
     /// `f_rest_*` count is not one of 0, 9, 24, 45.
-    #[error("element 'vertex': {count} f_rest_* properties; expected 0, 9, 24 or 45 (SH degree 0-3)")]
+    #[error(
+        "element 'vertex': {count} f_rest_* properties; expected 0, 9, 24 or 45 (SH degree 0-3)"
+    )]
     BadShCount {
         /// How many there are.
         count: usize,
@@ -352,7 +354,12 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
         rest,
         opacity: need("opacity")?,
         scale: [need("scale_0")?, need("scale_1")?, need("scale_2")?],
-        rot: [need("rot_0")?, need("rot_1")?, need("rot_2")?, need("rot_3")?],
+        rot: [
+            need("rot_0")?,
+            need("rot_1")?,
+            need("rot_2")?,
+            need("rot_3")?,
+        ],
         cols,
         stride: off,
         sh_degree,
@@ -464,7 +471,12 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
                     available: rows.len() as u64,
                 });
             }
-            decode_binary(&l, &vertex.props, &rows[..needed as usize], enc == Encoding::Be)?
+            decode_binary(
+                &l,
+                &vertex.props,
+                &rows[..needed as usize],
+                enc == Encoding::Be,
+            )?
         }
     };
     if non_unit > 0 {

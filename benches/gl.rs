@@ -1,0 +1,2 @@
+//! GL benchmark.
+fn main() {}
