@@ -8,8 +8,63 @@
 //! - [`Camera::gl_view`] / [`Camera::gl_projection`] give the same mapping in OpenGL's
 //!   conventions (camera looks down −z, +y up, NDC y = +1 at the top image row). A renderer that
 //!   reads an FBO back must flip rows (GL row 0 is the bottom).
+//!
+//! # Constructors
+//! - [`Camera::look_at`]: eye, target, up, vertical field of view.
+//! - [`Camera::from_3dgs`]: one entry of a 3DGS `cameras.json` ([`parse_cameras_json`]).
+//! - [`Camera::from_gltf`]: a glTF perspective camera on a node ([`GltfPerspective`]).
+//! - [`Camera::frame_points`]: frames a point set (the CLI's default view).
+//!
+//! All of them produce the same type, so both backends and every test see one camera model.
 
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use glam::{DMat3, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
+
+mod json;
+pub use json::{CamerasJsonEntry, load_cameras_json, parse_cameras_json};
+
+/// Why a camera could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraError {
+    /// A file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Not JSON.
+    #[error("cameras.json: {0}")]
+    Json(#[from] serde_json::Error),
+    /// JSON of the wrong shape or with out-of-range values.
+    #[error("cameras.json: {location}: {message}")]
+    Invalid {
+        /// Where, e.g. `[3].rotation[1][2]`.
+        location: String,
+        /// What was expected.
+        message: String,
+    },
+    /// Parameters that give no usable camera (zero size, non-finite or non-positive focal
+    /// length, degenerate pose).
+    #[error("invalid camera: {0}")]
+    Degenerate(String),
+}
+
+/// A glTF 2.0 perspective camera as instanced by a node, in the glTF convention: the camera
+/// looks down its local −Z with +Y up and +X right.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GltfPerspective {
+    /// Vertical field of view, radians.
+    pub yfov: f32,
+    /// Aspect ratio (width / height) of the field of view; `None`: the viewport's.
+    pub aspect_ratio: Option<f32>,
+    /// Near clipping distance (> 0).
+    pub znear: f32,
+    /// Far clipping distance; `None`: infinite projection.
+    pub zfar: Option<f32>,
+    /// The node's global transform (local → world).
+    pub node_to_world: Mat4,
+}
 
 /// A pinhole camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +119,171 @@ impl Camera {
         }
     }
 
+    /// A camera from a rotation camera → world (OpenCV axes) and the camera centre. The
+    /// rotation is orthonormalised first (Gram–Schmidt on its columns, in f64).
+    fn from_pose(r_c2w: DMat3, centre: DVec3) -> Result<Mat4, CameraError> {
+        let x = r_c2w.x_axis.normalize_or_zero();
+        let y = (r_c2w.y_axis - x * x.dot(r_c2w.y_axis)).normalize_or_zero();
+        let z = x.cross(y);
+        if x == DVec3::ZERO || y == DVec3::ZERO || !centre.is_finite() {
+            return Err(CameraError::Degenerate(
+                "pose rotation is singular or non-finite".into(),
+            ));
+        }
+        if z.dot(r_c2w.z_axis) <= 0.0 {
+            return Err(CameraError::Degenerate(
+                "pose rotation is a mirror (det < 0)".into(),
+            ));
+        }
+        // world → camera = [Rᵀ | −Rᵀ c].
+        let rt = DMat3::from_cols(x, y, z).transpose();
+        let t = -(rt * centre);
+        Ok(Mat4::from_cols(
+            rt.x_axis.as_vec3().extend(0.0),
+            rt.y_axis.as_vec3().extend(0.0),
+            rt.z_axis.as_vec3().extend(0.0),
+            t.as_vec3().extend(1.0),
+        ))
+    }
+
+    /// Checks that the intrinsics give a usable camera.
+    fn validated(self) -> Result<Self, CameraError> {
+        let ok = self.width > 0
+            && self.height > 0
+            && [self.fx, self.fy].iter().all(|f| f.is_finite() && *f > 0.0)
+            && self.cx.is_finite()
+            && self.cy.is_finite()
+            && self.near.is_finite()
+            && self.near > 0.0
+            && self.far > self.near
+            && self.world_to_camera.is_finite();
+        if ok {
+            Ok(self)
+        } else {
+            Err(CameraError::Degenerate(format!(
+                "{}x{} fx {} fy {} cx {} cy {} near {} far {}",
+                self.width, self.height, self.fx, self.fy, self.cx, self.cy, self.near, self.far
+            )))
+        }
+    }
+
+    /// A camera from one `cameras.json` entry of the INRIA 3DGS trainer: `rotation` is
+    /// camera → world (row i = `rotation[i]`), `position` the camera centre, OpenCV axes;
+    /// principal point `(cx, cy)` when present, else the image centre. `near`/`far` are the
+    /// trainer's 0.01 / 100.
+    pub fn from_3dgs(e: &CamerasJsonEntry) -> Result<Self, CameraError> {
+        let r = DMat3::from_cols_array_2d(&e.rotation).transpose(); // rows as written
+        let world_to_camera = Self::from_pose(r, DVec3::from_array(e.position))?;
+        Camera {
+            width: e.width,
+            height: e.height,
+            fx: e.fx as f32,
+            fy: e.fy as f32,
+            cx: e.cx.map_or(0.5 * e.width as f32, |v| v as f32),
+            cy: e.cy.map_or(0.5 * e.height as f32, |v| v as f32),
+            world_to_camera,
+            near: 0.01,
+            far: 100.0,
+        }
+        .validated()
+    }
+
+    /// A camera from a glTF perspective camera on a node, rendering `width × height` pixels.
+    ///
+    /// Follows the glTF projection matrix: `fy = (H/2) / tan(yfov/2)` and
+    /// `fx = (W/2) / (aspectRatio · tan(yfov/2))`; without `aspectRatio` the viewport's is
+    /// used, so `fx = fy`. (An `aspectRatio` different from W/H stretches the image, exactly as
+    /// the glTF matrix does on such a viewport.) The pose is the node's global transform with
+    /// scale removed (columns normalised, then Gram–Schmidt); GL axes (+Y up, −Z forward) are
+    /// converted to OpenCV axes by negating Y and Z. `far` is infinite without `zfar`.
+    pub fn from_gltf(g: &GltfPerspective, width: u32, height: u32) -> Result<Self, CameraError> {
+        let t = (0.5 * g.yfov as f64).tan();
+        if !(t.is_finite() && t > 0.0) || g.yfov >= std::f32::consts::PI {
+            return Err(CameraError::Degenerate(format!("yfov {}", g.yfov)));
+        }
+        let aspect = g
+            .aspect_ratio
+            .map_or(width as f64 / height.max(1) as f64, f64::from);
+        if !(aspect.is_finite() && aspect > 0.0) {
+            return Err(CameraError::Degenerate(format!("aspectRatio {aspect}")));
+        }
+        let m = g.node_to_world.as_dmat4();
+        let r = DMat3::from_cols(
+            m.x_axis.truncate(),
+            -m.y_axis.truncate(),
+            -m.z_axis.truncate(),
+        );
+        let world_to_camera = Self::from_pose(r, m.w_axis.truncate())?;
+        let fy = 0.5 * height as f64 / t;
+        let fx = 0.5 * width as f64 / (aspect * t);
+        Camera {
+            width,
+            height,
+            fx: fx as f32,
+            fy: fy as f32,
+            cx: 0.5 * width as f32,
+            cy: 0.5 * height as f32,
+            world_to_camera,
+            near: g.znear,
+            far: g.zfar.unwrap_or(f32::INFINITY),
+        }
+        .validated()
+    }
+
+    /// A camera that frames `points` (non-finite ones ignored): it looks at the centre of the
+    /// box spanned by the 1st..99th percentile of each coordinate (robust to stray splats) from
+    /// direction `(0, 0.35, 1)` (glTF is +Y up), far enough that the box's bounding sphere
+    /// fits the smaller field of view. `None` when there is no finite point.
+    pub fn frame_points(points: &[[f32; 3]], fov_y: f32, width: u32, height: u32) -> Option<Self> {
+        let mut axes: [Vec<f32>; 3] = Default::default();
+        for p in points.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
+            for (a, v) in axes.iter_mut().zip(p) {
+                a.push(*v);
+            }
+        }
+        if axes[0].is_empty() {
+            return None;
+        }
+        let (mut lo, mut hi) = ([0.0f32; 3], [0.0f32; 3]);
+        for k in 0..3 {
+            let a = &mut axes[k];
+            let n = a.len();
+            let (i0, i1) = ((n - 1) / 100, n - 1 - (n - 1) / 100);
+            lo[k] = *a.select_nth_unstable_by(i0, f32::total_cmp).1;
+            hi[k] = *a.select_nth_unstable_by(i1, f32::total_cmp).1;
+        }
+        let (lo, hi) = (Vec3::from_array(lo), Vec3::from_array(hi));
+        let centre = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(1e-3);
+        let tan_y = (0.5 * fov_y).tan();
+        let tan_min = tan_y.min(tan_y * width as f32 / height.max(1) as f32);
+        // The bounding sphere fits when dist · sin(half fov) ≥ radius; 10 % margin.
+        let dist = 1.1 * radius / tan_min.atan().sin();
+        let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
+        let eye = centre + dir * dist;
+        let mut cam = Self::look_at(eye, centre, Vec3::Y, fov_y, width, height);
+        cam.far = (dist + 2.0 * radius).max(cam.far);
+        Some(cam)
+    }
+
+    /// The same view at another resolution: focal lengths and principal point scale with the
+    /// size (`fx · W'/W`, `cx · W'/W`, likewise for y).
+    pub fn resized(&self, width: u32, height: u32) -> Self {
+        let (sx, sy) = (
+            width as f32 / self.width as f32,
+            height as f32 / self.height as f32,
+        );
+        Camera {
+            width,
+            height,
+            fx: self.fx * sx,
+            fy: self.fy * sy,
+            cx: self.cx * sx,
+            cy: self.cy * sy,
+            ..*self
+        }
+    }
+
     /// Camera centre in world space.
     pub fn eye(&self) -> Vec3 {
         self.world_to_camera.inverse().w_axis.truncate()
@@ -91,20 +311,21 @@ impl Camera {
     }
 
     /// OpenGL projection matrix that reproduces [`Camera::project`]: NDC x = 2u/W − 1,
-    /// NDC y = 1 − 2v/H, depth mapped from [near, far] to [−1, 1].
+    /// NDC y = 1 − 2v/H, depth mapped from [near, far] to [−1, 1]. With `far` infinite (glTF
+    /// cameras without `zfar`) it is the limit matrix: depth from [near, ∞) to [−1, 1).
     pub fn gl_projection(&self) -> Mat4 {
         let (w, h) = (self.width as f32, self.height as f32);
         let (n, f) = (self.near, self.far);
+        let (zz, zw) = if f.is_infinite() {
+            (-1.0, -2.0 * n)
+        } else {
+            (-(f + n) / (f - n), -2.0 * f * n / (f - n))
+        };
         Mat4::from_cols(
             Vec4::new(2.0 * self.fx / w, 0.0, 0.0, 0.0),
             Vec4::new(0.0, 2.0 * self.fy / h, 0.0, 0.0),
-            Vec4::new(
-                1.0 - 2.0 * self.cx / w,
-                2.0 * self.cy / h - 1.0,
-                -(f + n) / (f - n),
-                -1.0,
-            ),
-            Vec4::new(0.0, 0.0, -2.0 * f * n / (f - n), 0.0),
+            Vec4::new(1.0 - 2.0 * self.cx / w, 2.0 * self.cy / h - 1.0, zz, -1.0),
+            Vec4::new(0.0, 0.0, zw, 0.0),
         )
     }
 

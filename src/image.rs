@@ -53,3 +53,6 @@ impl Image {
         }
     }
 }
+
+mod io;
+pub use io::{ImageError, PngDepth};

@@ -10,6 +10,7 @@
 
 pub mod camera;
 pub mod cloud;
+pub mod compare;
 pub mod covariance;
 #[cfg(feature = "gl")]
 pub mod gl;
@@ -17,6 +18,8 @@ pub mod gl;
 pub mod headless;
 pub mod image;
 pub mod load;
+pub mod reference;
+pub mod scene;
 pub mod sh;
 pub mod validate;
 pub mod write;

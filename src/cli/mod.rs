@@ -3,7 +3,9 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod compare;
 mod info;
+mod render;
 mod validate;
 
 /// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
@@ -22,6 +24,11 @@ enum Command {
     /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
     Validate(validate::Args),
+    /// Render an image (without a scene: the bundled default scene).
+    Render(render::Args),
+    /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
+    /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
+    Compare(compare::Args),
 }
 
 /// Parses the arguments and runs the subcommand.
@@ -30,5 +37,7 @@ pub fn run() -> ExitCode {
     match cli.command {
         Command::Info(a) => info::run(a),
         Command::Validate(a) => validate::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Compare(a) => compare::run(a),
     }
 }

@@ -1,0 +1,123 @@
+//! 3DGS `cameras.json` (written by the INRIA trainer): a list of
+//! `{id, img_name, width, height, position[3], rotation[3][3], fx, fy}` with optional `cx`, `cy`.
+
+use super::CameraError;
+use serde_json::Value;
+
+/// One view of a `cameras.json`, values as written (f64).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CamerasJsonEntry {
+    /// `id`.
+    pub id: i64,
+    /// `img_name` (empty when absent).
+    pub img_name: String,
+    /// `width` in pixels.
+    pub width: u32,
+    /// `height` in pixels.
+    pub height: u32,
+    /// `position`: the camera centre in world space.
+    pub position: [f64; 3],
+    /// `rotation`: camera → world, `rotation[i]` is row i.
+    pub rotation: [[f64; 3]; 3],
+    /// `fx` in pixels.
+    pub fx: f64,
+    /// `fy` in pixels.
+    pub fy: f64,
+    /// `cx` if present.
+    pub cx: Option<f64>,
+    /// `cy` if present.
+    pub cy: Option<f64>,
+}
+
+fn invalid(location: String, message: impl Into<String>) -> CameraError {
+    CameraError::Invalid {
+        location,
+        message: message.into(),
+    }
+}
+
+fn number(v: Option<&Value>, loc: String) -> Result<f64, CameraError> {
+    match v.and_then(Value::as_f64) {
+        Some(x) if x.is_finite() => Ok(x),
+        Some(_) => Err(invalid(loc, "expected a finite number")),
+        None => Err(invalid(loc, "expected a number")),
+    }
+}
+
+fn size(v: Option<&Value>, loc: String) -> Result<u32, CameraError> {
+    match v.and_then(Value::as_u64) {
+        Some(x) if (1..=1 << 16).contains(&x) => Ok(x as u32),
+        _ => Err(invalid(loc, "expected an integer in 1..=65536")),
+    }
+}
+
+fn array<'a>(v: Option<&'a Value>, n: usize, loc: &str) -> Result<&'a [Value], CameraError> {
+    match v.and_then(Value::as_array) {
+        Some(a) if a.len() == n => Ok(a),
+        _ => Err(invalid(loc.to_owned(), format!("expected an array of {n}"))),
+    }
+}
+
+fn entry(i: usize, v: &Value) -> Result<CamerasJsonEntry, CameraError> {
+    let at = |k: &str| format!("[{i}].{k}");
+    if !v.is_object() {
+        return Err(invalid(format!("[{i}]"), "expected an object"));
+    }
+    let pos = array(v.get("position"), 3, &at("position"))?;
+    let mut position = [0.0; 3];
+    for (j, p) in pos.iter().enumerate() {
+        position[j] = number(Some(p), format!("{}[{j}]", at("position")))?;
+    }
+    let rows = array(v.get("rotation"), 3, &at("rotation"))?;
+    let mut rotation = [[0.0; 3]; 3];
+    for (r, row) in rows.iter().enumerate() {
+        let row = array(Some(row), 3, &format!("{}[{r}]", at("rotation")))?;
+        for (c, x) in row.iter().enumerate() {
+            rotation[r][c] = number(Some(x), format!("{}[{r}][{c}]", at("rotation")))?;
+        }
+    }
+    let opt = |k: &str| -> Result<Option<f64>, CameraError> {
+        match v.get(k) {
+            None | Some(Value::Null) => Ok(None),
+            some => number(some, at(k)).map(Some),
+        }
+    };
+    Ok(CamerasJsonEntry {
+        id: v.get("id").and_then(Value::as_i64).unwrap_or(i as i64),
+        img_name: v
+            .get("img_name")
+            .and_then(Value::as_str)
+            .unwrap_or_default()
+            .to_owned(),
+        width: size(v.get("width"), at("width"))?,
+        height: size(v.get("height"), at("height"))?,
+        position,
+        rotation,
+        fx: number(v.get("fx"), at("fx"))?,
+        fy: number(v.get("fy"), at("fy"))?,
+        cx: opt("cx")?,
+        cy: opt("cy")?,
+    })
+}
+
+/// Parses the text of a `cameras.json`. Every entry must be well-formed; errors name the entry
+/// and key.
+pub fn parse_cameras_json(text: &str) -> Result<Vec<CamerasJsonEntry>, CameraError> {
+    let v: Value = serde_json::from_str(text)?;
+    let list = v
+        .as_array()
+        .ok_or_else(|| invalid(String::new(), "expected a JSON array of cameras"))?;
+    list.iter().enumerate().map(|(i, e)| entry(i, e)).collect()
+}
+
+/// Reads and parses a `cameras.json` file.
+pub fn load_cameras_json(
+    path: impl AsRef<std::path::Path>,
+) -> Result<Vec<CamerasJsonEntry>, CameraError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|source| CameraError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    parse_cameras_json(&text)
+}

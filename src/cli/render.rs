@@ -1,0 +1,241 @@
+//! `splatgl render`: one image of a scene (or of the bundled default scene).
+
+use glam::Vec3;
+use splatgl::camera::{Camera, load_cameras_json};
+use splatgl::image::{Image, PngDepth};
+use splatgl::reference::{RenderOptions, SortMode};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Rendering backends. (`gl` joins when the GL backend lands; it will become the default.)
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// The CPU reference rasterizer (normative math, slow but exact).
+    Reference,
+}
+
+/// Blending order.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SortArg {
+    /// Euclidean distance camera → mean (the RC's `cameraDistance`).
+    Distance,
+    /// Camera-space depth (original 3DGS).
+    ViewDepth,
+}
+
+/// Arguments.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene file (.ply, .gltf, .glb). Without it: the bundled default scene.
+    pub scene: Option<PathBuf>,
+    /// 3DGS cameras.json to take the view from (see --view).
+    #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
+    pub camera: Option<PathBuf>,
+    /// Index (0-based, list order) of the view in --camera.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub view: usize,
+    /// Look-at camera: eye, target and optionally up (default 0,1,0).
+    #[arg(
+        long,
+        value_name = "ex,ey,ez,tx,ty,tz[,ux,uy,uz]",
+        allow_hyphen_values = true
+    )]
+    #[arg(conflicts_with = "gltf_camera")]
+    pub look_at: Option<String>,
+    /// Use the N-th glTF camera node of the scene.
+    #[arg(long, value_name = "N")]
+    pub gltf_camera: Option<usize>,
+    /// Image width (default 640, or the cameras.json view's, scaled).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default 480, or the cameras.json view's, scaled).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Vertical field of view in degrees (look-at and automatic framing).
+    #[arg(long, default_value_t = 50.0, value_name = "DEG")]
+    pub fov: f32,
+    /// Highest SH degree to evaluate (the file's degree caps it).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=3))]
+    pub sh_degree: u8,
+    /// Background colour, linear 0..1.
+    #[arg(long, default_value = "0,0,0", value_name = "r,g,b")]
+    pub background: String,
+    /// Blending order.
+    #[arg(long, value_enum, default_value_t = SortArg::Distance)]
+    pub sort: SortArg,
+    /// Renderer.
+    #[arg(long, value_enum, default_value_t = Backend::Reference)]
+    pub backend: Backend,
+    /// Output: .png (8-bit, or 16-bit with --depth16) or .pfm (32-bit float RGB).
+    #[arg(short, long, default_value = "out.png")]
+    pub output: PathBuf,
+    /// Write a 16-bit PNG.
+    #[arg(long)]
+    pub depth16: bool,
+    /// Keep alpha (1 − T): RGBA PNG; for .pfm also writes NAME.alpha.pfm.
+    #[arg(long)]
+    pub alpha: bool,
+}
+
+fn floats(s: &str, what: &str, counts: &[usize]) -> Result<Vec<f32>, String> {
+    let v: Result<Vec<f32>, _> = s.split(',').map(|t| t.trim().parse::<f32>()).collect();
+    match v {
+        Ok(v) if counts.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(format!(
+            "{what}: expected {} comma-separated finite numbers, got {s:?}",
+            counts
+                .iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(" or ")
+        )),
+    }
+}
+
+fn size_or(a: &Args, w: u32, h: u32) -> (u32, u32) {
+    match (a.width, a.height) {
+        (Some(x), Some(y)) => (x, y),
+        (Some(x), None) => (
+            x,
+            ((x as u64 * h as u64 + w as u64 / 2) / w as u64).max(1) as u32,
+        ),
+        (None, Some(y)) => (
+            ((y as u64 * w as u64 + h as u64 / 2) / h as u64).max(1) as u32,
+            y,
+        ),
+        (None, None) => (w, h),
+    }
+}
+
+fn camera(a: &Args, cloud: &splatgl::SplatCloud) -> Result<Camera, String> {
+    let fov = a.fov.to_radians();
+    if !(fov > 0.0 && fov < std::f32::consts::PI) {
+        return Err(format!("--fov {} must be in (0, 180)", a.fov));
+    }
+    if let Some(path) = &a.camera {
+        let list = load_cameras_json(path).map_err(|e| e.to_string())?;
+        let e = list.get(a.view).ok_or_else(|| {
+            format!(
+                "--view {}: {} has {} views",
+                a.view,
+                path.display(),
+                list.len()
+            )
+        })?;
+        let cam = Camera::from_3dgs(e).map_err(|e| e.to_string())?;
+        let (w, h) = size_or(a, cam.width, cam.height);
+        return Ok(cam.resized(w, h));
+    }
+    if a.gltf_camera.is_some() {
+        return Err(
+            "--gltf-camera: not available yet (glTF camera loading lands with the \
+                    glTF loader); use --look-at or --camera"
+                .into(),
+        );
+    }
+    let (w, h) = size_or(a, 640, 480);
+    if let Some(s) = &a.look_at {
+        let v = floats(s, "--look-at", &[6, 9])?;
+        let up = if v.len() == 9 {
+            Vec3::new(v[6], v[7], v[8])
+        } else {
+            Vec3::Y
+        };
+        let (eye, target) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+        let fwd = target - eye;
+        if fwd.length() == 0.0 || fwd.cross(up).length() <= 1e-6 * fwd.length() * up.length() {
+            return Err("--look-at: eye = target, or up parallel to the view direction".into());
+        }
+        return Ok(Camera::look_at(eye, target, up, fov, w, h));
+    }
+    if a.scene.is_none() {
+        return Ok(splatgl::scene::default_camera(w, h));
+    }
+    Camera::frame_points(&cloud.positions, fov, w, h)
+        .ok_or_else(|| "the scene has no finite splat to frame; give --look-at".into())
+}
+
+fn write(img: &Image, a: &Args) -> Result<(), String> {
+    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let r = match ext.to_ascii_lowercase().as_str() {
+        "png" => {
+            let depth = if a.depth16 {
+                PngDepth::Sixteen
+            } else {
+                PngDepth::Eight
+            };
+            img.write_png(&a.output, depth, a.alpha)
+        }
+        "pfm" => img.write_pfm(&a.output).and_then(|()| {
+            if a.alpha {
+                img.write_pfm_alpha(a.output.with_extension("alpha.pfm"))
+            } else {
+                Ok(())
+            }
+        }),
+        _ => {
+            return Err(format!(
+                "{}: output must end in .png or .pfm",
+                a.output.display()
+            ));
+        }
+    };
+    r.map_err(|e| e.to_string())
+}
+
+fn go(a: &Args) -> Result<(), String> {
+    let t0 = Instant::now();
+    let cloud = match &a.scene {
+        Some(p) => load(p)?,
+        None => splatgl::scene::default_scene(),
+    };
+    let cam = camera(a, &cloud)?;
+    let bg = floats(&a.background, "--background", &[3])?;
+    let opts = RenderOptions {
+        sh_degree: a.sh_degree,
+        background: [bg[0], bg[1], bg[2]],
+        sort: match a.sort {
+            SortArg::Distance => SortMode::Distance,
+            SortArg::ViewDepth => SortMode::ViewDepth,
+        },
+        ..Default::default()
+    };
+    let t1 = Instant::now();
+    let (img, stats) = match a.backend {
+        Backend::Reference => splatgl::reference::render_with_stats(&cloud, &cam, &opts),
+    };
+    let render_ms = t1.elapsed().as_secs_f64() * 1e3;
+    write(&img, a)?;
+    eprintln!(
+        "splatgl render: {} splats ({} visible), {}x{}, backend {:?}: render {render_ms:.1} ms, \
+         total {:.1} ms -> {}",
+        stats.splats,
+        stats.visible,
+        cam.width,
+        cam.height,
+        a.backend,
+        t0.elapsed().as_secs_f64() * 1e3,
+        a.output.display()
+    );
+    Ok(())
+}
+
+fn load(p: &Path) -> Result<splatgl::SplatCloud, String> {
+    let l = splatgl::load::load_path(p, &Default::default()).map_err(|e| e.to_string())?;
+    for w in &l.report.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(l.cloud)
+}
+
+/// Runs it. Exit status 0 on success, 2 on any error.
+pub fn run(a: Args) -> ExitCode {
+    match go(&a) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! The CPU reference rasterizer: the normative math of `KHR_gaussian_splatting` (RC) written
+//! directly from the spec text and the original 3DGS forward pass, independent of the shaders.
+//!
+//! Pipeline (see `docs/rendering-profile.md` for every choice the spec leaves open):
+//! 1. [`project::ViewContext::project`] per splat, in parallel: cull at view z ≤
+//!    [`RenderOptions::cull_depth`], Σ = R S² Rᵀ (global), Σ' = J W Σ Wᵀ Jᵀ with the
+//!    ±1.3·tan(half fov) clamp inside J, + 0.3 px² on the diagonal, colour from SH of degree
+//!    min(cloud, requested) along normalize(mean − eye), the 3σ bounding box.
+//! 2. [`back_to_front`]: camera distance (default) or view depth, stable, ties by index.
+//! 3. [`raster::bin`] into 16×16 tiles, then [`raster::rasterize`] per tile row in parallel:
+//!    at each pixel centre (x + 0.5, y + 0.5), m² = dᵀ Σ'⁻¹ d, skip m² > 9,
+//!    α = min(0.99, opacity · exp(−½ m²)), skip α < 1/255, and in f32
+//!    `C ← c·α + C·(1 − α)`, `A ← α + A·(1 − α)`, starting from (background, 0).
+
+pub mod project;
+pub mod raster;
+mod sort;
+
+pub use project::{NEAR_CULL_3DGS, Projected, ViewContext};
+pub use sort::{SortMode, back_to_front, sort_key};
+
+use crate::camera::Camera;
+use crate::cloud::SplatCloud;
+use crate::image::Image;
+use rayon::prelude::*;
+
+/// Options of a reference render.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderOptions {
+    /// Highest SH degree to evaluate; the cloud's degree caps it.
+    pub sh_degree: u8,
+    /// Background RGB (alpha of the background is 0).
+    pub background: [f32; 3],
+    /// Blending order.
+    pub sort: SortMode,
+    /// Splats with view z ≤ max(`near_cull`, camera.near) are culled (3DGS: 0.2).
+    pub near_cull: f32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            sh_degree: 3,
+            background: [0.0; 3],
+            sort: SortMode::Distance,
+            near_cull: NEAR_CULL_3DGS as f32,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// The depth at or below which splats are culled for `camera`:
+    /// `max(near_cull, camera.near)`.
+    pub fn cull_depth(&self, camera: &Camera) -> f32 {
+        self.near_cull.max(camera.near)
+    }
+}
+
+/// What a render did (for the CLI's progress line and for tests).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RenderStats {
+    /// Splats in the cloud.
+    pub splats: usize,
+    /// Splats that survived culling and touch the image.
+    pub visible: usize,
+    /// Splat–tile pairs rasterized.
+    pub tile_entries: usize,
+}
+
+/// Renders `cloud` as seen by `camera`.
+pub fn render(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Image {
+    render_with_stats(cloud, camera, opts).0
+}
+
+/// [`render`], also returning [`RenderStats`].
+pub fn render_with_stats(
+    cloud: &SplatCloud,
+    camera: &Camera,
+    opts: &RenderOptions,
+) -> (Image, RenderStats) {
+    let [r, g, b] = opts.background;
+    let mut image = Image::filled(camera.width, camera.height, [r, g, b, 0.0]);
+    let degree = opts.sh_degree.min(cloud.sh_degree);
+    let ctx = ViewContext::new(camera, opts.cull_depth(camera) as f64, degree);
+    let projected: Vec<Option<Projected>> = (0..cloud.len())
+        .into_par_iter()
+        .map(|i| ctx.project(cloud, i))
+        .collect();
+    let splats: Vec<Projected> = back_to_front(&cloud.positions, camera, opts.sort)
+        .into_iter()
+        .filter_map(|i| projected[i as usize])
+        .collect();
+    if camera.width == 0 || camera.height == 0 {
+        let stats = RenderStats {
+            splats: cloud.len(),
+            ..Default::default()
+        };
+        return (image, stats);
+    }
+    let tiles = raster::bin(&splats, camera.width, camera.height);
+    raster::rasterize(&mut image, &splats, &tiles);
+    let stats = RenderStats {
+        splats: cloud.len(),
+        visible: splats.len(),
+        tile_entries: tiles.iter().map(Vec::len).sum(),
+    };
+    (image, stats)
+}

@@ -1,0 +1,145 @@
+//! Per-splat preprocessing: cull, project the mean, Σ' = J W Σ Wᵀ Jᵀ (+ dilation), conic,
+//! 3σ bounding box, colour. Mirrors 3DGS `preprocessCUDA` / `computeCov2D`, in f64.
+
+use crate::camera::Camera;
+use crate::cloud::SplatCloud;
+use crate::covariance::{covariance_from_scale_rotation, unpack_sym};
+use glam::{DMat3, DMat4, DVec3};
+
+/// 3DGS culls splats whose camera-space depth is ≤ 0.2 (`in_frustum`).
+pub const NEAR_CULL_3DGS: f64 = 0.2;
+/// Added to the diagonal of Σ' (px²): the 3DGS low-pass / dilation.
+pub const DILATION_PX2: f64 = 0.3;
+/// x/z and y/z inside J are clamped to ±1.3·tan(half fov) (3DGS `computeCov2D`).
+pub const JACOBIAN_CLAMP: f64 = 1.3;
+/// Mahalanobis² cut-off: the RC's 3σ.
+pub const CUTOFF_M2: f32 = 9.0;
+/// α cap (3DGS `min(0.99, …)`).
+pub const ALPHA_MAX: f32 = 0.99;
+/// α below this is skipped (3DGS `alpha < 1/255`).
+pub const ALPHA_MIN: f32 = 1.0 / 255.0;
+
+/// One splat ready for rasterization (f32, pixel units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projected {
+    /// Index in the cloud.
+    pub index: u32,
+    /// Projected mean in pixels (top-left corner of the image = (0, 0)).
+    pub mean: [f32; 2],
+    /// Σ' after dilation, `[xx, xy, yy]` px².
+    pub cov: [f32; 3],
+    /// Σ'⁻¹, `[xx, xy, yy]`.
+    pub conic: [f32; 3],
+    /// Opacity attribute.
+    pub opacity: f32,
+    /// SH colour (negatives clamped to 0).
+    pub color: [f32; 3],
+    /// `[x0, x1, y0, y1]`: the pixels `x0..x1` × `y0..y1` (exclusive ends) whose centres lie in
+    /// the bounding box of the 3σ ellipse, clipped to the image; never empty.
+    pub bbox: [u32; 4],
+}
+
+/// Per-view constants shared by all splats.
+#[derive(Debug, Clone, Copy)]
+pub struct ViewContext {
+    w2c: DMat4,
+    w: DMat3,
+    eye: DVec3,
+    fx: f64,
+    fy: f64,
+    cx: f64,
+    cy: f64,
+    lim: [f64; 2],
+    cull_z: f64,
+    size: [u32; 2],
+    sh_degree: u8,
+}
+
+impl ViewContext {
+    /// Constants for `camera`; splats with view z ≤ `cull_z` are culled; SH up to `sh_degree`.
+    pub fn new(camera: &Camera, cull_z: f64, sh_degree: u8) -> Self {
+        let w2c = camera.world_to_camera.as_dmat4();
+        let tan = camera.tan_half_fov().as_dvec2();
+        ViewContext {
+            w2c,
+            w: DMat3::from_mat4(w2c),
+            eye: w2c.inverse().w_axis.truncate(),
+            fx: camera.fx as f64,
+            fy: camera.fy as f64,
+            cx: camera.cx as f64,
+            cy: camera.cy as f64,
+            lim: [JACOBIAN_CLAMP * tan.x, JACOBIAN_CLAMP * tan.y],
+            cull_z,
+            size: [camera.width, camera.height],
+            sh_degree,
+        }
+    }
+
+    /// Σ' = J W Σ Wᵀ Jᵀ + 0.3·I for a camera-space mean `t` and world covariance `sigma`,
+    /// as `[xx, xy, yy]`.
+    pub fn cov2d(&self, t: DVec3, sigma: DMat3) -> [f64; 3] {
+        let txtz = (t.x / t.z).clamp(-self.lim[0], self.lim[0]);
+        let tytz = (t.y / t.z).clamp(-self.lim[1], self.lim[1]);
+        let j0 = DVec3::new(self.fx / t.z, 0.0, -self.fx * txtz / t.z);
+        let j1 = DVec3::new(0.0, self.fy / t.z, -self.fy * tytz / t.z);
+        // Rows of J·W are Wᵀ jᵢ.
+        let (r0, r1) = (self.w.transpose() * j0, self.w.transpose() * j1);
+        let (s0, s1) = (sigma * r0, sigma * r1);
+        [
+            r0.dot(s0) + DILATION_PX2,
+            r0.dot(s1),
+            r1.dot(s1) + DILATION_PX2,
+        ]
+    }
+
+    /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
+    pub fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
+        let opacity = cloud.opacities[i];
+        if !(opacity.min(ALPHA_MAX) >= ALPHA_MIN) {
+            return None; // no pixel can reach α ≥ 1/255 (also NaN)
+        }
+        let mean = DVec3::from_array(cloud.positions[i].map(f64::from));
+        let t = self.w2c.transform_point3(mean);
+        if !(t.z > self.cull_z) || !t.is_finite() {
+            return None;
+        }
+        let sigma = unpack_sym(covariance_from_scale_rotation(
+            cloud.scales[i],
+            cloud.rotations[i],
+        ));
+        let [a, b, c] = self.cov2d(t, sigma);
+        let det = a * c - b * b;
+        if !(det > 0.0 && det.is_finite()) {
+            return None;
+        }
+        let u = self.fx * t.x / t.z + self.cx;
+        let v = self.fy * t.y / t.z + self.cy;
+        let bbox = pixel_range(u, 3.0 * a.sqrt(), self.size[0]).zip(pixel_range(
+            v,
+            3.0 * c.sqrt(),
+            self.size[1],
+        ))?;
+        let dir = (mean - self.eye).normalize().as_vec3().to_array();
+        let color = crate::sh::eval_color(cloud.sh_of(i), self.sh_degree, dir);
+        if !color.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        Some(Projected {
+            index: i as u32,
+            mean: [u as f32, v as f32],
+            cov: [a as f32, b as f32, c as f32],
+            conic: [(c / det) as f32, (-b / det) as f32, (a / det) as f32],
+            opacity,
+            color,
+            bbox: [bbox.0.0, bbox.0.1, bbox.1.0, bbox.1.1],
+        })
+    }
+}
+
+/// Pixels `i` with centre `i + 0.5` in `[centre − extent, centre + extent]`, clipped to
+/// `0..size`; `None` when empty.
+fn pixel_range(centre: f64, extent: f64, size: u32) -> Option<(u32, u32)> {
+    let lo = (centre - extent - 0.5).ceil().max(0.0);
+    let hi = (centre + extent - 0.5).floor().min(size as f64 - 1.0);
+    (lo <= hi).then(|| (lo as u32, hi as u32 + 1))
+}
