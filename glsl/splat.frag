@@ -17,7 +17,7 @@ void main() {
 #ifdef ERRATUM_F
     if (power > 4.0) {
 #else
-    if (power > 0.5 * SIGMA_CUTOFF * SIGMA_CUTOFF) {
+    if (power > 0.5 * CUTOFF_M2) {
 #endif
         discard;
     }

@@ -2,8 +2,8 @@
 //
 // Mirrors the step structure of KHR_gaussian_splatting (review draft) Appendix A with every
 // erratum fixed; docs/appendix-errata.md lists each deviation. The `#version` line, precision
-// statements and every numeric constant (SH_C*, DILATION, SIGMA_CUTOFF, ALPHA_MAX, ALPHA_MIN,
-// FOV_CLAMP, NEAR_CULL, texture layout) are injected from Rust as `#define`s; `ERRATUM_*`
+// statements and every numeric constant (SH_C*, DILATION, CUTOFF_M2, ALPHA_MAX, ALPHA_MIN,
+// FOV_CLAMP, texture layout) are injected from Rust as `#define`s; `ERRATUM_*`
 // defines switch in the appendix's literal behaviour for the erratum tests only.
 //
 // Data path (erratum j): the appendix's 21 vertex attributes cannot link on GLES 3.0 (16
@@ -25,6 +25,7 @@ uniform vec2 u_focal_length;       // fx, fy in pixels
 uniform vec2 u_tan_half_fov;       // tan of half the field of view, x and y
 uniform vec3 u_camera_position;    // eye in world space
 uniform vec4 u_viewport;           // x, y, width, height in window pixels
+uniform float u_cull_depth;        // max(NEAR_CULL, camera near): 3DGS in_frustum
 
 flat out vec3 v_color;
 flat out float v_opacity;
@@ -62,7 +63,7 @@ void main() {
     vec4 view_space_pos = u_view_matrix * vec4(a_glob_position, 1.0);
     // Erratum c: GL eye space looks down -z; the depth in front of the camera is -z.
     float z_depth = -view_space_pos.z;
-    if (z_depth <= NEAR_CULL) {
+    if (z_depth <= u_cull_depth) {
         cull();
         return;
     }
@@ -112,7 +113,7 @@ void main() {
     cov2d[1][1] += DILATION;
 #endif
 
-    // --- STEP 4: extent (radius of the 3-sigma circle) ---
+    // --- STEP 4: extent (radius of the circle around the 3-sigma ellipse) ---
     float det = cov2d[0][0] * cov2d[1][1] - cov2d[0][1] * cov2d[0][1];
     if (det <= 0.0) {
         cull();
@@ -120,7 +121,7 @@ void main() {
     }
     float mid = 0.5 * (cov2d[0][0] + cov2d[1][1]);
     float lambda1 = mid + sqrt(max(0.1, mid * mid - det));
-    float radius = ceil(SIGMA_CUTOFF * sqrt(lambda1));
+    float radius = ceil(sqrt(CUTOFF_M2 * lambda1));
 
     vec4 clip_space_pos = u_projection_matrix * view_space_pos;
     vec2 ndc_pos = clip_space_pos.xy / clip_space_pos.w;

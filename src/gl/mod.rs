@@ -16,13 +16,13 @@
 //! # Ok(()) }
 //! ```
 //!
-//! * [`program`]: GLSL assembly (`#version` chosen at run time, constants injected as
+//! * [`program`] — GLSL assembly (`#version` chosen at run time, constants injected as
 //!   `#define`s from [`consts`]) and compile/link with numbered-source error reports.
-//! * [`data`]: texture layout of the splat data (bytes per splat).
-//! * [`renderer`]: [`SplatRenderer`].
-//! * [`target`]: [`OffscreenTarget`], the RGBA16F accumulation target with a resolve pass.
-//! * [`sort`]: [`sort_back_to_front`], the one ordering function (a radix sorter plugs in here).
-//! * [`state`]: every piece of GL state the backend touches.
+//! * [`data`] — texture layout of the splat data (bytes per splat).
+//! * [`renderer`] — [`SplatRenderer`].
+//! * [`target`] — [`OffscreenTarget`], the RGBA16F accumulation target with a resolve pass.
+//! * [`sort`] — [`sort_back_to_front`], the one ordering function (a radix sorter plugs in here).
+//! * [`state`] — every piece of GL state the backend touches.
 
 pub mod consts;
 pub mod data;

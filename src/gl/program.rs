@@ -102,11 +102,10 @@ pub fn defines() -> String {
     let mut s = String::new();
     let mut def = |name: &str, value: String| s.push_str(&format!("#define {name} {value}\n"));
     def("DILATION", float_lit(consts::DILATION as f64));
-    def("SIGMA_CUTOFF", float_lit(consts::SIGMA_CUTOFF as f64));
+    def("CUTOFF_M2", float_lit(consts::CUTOFF_M2 as f64));
     def("ALPHA_MAX", float_lit(consts::ALPHA_MAX as f64));
     def("ALPHA_MIN", float_lit(consts::ALPHA_MIN as f64));
     def("FOV_CLAMP", float_lit(consts::FOV_CLAMP as f64));
-    def("NEAR_CULL", float_lit(consts::NEAR_CULL as f64));
     def("SH_DC_BIAS", float_lit(consts::SH_DC_BIAS as f64));
     def("SH_C0", float_lit(SH_C0));
     def("SH_C1", float_lit(SH_C1));

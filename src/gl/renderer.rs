@@ -31,6 +31,7 @@ struct Uniforms {
     tan_half_fov: Option<glow::UniformLocation>,
     camera_position: Option<glow::UniformLocation>,
     viewport: Option<glow::UniformLocation>,
+    cull_depth: Option<glow::UniformLocation>,
 }
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
@@ -82,6 +83,7 @@ impl SplatRenderer {
                 tan_half_fov: loc("u_tan_half_fov"),
                 camera_position: loc("u_camera_position"),
                 viewport: loc("u_viewport"),
+                cull_depth: loc("u_cull_depth"),
             };
             let vao = match gl.create_vertex_array() {
                 Ok(v) => v,
@@ -246,6 +248,10 @@ impl SplatRenderer {
                 viewport[1] as f32,
                 viewport[2] as f32,
                 viewport[3] as f32,
+            );
+            gl.uniform_1_f32(
+                u.cull_depth.as_ref(),
+                super::consts::NEAR_CULL.max(camera.near),
             );
             gl.uniform_1_i32(u.sh_degree.as_ref(), i32::from(degree));
             gl.uniform_1_i32(u.sh_texels.as_ref(), tex.sh_texels as i32);
