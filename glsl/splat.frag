@@ -24,7 +24,11 @@ void main() {
     float G_x = exp(-power);
 
     // --- STEP 2: alpha, capped at 0.99 (erratum k), skipped below 1/255 ---
+#ifdef ERRATUM_K
+    float final_alpha = v_opacity * G_x;
+#else
     float final_alpha = min(ALPHA_MAX, v_opacity * G_x);
+#endif
     if (final_alpha < ALPHA_MIN) {
         discard;
     }

@@ -98,8 +98,12 @@ void main() {
 #endif
     mat3 T = W * sigma3d * transpose(W);
     // Erratum k: 3DGS clamps x/z and y/z to 1.3 tan(half fov) inside J only.
+#ifdef ERRATUM_K
+    vec2 t = view_space_pos.xy;
+#else
     vec2 lim = FOV_CLAMP * u_tan_half_fov;
     vec2 t = clamp(view_space_pos.xy / z_depth, -lim, lim) * z_depth;
+#endif
     float fx = u_focal_length.x, fy = u_focal_length.y;
     // Rows: window x, window y (up); columns: eye x, y, z. mat3(...) fills columns.
     mat3 J = mat3(

@@ -315,7 +315,12 @@ impl HeadlessRenderer {
         &self.ctx
     }
 
-    /// The renderer (for driving draws by hand, e.g. in benchmarks).
+    /// The renderer.
+    pub fn renderer(&self) -> &SplatRenderer {
+        &self.renderer
+    }
+
+    /// The renderer, mutable (for driving draws by hand, e.g. in benchmarks).
     pub fn renderer_mut(&mut self) -> &mut SplatRenderer {
         &mut self.renderer
     }

@@ -747,3 +747,82 @@ fn erratum_i_no_dilation() {
     };
     assert!(lit.psnr < 35.0 && lit.max_rgb > 0.2, "{lit:?}");
 }
+
+#[test]
+fn erratum_k_fov_clamp_and_alpha_cap() {
+    // Large splats whose means lie far outside the view (x/z well beyond 1.3·tan(half fov)),
+    // reaching into the image, plus opaque ones (α would exceed 0.99 without the cap).
+    let mut cloud = SplatCloud::new(0);
+    for (k, x) in [-3.2f32, 3.4, 0.0].into_iter().enumerate() {
+        let s = if x == 0.0 { [0.2; 3] } else { [1.6, 0.5, 0.5] };
+        let q = Quat::from_rotation_z(0.3 * k as f32);
+        cloud.push(
+            [x, 0.2, 0.0],
+            s,
+            q.to_array(),
+            1.0,
+            &sh_for([0.9, 0.8, 0.3], 0),
+        );
+    }
+    let c = cam(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        k_no_clamp_no_cap: true,
+        ..Default::default()
+    };
+    let Some((ours, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(
+        lit.max_rgb > 0.05 && ours.max_rgb < lit.max_rgb,
+        "{ours:?} {lit:?}"
+    );
+}
+
+#[test]
+fn erratum_j_one_vertex_attribute() {
+    // The appendix's 21 attributes exceed GLES 3.0's guaranteed 16; ours uses one.
+    let Some(r) = headless() else { return };
+    let gl = r.context().gl();
+    use glow::HasContext;
+    let program = r.renderer().program();
+    // SAFETY: queries on the current context and a program the renderer owns (indices below
+    // GL_ACTIVE_ATTRIBUTES).
+    let (max_attribs, names) = unsafe {
+        let n = gl.get_active_attributes(program);
+        let names: Vec<String> = (0..n)
+            .filter_map(|i| gl.get_active_attribute(program, i))
+            .map(|a| a.name)
+            .collect();
+        (gl.get_parameter_i32(glow::MAX_VERTEX_ATTRIBS), names)
+    };
+    eprintln!("GL_MAX_VERTEX_ATTRIBS = {max_attribs}, active attributes = {names:?}");
+    // Built-ins (gl_VertexID) are listed by some drivers but use no attribute slot.
+    let user: Vec<_> = names.iter().filter(|n| !n.starts_with("gl_")).collect();
+    assert_eq!(user, ["a_splat_index"]);
+    // And the appendix's attribute set (quad + 4 splat attributes + 16 SH) does not link here.
+    let mut vs =
+        String::from("#version 300 es\nin vec2 a_quad_vertex;\nin vec3 a_glob_position;\n");
+    vs += "in vec3 a_glob_scale;\nin vec4 a_glob_rotation;\nin float a_glob_opacity;\n";
+    let mut sum = String::from("a_glob_position + a_glob_scale + a_glob_rotation.xyz");
+    for k in 0..16 {
+        vs += &format!("in vec3 a_sh_{k};\n");
+        sum += &format!(" + a_sh_{k}");
+    }
+    vs += &format!(
+        "void main() {{ gl_Position = vec4({sum} + vec3(a_quad_vertex, a_glob_opacity), 1.0); }}\n"
+    );
+    let fs =
+        "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() { o = vec4(1.0); }\n";
+    let err = splatgl::gl::program::build_program(gl, "appendix-21", &vs, fs);
+    match &err {
+        Err(splatgl::gl::GlError::Link { log, .. }) => eprintln!("21-attribute program: {log}"),
+        other => eprintln!(
+            "21-attribute program: {:?}",
+            other.as_ref().map(|_| "linked")
+        ),
+    }
+    if max_attribs < 21 {
+        assert!(matches!(err, Err(splatgl::gl::GlError::Link { .. })));
+    }
+    assert!(max_attribs >= 16, "GLES 3.0 guarantees 16");
+}

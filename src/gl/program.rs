@@ -70,6 +70,8 @@ pub struct Errata {
     pub g_src_alpha_blend: bool,
     /// (i) no 0.3 px² dilation of Σ'.
     pub i_no_dilation: bool,
+    /// (k) no ±1.3·tan(half fov) clamp inside J and no 0.99 cap on α.
+    pub k_no_clamp_no_cap: bool,
 }
 
 impl Errata {
@@ -82,6 +84,7 @@ impl Errata {
             (self.e_appendix_sh, "ERRATUM_E"),
             (self.f_power_4, "ERRATUM_F"),
             (self.i_no_dilation, "ERRATUM_I"),
+            (self.k_no_clamp_no_cap, "ERRATUM_K"),
         ] {
             if on {
                 s.push_str(&format!("#define {name}\n"));

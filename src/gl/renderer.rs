@@ -152,6 +152,11 @@ impl SplatRenderer {
         super::check_error(gl, "allocating the order buffer")
     }
 
+    /// The linked splat program (for inspection, e.g. its active attributes).
+    pub fn program(&self) -> glow::Program {
+        self.program
+    }
+
     /// Number of splats uploaded.
     pub fn len(&self) -> usize {
         self.textures.as_ref().map_or(0, |t| t.len)
