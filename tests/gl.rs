@@ -826,3 +826,153 @@ fn erratum_j_one_vertex_attribute() {
     }
     assert!(max_attribs >= 16, "GLES 3.0 guarantees 16");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Embedding API: the renderer on a host framebuffer, depth test, state left as documented.
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn embedding_depth_test_and_documented_state() {
+    use glow::HasContext;
+    use splatgl::gl::{SplatRenderer, sort_back_to_front};
+    use splatgl::headless::HeadlessContext;
+    let ctx = match HeadlessContext::new() {
+        Ok(c) => c,
+        Err(HeadlessError::EglUnavailable(m)) => {
+            eprintln!("SKIPPED: EGL cannot be opened here ({m})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    let gl = ctx.gl();
+    let (w, h) = (32u32, 32u32);
+    // The "host": an RGBA8 + DEPTH24 framebuffer with a viewport offset inside a larger one.
+    // SAFETY: object creation and binding on the current context; deleted at the end.
+    let (fbo, rbs) = unsafe {
+        let color = gl.create_renderbuffer().unwrap();
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
+        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 2 * w as i32, h as i32);
+        let depth = gl.create_renderbuffer().unwrap();
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+        gl.renderbuffer_storage(
+            glow::RENDERBUFFER,
+            glow::DEPTH_COMPONENT24,
+            2 * w as i32,
+            h as i32,
+        );
+        let fbo = gl.create_framebuffer().unwrap();
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::COLOR_ATTACHMENT0,
+            glow::RENDERBUFFER,
+            Some(color),
+        );
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::DEPTH_ATTACHMENT,
+            glow::RENDERBUFFER,
+            Some(depth),
+        );
+        assert_eq!(
+            gl.check_framebuffer_status(glow::FRAMEBUFFER),
+            glow::FRAMEBUFFER_COMPLETE
+        );
+        (fbo, [color, depth])
+    };
+    let mut cloud = SplatCloud::new(0);
+    cloud.push(
+        [0.0; 3],
+        [0.3; 3],
+        [0.0, 0.0, 0.0, 1.0],
+        0.95,
+        &sh_for([1.0, 1.0, 1.0], 0),
+    );
+    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, w, h);
+    let mut renderer = SplatRenderer::new(gl).unwrap();
+    renderer.upload(gl, &cloud).unwrap();
+    let mut order = Vec::new();
+    sort_back_to_front(&cloud.positions, c.eye(), &mut order);
+    // Right half of the framebuffer is the host's viewport for the splats.
+    let mut centre_red = |depth_clear: f32, depth_test: bool| -> u8 {
+        // SAFETY: clears and reads one pixel of the bound framebuffer.
+        unsafe {
+            gl.viewport(0, 0, 2 * w as i32, h as i32);
+            gl.depth_mask(true);
+            gl.clear_color(0.0, 0.0, 0.0, 0.0);
+            gl.clear_depth_f32(depth_clear);
+            gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+            gl.viewport(w as i32, 0, w as i32, h as i32);
+        }
+        renderer.settings_mut().depth_test = depth_test;
+        renderer.draw(gl, &c, &order).unwrap();
+        let mut px = [0u8; 4];
+        // SAFETY: reads one RGBA8 pixel into a 4-byte buffer.
+        unsafe {
+            gl.read_pixels(
+                (w + w / 2) as i32,
+                (h / 2) as i32,
+                1,
+                1,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelPackData::Slice(Some(&mut px)),
+            );
+        }
+        px[0]
+    };
+    assert!(centre_red(0.0, false) > 200, "drawn without depth test");
+    assert!(centre_red(1.0, true) > 200, "host depth far: splat passes");
+    assert_eq!(
+        centre_red(0.0, true),
+        0,
+        "host geometry in front: splat hidden"
+    );
+    // The left half (outside the viewport) stays untouched.
+    let mut px = [9u8; 4];
+    // SAFETY: as above; then state queries.
+    unsafe {
+        gl.read_pixels(
+            w as i32 / 2,
+            h as i32 / 2,
+            1,
+            1,
+            glow::RGBA,
+            glow::UNSIGNED_BYTE,
+            glow::PixelPackData::Slice(Some(&mut px)),
+        );
+        assert_eq!(px, [0; 4]);
+        // State left as documented in splatgl::gl::state.
+        assert_eq!(gl.get_parameter_i32(glow::CURRENT_PROGRAM), 0);
+        assert_eq!(gl.get_parameter_i32(glow::VERTEX_ARRAY_BINDING), 0);
+        assert_eq!(gl.get_parameter_i32(glow::ARRAY_BUFFER_BINDING), 0);
+        assert_eq!(
+            gl.get_parameter_i32(glow::ACTIVE_TEXTURE),
+            glow::TEXTURE0 as i32
+        );
+        assert_eq!(gl.get_parameter_i32(glow::TEXTURE_BINDING_2D), 0);
+        assert!(gl.is_enabled(glow::BLEND));
+        assert_eq!(gl.get_parameter_i32(glow::BLEND_SRC_RGB), glow::ONE as i32);
+        assert_eq!(
+            gl.get_parameter_i32(glow::BLEND_DST_ALPHA),
+            glow::ONE_MINUS_SRC_ALPHA as i32
+        );
+        assert_eq!(gl.get_parameter_i32(glow::DEPTH_WRITEMASK), 0);
+        assert_eq!(
+            gl.get_parameter_i32(glow::DRAW_FRAMEBUFFER_BINDING),
+            fbo.0.get() as i32
+        );
+        let mut vp = [0i32; 4];
+        gl.get_parameter_i32_slice(glow::VIEWPORT, &mut vp);
+        assert_eq!(vp, [w as i32, 0, w as i32, h as i32]);
+    }
+    renderer.destroy(gl);
+    // SAFETY: deleting the host objects created above.
+    unsafe {
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.delete_framebuffer(fbo);
+        for rb in rbs {
+            gl.delete_renderbuffer(rb);
+        }
+    }
+}

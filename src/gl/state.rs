@@ -22,6 +22,8 @@
 //! | `GL_CULL_FACE` | disabled | **disabled** (left) |
 //! | `GL_SCISSOR_TEST`, stencil, colour mask | not touched | unchanged |
 //!
+//! `tests/gl.rs::embedding_depth_test_and_documented_state` checks the "left afterwards" column.
+//!
 //! A host that needs other values back (e.g. `glDepthMask(true)` for its next pass) sets them
 //! after the call; querying and restoring everything would cost a round-trip per state per frame.
 //!
@@ -34,7 +36,8 @@
 //! # [`OffscreenTarget`](super::OffscreenTarget)
 //!
 //! `begin` binds the target's framebuffer (the previous draw framebuffer binding is remembered),
-//! sets the viewport to the target's size and clears it; `resolve` binds the remembered
+//! sets the viewport to the target's size, sets the clear colour (left set) and clears it;
+//! `resolve` binds the remembered
 //! framebuffer again and restores the viewport it found at `begin`, then draws one triangle with
 //! blending **disabled** and depth testing **disabled** (both left so) and leaves program 0,
 //! VAO 0, texture unit 0 bound to 0.
