@@ -1,8 +1,11 @@
 //! Texture layout of the splat data, uploaded once per cloud.
 //!
-//! Both textures are `TEX_WIDTH` (2048, the GLES 3.0 minimum for `GL_MAX_TEXTURE_SIZE`) texels
-//! wide; splat `i`'s `k`-th texel is at linear index `i·T + k` (T texels per splat), i.e.
-//! `(idx & 2047, idx >> 11)`. Both use `NEAREST` filtering and are read with `texelFetch`.
+//! Both textures are `W = 2^w` texels wide, the largest power of two ≤ min(8192,
+//! `GL_MAX_TEXTURE_SIZE`) (so at least 2048 on any GLES 3.0 device; [`tex_width_log2`]); splat
+//! `i`'s `k`-th texel is at linear index `i·T + k` (T texels per splat), i.e.
+//! `(idx & (W − 1), idx >> w)`. Both use `NEAREST` filtering and are read with `texelFetch`.
+//! Capacity: `W · GL_MAX_TEXTURE_SIZE / max(3, T_sh)` splats — 11.2M at SH degree 3 and 44.7M
+//! at degree 0 with llvmpipe's 16384; [`SplatTextures::upload`] reports an error beyond.
 //!
 //! | texture | format | texels/splat | content | bytes/splat |
 //! |---|---|---|---|---|
@@ -23,10 +26,15 @@ use glow::HasContext;
 use super::GlError;
 use crate::cloud::{SplatCloud, sh_coeff_count};
 
-/// Width of both data textures in texels.
-pub const TEX_WIDTH: usize = 1 << TEX_WIDTH_LOG2;
-/// log2 of [`TEX_WIDTH`].
-pub const TEX_WIDTH_LOG2: u32 = 11;
+/// log2 of the widest data texture used (8192 texels).
+pub const MAX_TEX_WIDTH_LOG2: u32 = 13;
+
+/// log2 of the data textures' width for a context with this `GL_MAX_TEXTURE_SIZE`: the largest
+/// power of two ≤ min(8192, max_texture_size), and at least 2048 (the GLES 3.0 minimum).
+pub fn tex_width_log2(max_texture_size: i32) -> u32 {
+    let m = max_texture_size.max(2048) as u32;
+    (31 - m.leading_zeros()).min(MAX_TEX_WIDTH_LOG2)
+}
 /// Texels per splat in the geometry texture.
 pub const GEOM_TEXELS: usize = 3;
 
@@ -40,9 +48,9 @@ pub const fn bytes_per_splat(degree: u8) -> usize {
     GEOM_TEXELS * 16 + sh_texels(degree) * 8
 }
 
-/// Rows of a `TEX_WIDTH`-wide texture holding `n` splats of `per_splat` texels.
-fn rows(n: usize, per_splat: usize) -> usize {
-    (n * per_splat).div_ceil(TEX_WIDTH).max(1)
+/// Rows of a `width`-wide texture holding `n` splats of `per_splat` texels.
+fn rows(n: usize, per_splat: usize, width: usize) -> usize {
+    (n * per_splat).div_ceil(width).max(1)
 }
 
 /// The two data textures of an uploaded cloud.
@@ -79,17 +87,18 @@ fn geometry_of(cloud: &SplatCloud, i: usize, out: &mut [f32]) {
     ]);
 }
 
-/// Uploads a `TEX_WIDTH`-wide float texture whose linear texel stream is produced by `fill`
+/// Uploads a `width`-wide float texture whose linear texel stream is produced by `fill`
 /// (called per splat with a slice of `per_splat · 4` floats), a few rows at a time so the
 /// staging memory stays small for large clouds.
 fn upload_texture(
     gl: &glow::Context,
     internal_format: u32,
+    width: usize,
     n: usize,
     per_splat: usize,
     mut fill: impl FnMut(usize, &mut [f32]),
 ) -> Result<glow::Texture, GlError> {
-    let height = rows(n, per_splat);
+    let height = rows(n, per_splat, width);
     // SAFETY: texture creation/allocation on the current context with sizes checked by the
     // caller against GL_MAX_TEXTURE_SIZE; sub-image uploads stay inside the allocated storage
     // (row ranges computed below) and read exactly width·rows·4 floats from `staging`.
@@ -103,7 +112,7 @@ fn upload_texture(
             glow::TEXTURE_2D,
             1,
             internal_format,
-            TEX_WIDTH as i32,
+            width as i32,
             height as i32,
         );
         for (pname, v) in [
@@ -117,7 +126,7 @@ fn upload_texture(
         gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
         gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 0);
         const ROWS_PER_CHUNK: usize = 64;
-        let floats_per_row = TEX_WIDTH * 4;
+        let floats_per_row = width * 4;
         let mut staging = vec![0.0f32; ROWS_PER_CHUNK * floats_per_row];
         let mut tmp = vec![0.0f32; per_splat * 4];
         let total_floats = n * per_splat * 4;
@@ -143,7 +152,7 @@ fn upload_texture(
                 0,
                 0,
                 row as i32,
-                TEX_WIDTH as i32,
+                width as i32,
                 chunk_rows as i32,
                 glow::RGBA,
                 glow::FLOAT,
@@ -159,24 +168,30 @@ fn upload_texture(
 }
 
 impl SplatTextures {
-    /// Uploads a cloud (checks its invariants and the texture size limit first).
-    pub fn upload(gl: &glow::Context, cloud: &SplatCloud) -> Result<Self, GlError> {
+    /// Uploads a cloud into textures `2^width_log2` texels wide (checks the cloud's invariants
+    /// and the texture size limit first).
+    pub fn upload(
+        gl: &glow::Context,
+        cloud: &SplatCloud,
+        width_log2: u32,
+    ) -> Result<Self, GlError> {
+        let width = 1usize << width_log2;
         cloud.check_lengths().map_err(GlError::Upload)?;
         let n = cloud.len();
         let sh_t = sh_texels(cloud.sh_degree);
         let k = cloud.coeffs_per_splat();
         // SAFETY: a plain integer query.
         let max_size = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) } as usize;
-        let need = rows(n, GEOM_TEXELS.max(sh_t));
+        let need = rows(n, GEOM_TEXELS.max(sh_t), width);
         if need > max_size {
             return Err(GlError::Upload(format!(
                 "{n} splats need {need} texture rows; GL_MAX_TEXTURE_SIZE is {max_size}"
             )));
         }
-        let geometry = upload_texture(gl, glow::RGBA32F, n, GEOM_TEXELS, |i, out| {
+        let geometry = upload_texture(gl, glow::RGBA32F, width, n, GEOM_TEXELS, |i, out| {
             geometry_of(cloud, i, out)
         })?;
-        let sh = upload_texture(gl, glow::RGBA16F, n, sh_t, |i, out| {
+        let sh = upload_texture(gl, glow::RGBA16F, width, n, sh_t, |i, out| {
             out.fill(0.0);
             for (j, c) in cloud.sh[i * k..(i + 1) * k].iter().enumerate() {
                 out[3 * j..3 * j + 3].copy_from_slice(c);
@@ -217,8 +232,12 @@ mod tests {
     fn layout_sizes() {
         assert_eq!([0, 1, 2, 3].map(sh_texels), [1, 3, 7, 12]);
         assert_eq!([0, 1, 2, 3].map(bytes_per_splat), [56, 72, 104, 144]);
-        assert_eq!(rows(0, 3), 1);
-        assert_eq!(rows(2048, 3), 3);
-        assert_eq!(rows(2049, 3), 4);
+        assert_eq!(rows(0, 3, 2048), 1);
+        assert_eq!(rows(2048, 3, 2048), 3);
+        assert_eq!(rows(2049, 3, 2048), 4);
+        assert_eq!(tex_width_log2(16384), 13);
+        assert_eq!(tex_width_log2(4096), 12);
+        assert_eq!(tex_width_log2(3000), 11);
+        assert_eq!(tex_width_log2(0), 11);
     }
 }

@@ -99,8 +99,9 @@ fn float_lit(v: f64) -> String {
     format!("{v:e}")
 }
 
-/// The `#define`s shared by all stages: kernel constants, SH constants, texture layout.
-pub fn defines() -> String {
+/// The `#define`s shared by all stages: kernel constants, SH constants, texture layout
+/// (data textures `2^tex_width_log2` texels wide).
+pub fn defines(tex_width_log2: u32) -> String {
     use crate::sh::{SH_C0, SH_C1, SH_C2, SH_C3};
     let mut s = String::new();
     let mut def = |name: &str, value: String| s.push_str(&format!("#define {name} {value}\n"));
@@ -118,8 +119,8 @@ pub fn defines() -> String {
     for (i, c) in SH_C3.iter().enumerate() {
         def(&format!("SH_C3_{i}"), float_lit(*c));
     }
-    def("TEX_WIDTH", data::TEX_WIDTH.to_string());
-    def("TEX_WIDTH_LOG2", data::TEX_WIDTH_LOG2.to_string());
+    def("TEX_WIDTH", (1u32 << tex_width_log2).to_string());
+    def("TEX_WIDTH_LOG2", tex_width_log2.to_string());
     def("GEOM_TEXELS", data::GEOM_TEXELS.to_string());
     def(
         "MAX_SH_TEXELS",
@@ -128,9 +129,9 @@ pub fn defines() -> String {
     s
 }
 
-/// Assembles one stage: version line, precision, defines, then the file (with
+/// Assembles one stage: version line, precision, defines (see [`defines`]), then the file (with
 /// `//@include sh.glsl` replaced by [`SH_GLSL`]).
-pub fn assemble(version: GlslVersion, errata: &Errata, body: &str) -> String {
+pub fn assemble(version: GlslVersion, errata: &Errata, tex_width_log2: u32, body: &str) -> String {
     // Desktop GLSL accepts (and ignores) float/int precision; sampler precision is ES-only.
     let precision = match version {
         GlslVersion::Es300 => {
@@ -141,7 +142,7 @@ pub fn assemble(version: GlslVersion, errata: &Errata, body: &str) -> String {
     format!(
         "{}\n{precision}{}{}{}",
         version.line(),
-        defines(),
+        defines(tex_width_log2),
         errata.defines(),
         body.replace("//@include sh.glsl", SH_GLSL)
     )
@@ -232,10 +233,11 @@ mod tests {
 
     #[test]
     fn defines_carry_rust_constants() {
-        let d = defines();
+        let d = defines(11);
         assert!(d.contains(&format!("#define DILATION {}", float_lit(0.3f32 as f64))));
         assert!(d.contains("#define SH_C3_5 1.445"));
         assert!(d.contains("#define MAX_SH_TEXELS 12"));
+        assert!(d.contains("#define TEX_WIDTH 2048\n#define TEX_WIDTH_LOG2 11\n"));
         // Every float literal has an exponent (so GLSL reads it as float).
         for line in d.lines().filter(|l| l.contains("SH_C")) {
             assert!(line.contains('e'), "{line}");
@@ -244,7 +246,7 @@ mod tests {
 
     #[test]
     fn assembled_source_starts_with_version_and_splices_sh() {
-        let s = assemble(GlslVersion::Es300, &Errata::default(), SPLAT_VERT);
+        let s = assemble(GlslVersion::Es300, &Errata::default(), 11, SPLAT_VERT);
         assert!(s.starts_with("#version 300 es\n"));
         assert!(s.contains("vec3 sh_color(int splat, vec3 view_dir)"));
         assert!(!s.contains("ERRATUM_A\n#") && !s.contains("#define ERRATUM"));
@@ -252,7 +254,7 @@ mod tests {
             a_transposed_rotation: true,
             ..Errata::default()
         };
-        assert!(assemble(GlslVersion::Core330, &e, SPLAT_VERT).contains("#define ERRATUM_A"));
+        assert!(assemble(GlslVersion::Core330, &e, 11, SPLAT_VERT).contains("#define ERRATUM_A"));
     }
 
     #[test]

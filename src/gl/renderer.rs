@@ -52,6 +52,7 @@ pub struct SplatRenderer {
     cloud_degree: u8,
     settings: DrawSettings,
     errata: Errata,
+    tex_width_log2: u32,
 }
 
 impl SplatRenderer {
@@ -65,8 +66,11 @@ impl SplatRenderer {
     /// back in. **Tests and demonstrations only.**
     pub fn with_errata(gl: &glow::Context, errata: Errata) -> Result<Self, GlError> {
         let version = GlslVersion::for_context(gl);
-        let vs = program::assemble(version, &errata, program::SPLAT_VERT);
-        let fs = program::assemble(version, &errata, program::SPLAT_FRAG);
+        // SAFETY: a plain integer query.
+        let max_texture_size = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) };
+        let tex_width_log2 = super::data::tex_width_log2(max_texture_size);
+        let vs = program::assemble(version, &errata, tex_width_log2, program::SPLAT_VERT);
+        let fs = program::assemble(version, &errata, tex_width_log2, program::SPLAT_FRAG);
         let program = program::build_program(gl, "splat", &vs, &fs)?;
         // SAFETY: queries on the program just linked, and creation of a VAO and a buffer; on
         // failure everything created so far is deleted.
@@ -125,6 +129,7 @@ impl SplatRenderer {
                 cloud_degree: 0,
                 settings: DrawSettings::default(),
                 errata,
+                tex_width_log2,
             })
         }
     }
@@ -132,7 +137,7 @@ impl SplatRenderer {
     /// Uploads a cloud's data into textures (once per cloud; replaces any previous cloud) and
     /// sizes the order buffer for `cloud.len()` indices.
     pub fn upload(&mut self, gl: &glow::Context, cloud: &SplatCloud) -> Result<(), GlError> {
-        let textures = SplatTextures::upload(gl, cloud)?;
+        let textures = SplatTextures::upload(gl, cloud, self.tex_width_log2)?;
         if let Some(old) = self.textures.replace(textures) {
             old.destroy(gl);
         }

@@ -44,8 +44,8 @@ impl OffscreenTarget {
                 ));
             }
         }
-        let vs = program::assemble(version, &Errata::default(), program::RESOLVE_VERT);
-        let fs = program::assemble(version, &Errata::default(), program::RESOLVE_FRAG);
+        let vs = program::assemble(version, &Errata::default(), 11, program::RESOLVE_VERT);
+        let fs = program::assemble(version, &Errata::default(), 11, program::RESOLVE_FRAG);
         let program = program::build_program(gl, "resolve", &vs, &fs)?;
         // SAFETY: creates and configures objects owned by the target; the framebuffer binding
         // is restored before returning.
