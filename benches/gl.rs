@@ -5,7 +5,7 @@
 //! [`OffscreenTarget`] plus its resolve pass (the draw column then includes the resolve).
 //!
 //! `cargo bench --bench gl` (set `SPLATGL_BENCH_FRAMES`, default 5, and `SPLATGL_BENCH_SIZES`,
-//! default `100000,1000000`). A short, plain timing loop rather than criterion: one 1M-splat
+//! default `100000,1000000`, and `SPLATGL_BENCH_SCALE`, default 1, a factor on the splat scales). A short, plain timing loop rather than criterion: one 1M-splat
 //! frame on llvmpipe takes long enough that criterion's minimum sample counts would make the
 //! run minutes long. Each phase ends with `glFinish`, so GPU work is attributed to it.
 //!
@@ -43,6 +43,11 @@ fn main() {
         .split(',')
         .filter_map(|s| s.trim().parse().ok())
         .collect();
+    // Extra factor on the splat scales (e.g. 0.01: sub-pixel splats, to see the vertex cost).
+    let scale_factor: f32 = std::env::var("SPLATGL_BENCH_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1.0);
     let ctx = match HeadlessContext::new() {
         Ok(c) => c,
         Err(HeadlessError::EglUnavailable(m)) => {
@@ -92,7 +97,7 @@ fn main() {
     );
     for (n, float_target) in sizes.iter().flat_map(|&n| [(n, false), (n, true)]) {
         let mut cloud = scene::random_cloud(n, 3, 1.0, 1234);
-        let k = 0.2 * (1e5 / n as f32).cbrt();
+        let k = scale_factor * 0.2 * (1e5 / n as f32).cbrt();
         for s in &mut cloud.scales {
             *s = s.map(|v| v * k);
         }

@@ -137,8 +137,14 @@ void main() {
 #else
     // Erratum d: r pixels are 2r/viewport in NDC; the centre in window pixels is
     // (ndc/2 + 1/2) * viewport size + viewport origin (gl_FragCoord's frame).
-    clip_space_pos.xy += corner * (2.0 * radius / u_viewport.zw) * clip_space_pos.w;
     v_center_px = (ndc_pos * 0.5 + 0.5) * u_viewport.zw + u_viewport.xy;
+    // Quads entirely outside the viewport would be clipped anyway: skip their SH work.
+    if (any(lessThan(v_center_px + radius, u_viewport.xy)) ||
+        any(greaterThan(v_center_px - radius, u_viewport.xy + u_viewport.zw))) {
+        cull();
+        return;
+    }
+    clip_space_pos.xy += corner * (2.0 * radius / u_viewport.zw) * clip_space_pos.w;
 #endif
     gl_Position = clip_space_pos;
 
