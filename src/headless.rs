@@ -93,7 +93,17 @@ fn egl() -> Result<&'static Egl, HeadlessError> {
     .map_err(|e| HeadlessError::EglUnavailable(e.clone()))
 }
 
-/// An OpenGL ES 3 context on the surfaceless platform (no window, no default framebuffer:
+/// Which client API a [`HeadlessContext`] speaks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GlApi {
+    /// OpenGL ES 3.0 or newer (shaders get `#version 300 es`). The default.
+    #[default]
+    Gles3,
+    /// Desktop OpenGL 3.3 core profile (shaders get `#version 330 core`).
+    DesktopCore33,
+}
+
+/// An OpenGL ES 3 (or desktop GL 3.3 core) context on the surfaceless platform (no window, no default framebuffer:
 /// render into FBOs). Current on the creating thread; not `Send`.
 pub struct HeadlessContext {
     context: egl::Context,
@@ -112,12 +122,27 @@ impl std::fmt::Debug for HeadlessContext {
 impl HeadlessContext {
     /// Creates a GLES 3.0 (or newer) context and makes it current on this thread.
     pub fn new() -> Result<Self, HeadlessError> {
+        Self::with_api(GlApi::Gles3)
+    }
+
+    /// Creates a context of the given API and makes it current on this thread.
+    pub fn with_api(api: GlApi) -> Result<Self, HeadlessError> {
         let e = egl()?;
         let display = e.display();
         let err = |call| move |error| HeadlessError::Egl { call, error };
-        e.instance
-            .bind_api(egl::OPENGL_ES_API)
-            .map_err(err("eglBindAPI"))?;
+        let (bind, renderable, minor, profile): (_, _, _, &[egl::Int]) = match api {
+            GlApi::Gles3 => (egl::OPENGL_ES_API, egl::OPENGL_ES3_BIT, 0, &[]),
+            GlApi::DesktopCore33 => (
+                egl::OPENGL_API,
+                egl::OPENGL_BIT,
+                3,
+                &[
+                    egl::CONTEXT_OPENGL_PROFILE_MASK,
+                    egl::CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                ],
+            ),
+        };
+        e.instance.bind_api(bind).map_err(err("eglBindAPI"))?;
         let config = e
             .instance
             .choose_first_config(
@@ -125,7 +150,7 @@ impl HeadlessContext {
                 // Surfaceless: no window surfaces, so don't let SURFACE_TYPE default to WINDOW_BIT.
                 &[
                     egl::RENDERABLE_TYPE,
-                    egl::OPENGL_ES3_BIT,
+                    renderable,
                     egl::SURFACE_TYPE,
                     egl::DONT_CARE,
                     egl::NONE,
@@ -136,20 +161,17 @@ impl HeadlessContext {
                 call: "eglChooseConfig",
                 error: egl::Error::BadConfig,
             })?;
+        let mut attribs = vec![
+            egl::CONTEXT_MAJOR_VERSION,
+            3,
+            egl::CONTEXT_MINOR_VERSION,
+            minor,
+        ];
+        attribs.extend_from_slice(profile);
+        attribs.push(egl::NONE);
         let context = e
             .instance
-            .create_context(
-                display,
-                config,
-                None,
-                &[
-                    egl::CONTEXT_MAJOR_VERSION,
-                    3,
-                    egl::CONTEXT_MINOR_VERSION,
-                    0,
-                    egl::NONE,
-                ],
-            )
+            .create_context(display, config, None, &attribs)
             .map_err(err("eglCreateContext"))?;
         if let Err(error) = e.instance.make_current(display, None, None, Some(context)) {
             let _ = e.instance.destroy_context(display, context);
@@ -295,7 +317,12 @@ impl HeadlessRenderer {
 
     /// Like [`HeadlessRenderer::new`] with Appendix A errata switched in (tests only).
     pub fn with_errata(errata: crate::gl::Errata) -> Result<Self, HeadlessError> {
-        let ctx = HeadlessContext::new()?;
+        Self::with_api(GlApi::Gles3, errata)
+    }
+
+    /// A renderer on a context of the given API, with `errata` (use `Errata::default()`).
+    pub fn with_api(api: GlApi, errata: crate::gl::Errata) -> Result<Self, HeadlessError> {
+        let ctx = HeadlessContext::with_api(api)?;
         let renderer = SplatRenderer::with_errata(ctx.gl(), errata)?;
         Ok(HeadlessRenderer {
             renderer,
@@ -377,6 +404,12 @@ impl HeadlessRenderer {
         self.renderer.settings_mut().depth_test = false;
         let gl = self.ctx.gl();
         let fbo = self.fbo.as_ref().expect("ensured above");
+        // Desktop GL converts to sRGB on write only with GL_FRAMEBUFFER_SRGB (ES always does).
+        let desktop_srgb = srgb_fbo && !gl.version().is_embedded;
+        if desktop_srgb {
+            // SAFETY: enabling a capability on the current context.
+            unsafe { gl.enable(glow::FRAMEBUFFER_SRGB) };
+        }
         // SAFETY: binds this renderer's own framebuffer and clears it.
         unsafe {
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo.fbo));
@@ -392,6 +425,10 @@ impl HeadlessRenderer {
                 self.renderer.draw(gl, camera, order)?;
                 target.resolve(gl, linear);
             }
+        }
+        if desktop_srgb {
+            // SAFETY: restoring the default (disabled).
+            unsafe { gl.disable(glow::FRAMEBUFFER_SRGB) };
         }
         self.bytes.resize(w as usize * h as usize * 4, 0);
         // SAFETY: reads w·h RGBA8 pixels from our framebuffer into a buffer of exactly that
