@@ -63,7 +63,9 @@ void main() {
     vec4 view_space_pos = u_view_matrix * vec4(a_glob_position, 1.0);
     // Erratum c: GL eye space looks down -z; the depth in front of the camera is -z.
     float z_depth = -view_space_pos.z;
-    if (z_depth <= u_cull_depth) {
+    // Written as !(a > b) so a NaN depth (non-finite mean) is culled too; splats whose alpha
+    // can never reach ALPHA_MIN (or is NaN) are culled like the reference does.
+    if (!(z_depth > u_cull_depth) || !(min(a_glob_opacity, ALPHA_MAX) >= ALPHA_MIN)) {
         cull();
         return;
     }
@@ -71,7 +73,9 @@ void main() {
     // --- STEP 2: 3D covariance  Sigma = R S S^T R^T ---
     // Scale is linear in the Release Candidate (the review draft's exp() is gone).
     vec3 scale = geom2.xyz;
-    vec4 q = normalize(a_glob_rotation);
+    // Normalised like the reference; a zero quaternion means identity there too.
+    float q_len = length(a_glob_rotation);
+    vec4 q = q_len > 0.0 ? a_glob_rotation / q_len : vec4(0.0, 0.0, 0.0, 1.0);
 #ifdef ERRATUM_A
     // Appendix literal: rows written into mat3(...), which fills columns -> R^T.
     mat3 rotation_matrix = mat3(
@@ -119,7 +123,7 @@ void main() {
 
     // --- STEP 4: extent (radius of the circle around the 3-sigma ellipse) ---
     float det = cov2d[0][0] * cov2d[1][1] - cov2d[0][1] * cov2d[0][1];
-    if (det <= 0.0) {
+    if (!(det > 0.0) || isinf(det)) {
         cull();
         return;
     }
@@ -151,6 +155,10 @@ void main() {
     // --- STEP 5: view-dependent colour from spherical harmonics ---
     vec3 view_dir = normalize(a_glob_position - u_camera_position);
     v_color = sh_color(splat, view_dir);
+    if (any(isnan(v_color)) || any(isinf(v_color))) {
+        cull();
+        return;
+    }
 
     // --- STEP 6: pass data to the fragment shader ---
     v_opacity = a_glob_opacity;

@@ -385,6 +385,9 @@ impl HeadlessRenderer {
         self.ctx.make_current()?;
         let linear = opts.color_space.unwrap_or(self.color_space) == ColorSpace::LinRec709Display;
         let (w, h) = (camera.width, camera.height);
+        if w == 0 || h == 0 {
+            return Ok(Image::filled(w, h, [0.0; 4])); // no pixels (a 0-sized FBO is incomplete)
+        }
         let srgb_fbo = linear && opts.target == TargetKind::Rgba8;
         self.ensure_fbo(w, h, srgb_fbo)?;
         if opts.target == TargetKind::Rgba16fResolve

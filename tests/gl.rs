@@ -132,6 +132,7 @@ fn overbright(cloud: &SplatCloud, cam: &Camera, degree: u8) -> f32 {
             let c = splatgl::sh::eval_color(cloud.sh_of(i), degree, dir.to_array());
             c[0].max(c[1]).max(c[2]) - 1.0
         })
+        .filter(|e| e.is_finite()) // non-finite colours are culled by both backends
         .fold(0.0f32, f32::max)
 }
 
@@ -553,6 +554,32 @@ fn rgba16f_resolve_measured_against_rgba8() {
 }
 
 #[test]
+fn non_finite_splats_are_skipped_like_the_reference() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = scene::random_cloud(200, 1, 1.0, 77);
+    let n = cloud.len();
+    cloud.positions[3] = [f32::NAN, 0.0, 0.0];
+    cloud.positions[5] = [0.0, f32::INFINITY, 0.0];
+    cloud.scales[7] = [f32::INFINITY, 0.1, 0.1];
+    cloud.scales[9] = [f32::NAN, 0.1, 0.1];
+    cloud.opacities[11] = f32::NAN;
+    cloud.opacities[13] = f32::INFINITY; // seen in real files: alpha = 0.99 on both backends
+    cloud.rotations[15] = [0.0; 4]; // degenerate quaternion
+    cloud.sh[17 * 4] = [f32::NAN, 0.0, 0.0];
+    cloud.sh[19 * 4 + 1] = [f32::INFINITY; 3];
+    assert_eq!(cloud.len(), n);
+    let c = cam(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 64);
+    check(
+        "non-finite",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+}
+
+#[test]
 fn empty_cloud_and_partial_orders() {
     let Some(mut r) = headless() else { return };
     let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 32, 32);
@@ -579,6 +606,15 @@ fn empty_cloud_and_partial_orders() {
             capacity: 10
         }))
     ));
+    // A zero-sized camera gives an empty image, not an incomplete-framebuffer error.
+    let mut z = c;
+    z.width = 0;
+    assert!(
+        r.render(&z, &RenderOptions::default())
+            .unwrap()
+            .pixels
+            .is_empty()
+    );
     // An empty order draws nothing.
     let img = r
         .render_with_order(&c, &RenderOptions::default(), &[])
