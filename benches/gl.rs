@@ -33,6 +33,9 @@ fn ms(d: Duration) -> f64 {
 }
 
 fn main() {
+    // `cargo test --all-targets` runs bench binaries without `--bench`: then only smoke-test
+    // the code path on a tiny cloud instead of timing 1M splats in a debug build.
+    let smoke = !std::env::args().any(|a| a == "--bench");
     let frames: usize = std::env::var("SPLATGL_BENCH_FRAMES")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -43,6 +46,11 @@ fn main() {
         .split(',')
         .filter_map(|s| s.trim().parse().ok())
         .collect();
+    let (frames, sizes) = if smoke {
+        (1, vec![1000])
+    } else {
+        (frames, sizes)
+    };
     // Extra factor on the splat scales (e.g. 0.01: sub-pixel splats, to see the vertex cost).
     let scale_factor: f32 = std::env::var("SPLATGL_BENCH_SCALE")
         .ok()
