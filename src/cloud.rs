@@ -319,10 +319,8 @@ impl SplatCloud {
             max: first,
         };
         for p in it {
-            for i in 0..3 {
-                b.min[i] = b.min[i].min(p[i]);
-                b.max[i] = b.max[i].max(p[i]);
-            }
+            b.min = std::array::from_fn(|i| b.min[i].min(p[i]));
+            b.max = std::array::from_fn(|i| b.max[i].max(p[i]));
         }
         Some(b)
     }
@@ -350,24 +348,40 @@ impl SplatCloud {
         self.sh_degree = degree;
     }
 
-    /// Appends another cloud. SH degrees are unified to the lower of the two (the spec forbids
-    /// partial degrees, so a merged cloud can only keep what every splat has). Returns whether
-    /// coefficients were dropped.
+    /// Raises the SH degree to `degree` by appending zero coefficients (a zero coefficient
+    /// adds nothing to the colour, so the rendered result is unchanged).
+    pub fn pad_sh(&mut self, degree: u8) {
+        if degree <= self.sh_degree {
+            return;
+        }
+        let (old, new) = (self.coeffs_per_splat(), sh_coeff_count(degree));
+        let mut out = Vec::with_capacity(self.len() * new);
+        for chunk in self.sh.chunks_exact(old) {
+            out.extend_from_slice(chunk);
+            out.resize(out.len() + new - old, [0.0; 3]);
+        }
+        self.sh = out;
+        self.sh_degree = degree;
+    }
+
+    /// Appends another cloud. SH degrees are unified to the higher of the two by zero-padding
+    /// (lossless: the colours do not change). Returns whether padding happened.
     pub fn append(&mut self, mut other: SplatCloud) -> bool {
-        let target = self.sh_degree.min(other.sh_degree);
-        let dropped = self.sh_degree != other.sh_degree && !(self.is_empty() || other.is_empty());
+        let target = self.sh_degree.max(other.sh_degree);
+        let padded = self.sh_degree != other.sh_degree && !(self.is_empty() || other.is_empty());
         if self.is_empty() {
             self.sh_degree = other.sh_degree;
+            self.sh.clear();
         } else if !other.is_empty() {
-            self.truncate_sh(target);
-            other.truncate_sh(target);
+            self.pad_sh(target);
+            other.pad_sh(target);
         }
         self.positions.append(&mut other.positions);
         self.scales.append(&mut other.scales);
         self.rotations.append(&mut other.rotations);
         self.opacities.append(&mut other.opacities);
         self.sh.append(&mut other.sh);
-        dropped
+        padded
     }
 
     /// The 3×3 covariance Σ = R diag(s)² Rᵀ of splat `i`, as the upper triangle
@@ -409,10 +423,11 @@ mod tests {
             &[[2.0; 3]; 4],
         );
         assert!(a.append(b));
-        assert_eq!(a.sh_degree, 1);
-        assert_eq!(a.sh.len(), 8);
+        assert_eq!(a.sh_degree, 3);
+        assert_eq!(a.sh.len(), 32);
         assert!(a.check_lengths().is_ok());
         assert_eq!(a.sh_of(1)[0], [2.0; 3]);
+        assert_eq!(a.sh_of(1)[4], [0.0; 3], "padded with zeros");
     }
 
     #[test]

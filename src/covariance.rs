@@ -1,11 +1,13 @@
 //! Covariance algebra in f64: Σ from scale + rotation, node transforms (Σ = M C Cᵀ Mᵀ), and the
 //! way back from Σ to scale + rotation (symmetric eigen-decomposition).
 //!
-//! The loader applies node transforms with these functions and stores the result back as scale
-//! + rotation: every symmetric positive semi-definite Σ is `R diag(s)² Rᵀ` for some rotation R
+//! The loader applies node transforms with these functions and stores the result back as
+//! scale and rotation: every symmetric positive semi-definite Σ is `R diag(s)² Rᵀ` for some rotation R
 //! (eigenvectors, with one flipped if needed to make det R = +1), so no information is lost even
 //! for non-similarity (shearing, non-uniform) node matrices. For a similarity matrix the result
 //! is computed in closed form (R' = R_M·R, s' = k·s) and is exact to f32 rounding.
+
+#![allow(clippy::needless_range_loop)] // index loops mirror the matrix formulas
 
 use glam::{DMat3, DQuat, DVec3};
 

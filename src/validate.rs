@@ -1,1 +1,146 @@
-//! `splatgl validate` (in progress).
+//! `splatgl validate`: every MUST of `KHR_gaussian_splatting` (RC) for glTF input, glTF 2.0
+//! structural errors, and loadability for PLY input, as a list of [`Finding`]s.
+//!
+//! The checks are the loader's own (one pass, [`crate::load::gltf::walk`]), so what
+//! `validate` accepts is exactly what `load` reads.
+
+pub use crate::load::finding::{Finding, Severity};
+use crate::load::{Format, LoadOptions, detect_format, gltf, ply};
+use std::path::Path;
+
+/// Overall verdict; the process exit status of `splatgl validate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// No errors (warnings allowed): exit 0.
+    Valid = 0,
+    /// At least one error: exit 1.
+    Invalid = 1,
+    /// The file cannot be read or parsed at all: exit 2.
+    Unreadable = 2,
+}
+
+/// The result of validating one file.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// Detected format, if any.
+    pub format: Option<Format>,
+    /// Findings in document order.
+    pub findings: Vec<Finding>,
+    /// Whether the container could be parsed.
+    pub readable: bool,
+    /// Number of splats that would be loaded (when loading succeeds).
+    pub splat_count: Option<usize>,
+}
+
+impl Report {
+    /// Valid / invalid / unreadable.
+    pub fn status(&self) -> Status {
+        if !self.readable {
+            Status::Unreadable
+        } else if self.errors() > 0 {
+            Status::Invalid
+        } else {
+            Status::Valid
+        }
+    }
+    /// Number of errors.
+    pub fn errors(&self) -> usize {
+        self.findings
+            .iter()
+            .filter(|f| f.severity == Severity::Error)
+            .count()
+    }
+    /// Number of warnings.
+    pub fn warnings(&self) -> usize {
+        self.findings.len() - self.errors()
+    }
+    /// Machine-readable form (the `--json` output).
+    pub fn to_json(&self, file: &Path) -> serde_json::Value {
+        serde_json::json!({
+            "file": file.display().to_string(),
+            "format": self.format.map(Format::name),
+            "status": match self.status() {
+                Status::Valid => "valid",
+                Status::Invalid => "invalid",
+                Status::Unreadable => "unreadable",
+            },
+            "valid": self.status() == Status::Valid,
+            "errors": self.errors(),
+            "warnings": self.warnings(),
+            "splat_count": self.splat_count,
+            "findings": self.findings.iter().map(|f| serde_json::json!({
+                "severity": f.severity.name(),
+                "path": f.path,
+                "message": f.message,
+                "index": f.index,
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// Validates a file on disk.
+pub fn validate_path(path: &Path, opts: &LoadOptions) -> Report {
+    match std::fs::read(path) {
+        Ok(bytes) => validate_bytes(&bytes, Some(path), opts),
+        Err(e) => Report {
+            format: None,
+            findings: vec![Finding::fatal(
+                "",
+                format!("cannot read {}: {e}", path.display()),
+            )],
+            readable: false,
+            splat_count: None,
+        },
+    }
+}
+
+/// Validates bytes (`path` resolves external glTF buffers and picks the format by extension).
+pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> Report {
+    let format = detect_format(bytes, path);
+    let mut report = Report {
+        format,
+        findings: Vec::new(),
+        readable: true,
+        splat_count: None,
+    };
+    match format {
+        None => {
+            report.readable = false;
+            report.findings.push(Finding::fatal(
+                "",
+                "unknown file format (expected glTF, GLB or PLY)",
+            ));
+        }
+        Some(Format::Ply) => match ply::load(bytes) {
+            Ok(l) => {
+                report.splat_count = Some(l.cloud.len());
+                for w in l.report.warnings {
+                    report
+                        .findings
+                        .push(Finding::warning(w.location, w.message));
+                }
+            }
+            Err(e) => {
+                report.readable = !matches!(e, ply::PlyError::Header { .. });
+                report.findings.push(Finding::fatal("", e.to_string()));
+            }
+        },
+        Some(f) => match gltf::walk(bytes, f, path, opts) {
+            Err(e) => {
+                report.readable = false;
+                report.findings.push(Finding::fatal("", e.to_string()));
+            }
+            Ok(w) => {
+                report.findings = w.findings;
+                if w.splat_primitives == 0 {
+                    report.findings.push(Finding::fatal(
+                        "meshes",
+                        "no primitive uses KHR_gaussian_splatting",
+                    ));
+                }
+                report.splat_count = w.cloud.as_ref().map(|c| c.len());
+            }
+        },
+    }
+    report
+}

@@ -1,21 +1,81 @@
-//! `splatgl info`.
+//! `splatgl info FILE [--json]`.
+use splatgl::cloud::{ColorSpace, Kernel, Projection, SortingMethod};
 use std::process::ExitCode;
-/// Arguments.
+
+/// Arguments of `info`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The file.
+    /// The file (.gltf, .glb or .ply).
     pub file: std::path::PathBuf,
+    /// Print JSON (keys: format, splat_count, sh_degree, color_space, kernel, projection,
+    /// sorting_method, bounds_min, bounds_max, scale_space, non_unit_quaternions,
+    /// memory_bytes, warnings).
+    #[arg(long)]
+    pub json: bool,
+    /// How glTF SCALE values are read: auto, linear or log.
+    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
+    pub scale_space: splatgl::load::ScaleSpace,
 }
-/// Runs it.
+
+/// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
 pub fn run(a: Args) -> ExitCode {
-    match splatgl::load::load_path(&a.file, &Default::default()) {
-        Ok(l) => {
-            println!("{} splats, degree {}", l.cloud.len(), l.cloud.sh_degree);
-            ExitCode::SUCCESS
-        }
+    let opts = splatgl::load::LoadOptions {
+        scale_space: a.scale_space,
+    };
+    let loaded = match splatgl::load::load_path(&a.file, &opts) {
+        Ok(l) => l,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::from(2)
+            return ExitCode::from(2);
         }
+    };
+    let c = &loaded.cloud;
+    let r = &loaded.report;
+    let b = c.bounds();
+    let warnings: Vec<String> = r.warnings.iter().map(|w| w.to_string()).collect();
+    let info = serde_json::json!({
+        "file": a.file.display().to_string(),
+        "format": r.format.name(),
+        "splat_count": c.len(),
+        "sh_degree": c.sh_degree,
+        "color_space": c.meta.color_space.to_string_with(ColorSpace::as_str),
+        "kernel": c.meta.kernel.to_string_with(Kernel::as_str),
+        "projection": c.meta.projection.to_string_with(Projection::as_str),
+        "sorting_method": c.meta.sorting_method.to_string_with(SortingMethod::as_str),
+        "bounds_min": b.map(|b| b.min),
+        "bounds_max": b.map(|b| b.max),
+        "scale_space": r.scale_space.map(|s| s.name()),
+        "non_unit_quaternions": r.non_unit_quaternions,
+        "memory_bytes": c.memory_bytes(),
+        "warnings": warnings,
+    });
+    if a.json {
+        println!("{info:#}");
+        return ExitCode::SUCCESS;
     }
+    println!("file:           {}", a.file.display());
+    println!("format:         {}", r.format.name());
+    println!("splats:         {}", c.len());
+    println!("SH degree:      {}", c.sh_degree);
+    println!(
+        "colour space:   {}",
+        info["color_space"].as_str().unwrap_or("?")
+    );
+    println!("kernel:         {}", info["kernel"].as_str().unwrap_or("?"));
+    match b {
+        Some(b) => println!("bounds:         {:?} .. {:?}", b.min, b.max),
+        None => println!("bounds:         (empty)"),
+    }
+    println!(
+        "scale space:    {}",
+        r.scale_space.map_or("-", |s| s.name())
+    );
+    println!(
+        "memory:         {:.1} MiB",
+        c.memory_bytes() as f64 / 1048576.0
+    );
+    for w in &warnings {
+        println!("warning: {w}");
+    }
+    ExitCode::SUCCESS
 }

@@ -1,21 +1,44 @@
-//! `splatgl validate`.
+//! `splatgl validate FILE [--json]`.
 use std::process::ExitCode;
-/// Arguments.
+
+/// Arguments of `validate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The file.
+    /// The file to check (.gltf, .glb or .ply).
     pub file: std::path::PathBuf,
+    /// Print the findings as JSON (keys: file, format, status, valid, errors, warnings,
+    /// splat_count, findings[{severity, path, message, index}]).
+    #[arg(long)]
+    pub json: bool,
+    /// How SCALE values are read: auto (signed types or negatives mean the review draft's
+    /// log space), linear (RC) or log.
+    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
+    pub scale_space: splatgl::load::ScaleSpace,
 }
-/// Runs it.
+
+/// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
 pub fn run(a: Args) -> ExitCode {
-    match splatgl::load::load_path(&a.file, &Default::default()) {
-        Ok(l) => {
-            println!("{} splats, degree {}", l.cloud.len(), l.cloud.sh_degree);
-            ExitCode::SUCCESS
+    let opts = splatgl::load::LoadOptions {
+        scale_space: a.scale_space,
+    };
+    let report = splatgl::validate::validate_path(&a.file, &opts);
+    if a.json {
+        println!("{:#}", report.to_json(&a.file));
+    } else {
+        for f in &report.findings {
+            println!("{f}");
         }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
+        let verdict = match report.status() {
+            splatgl::validate::Status::Valid => "valid",
+            splatgl::validate::Status::Invalid => "INVALID",
+            splatgl::validate::Status::Unreadable => "UNREADABLE",
+        };
+        println!(
+            "{}: {verdict} ({} errors, {} warnings)",
+            a.file.display(),
+            report.errors(),
+            report.warnings()
+        );
     }
+    ExitCode::from(report.status() as u8)
 }

@@ -6,6 +6,7 @@
 //! expected. No input panics, and sizes claimed by headers are checked against the bytes that
 //! are really there before anything is allocated.
 
+pub mod finding;
 pub mod gltf;
 pub mod ply;
 

@@ -303,6 +303,18 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
         )));
     }
     let find = |name: &str| vertex.props.iter().position(|p| p.name == name);
+    let n_rest = vertex
+        .props
+        .iter()
+        .filter(|p| p.name.starts_with("f_rest_"))
+        .count();
+    let sh_degree = match n_rest {
+        0 => 0,
+        9 => 1,
+        24 => 2,
+        45 => 3,
+        count => return Err(PlyError::BadShCount { count }),
+    };
     let need = |name: &str| {
         find(name).ok_or_else(|| PlyError::MissingProperty {
             property: name.to_owned(),
@@ -331,18 +343,6 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
             ([r, need("green")?, need("blue")?], Some(div))
         }
         None => return Err(need("f_dc_0").unwrap_err()),
-    };
-    let n_rest = vertex
-        .props
-        .iter()
-        .filter(|p| p.name.starts_with("f_rest_"))
-        .count();
-    let sh_degree = match n_rest {
-        0 => 0,
-        9 => 1,
-        24 => 2,
-        45 => 3,
-        count => return Err(PlyError::BadShCount { count }),
     };
     let rest = (0..n_rest)
         .map(|i| need(&format!("f_rest_{i}")))
@@ -462,7 +462,7 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
             let start = skip_binary(&header.elements[..vi], body, enc == Encoding::Be)?;
             let rows = &body[start..];
             let n = vertex.count;
-            let needed = n.checked_mul(l.stride as u64).unwrap_or(u64::MAX);
+            let needed = n.saturating_mul(l.stride as u64);
             if needed > rows.len() as u64 || (n > 0 && l.stride == 0) {
                 return Err(PlyError::Truncated {
                     element: "vertex".into(),
@@ -510,7 +510,7 @@ fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyEr
         }
         if el.props.iter().all(|p| p.list.is_none()) {
             let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
-            let needed = el.count.checked_mul(row as u64).unwrap_or(u64::MAX);
+            let needed = el.count.saturating_mul(row as u64);
             if needed > (body.len() - pos) as u64 {
                 return Err(truncated(pos));
             }
@@ -562,6 +562,7 @@ fn decode_binary(
 ) -> Result<(SplatCloud, usize), PlyError> {
     let n = rows.len().checked_div(l.stride).unwrap_or(0);
     let k = sh_coeff_count(l.sh_degree);
+    let all_f32_le = !be && l.cols.iter().all(|&(_, t)| t == Scalar::F32);
     let mut cloud = SplatCloud::new(l.sh_degree);
     cloud.positions = vec![[0.0; 3]; n];
     cloud.scales = vec![[0.0; 3]; n];
@@ -581,21 +582,24 @@ fn decode_binary(
             let mut non_unit = 0;
             for i in 0..p.len() {
                 let row = &raw[i * l.stride..(i + 1) * l.stride];
-                let get = |c: usize| {
-                    let (off, ty) = l.cols[c];
-                    ty.read(&row[off..], be)
+                let out = (&mut p[i], &mut s[i], &mut r[i], &mut o[i]);
+                let sh = &mut sh[i * k..(i + 1) * k];
+                // The common case (every column f32, little endian) gets its own
+                // monomorphised copy of `convert_row` without the per-value type dispatch.
+                let off = if all_f32_le {
+                    let get = |c: usize| {
+                        let off = l.cols[c].0;
+                        f32::from_le_bytes([row[off], row[off + 1], row[off + 2], row[off + 3]])
+                            as f64
+                    };
+                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
+                } else {
+                    let get = |c: usize| {
+                        let (off, ty) = l.cols[c];
+                        ty.read(&row[off..], be)
+                    };
+                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
                 };
-                let off = convert_row(
-                    l,
-                    props,
-                    b * BLOCK + i,
-                    get,
-                    &mut p[i],
-                    &mut s[i],
-                    &mut r[i],
-                    &mut o[i],
-                    &mut sh[i * k..(i + 1) * k],
-                )?;
                 non_unit += off as usize;
             }
             Ok(non_unit)
@@ -663,7 +667,12 @@ fn load_ascii(
                 line: line_no,
                 message: format!("expected {ncols} values, found {c}"),
             })?;
-            *v = tok.parse::<f64>().map_err(|_| PlyError::Ascii {
+            // Parse at the declared precision so ASCII equals the binary encoding exactly.
+            let parsed = match vertex.props[c].ty {
+                Scalar::F32 => tok.parse::<f32>().map(f64::from).ok(),
+                _ => tok.parse::<f64>().ok(),
+            };
+            *v = parsed.ok_or_else(|| PlyError::Ascii {
                 line: line_no,
                 message: format!(
                     "value {tok:?} of property '{}' is not a number",

@@ -1,0 +1,81 @@
+//! Applying a node's global transform to a local-space cloud (RC §Splat Reconstruction).
+
+use crate::cloud::SplatCloud;
+use crate::covariance::{
+    as_similarity, polar_rotation, scale_rotation_from_covariance, transformed_covariance,
+};
+use crate::load::finding::Finding;
+use crate::sh::ShRotation;
+use glam::{DMat3, DMat4, DQuat, DVec3};
+
+/// Checks the RC's decomposability conditions for a node matrix (SHOULDs: warnings).
+fn check_decomposable(m: DMat3, node: usize, findings: &mut Vec<Finding>) {
+    let path = format!("nodes[{node}]");
+    let lens = [m.x_axis.length(), m.y_axis.length(), m.z_axis.length()];
+    if lens.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
+        findings.push(Finding::warning(
+            path,
+            "global transform has a zero or non-finite column: not decomposable, splat rendering is undefined (RC)",
+        ));
+        return;
+    }
+    let n = DMat3::from_cols(m.x_axis / lens[0], m.y_axis / lens[1], m.z_axis / lens[2]);
+    if (n.determinant() - 1.0).abs() > 1e-3 {
+        findings.push(Finding::warning(
+            path,
+            format!(
+                "global transform is not rotation × positive scale (det of the normalised 3×3 = {:.4}): splat rendering is undefined (RC)",
+                n.determinant()
+            ),
+        ));
+    }
+}
+
+/// Returns the cloud in global space under `m` (the node's global matrix).
+pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Finding>) -> SplatCloud {
+    let mut out = local.clone();
+    if m == DMat4::IDENTITY {
+        return out;
+    }
+    let m3 = DMat3::from_mat4(m);
+    check_decomposable(m3, node, findings);
+    for p in &mut out.positions {
+        let g = m.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+        *p = [g.x as f32, g.y as f32, g.z as f32];
+    }
+    if m3 != DMat3::IDENTITY {
+        match as_similarity(m3, 1e-6) {
+            Some((r, k)) => {
+                let qm = DQuat::from_mat3(&r).normalize();
+                for (s, q) in out.scales.iter_mut().zip(out.rotations.iter_mut()) {
+                    *s = s.map(|v| (v as f64 * k) as f32);
+                    let ql = DQuat::from_xyzw(q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64);
+                    let g = (qm * ql).normalize();
+                    *q = [g.x as f32, g.y as f32, g.z as f32, g.w as f32];
+                }
+            }
+            None => {
+                for (s, q) in out.scales.iter_mut().zip(out.rotations.iter_mut()) {
+                    let sigma = transformed_covariance(m3, *s, *q);
+                    (*s, *q) = scale_rotation_from_covariance(sigma);
+                }
+            }
+        }
+        if out.sh_degree > 0 {
+            match polar_rotation(m3) {
+                Some(r) => {
+                    let rot = ShRotation::new(r);
+                    let k = out.coeffs_per_splat();
+                    for c in out.sh.chunks_exact_mut(k) {
+                        rot.apply(c);
+                    }
+                }
+                None => findings.push(Finding::warning(
+                    format!("nodes[{node}]"),
+                    "singular transform: SH coefficients left unrotated",
+                )),
+            }
+        }
+    }
+    out
+}

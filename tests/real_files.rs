@@ -1,0 +1,160 @@
+//! Every file in ../shared/data/real/ that the glTF and PLY loaders cover loads with the right
+//! count and SH degree, with the warnings it deserves; the others fail with a precise error.
+
+mod common;
+use common::real;
+use splatgl::load::{LoadError, LoadOptions, ScaleSeen, load_path};
+use splatgl::validate::{Status, validate_path};
+
+fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Loaded> {
+    let path = real(name)?;
+    let l = load_path(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(l.cloud.len(), count, "{name}: splat count");
+    assert_eq!(l.cloud.sh_degree, degree, "{name}: SH degree");
+    assert!(l.cloud.check_lengths().is_ok());
+    for q in &l.cloud.rotations {
+        let n: f32 = q.iter().map(|v| v * v).sum();
+        assert!((n - 1.0).abs() < 1e-5, "{name}: quaternions are normalised");
+    }
+    assert!(l.cloud.opacities.iter().all(|o| (0.0..=1.0).contains(o)));
+    assert!(
+        l.cloud
+            .scales
+            .iter()
+            .flatten()
+            .all(|s| *s >= 0.0 && s.is_finite())
+    );
+    Some(l)
+}
+
+fn has_warning(l: &splatgl::load::Loaded, needle: &str) -> bool {
+    l.report
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains(needle))
+}
+
+#[test]
+fn inria_ply_files() {
+    if let Some(l) = load_ok("supersplat_fruit_drops_minimal_sh3.ply", 4721, 3) {
+        assert!(
+            l.report.non_unit_quaternions > 4000,
+            "|q| ranges 0.60..1.93"
+        );
+        assert!(has_warning(&l, "not unit length"));
+    }
+    if let Some(l) = load_ok("mujoco_warp_fox_sh0.ply", 50_000, 0) {
+        // +inf logits become opacity 1.
+        assert!(l.cloud.opacities.contains(&1.0));
+    }
+    if let Some(l) = load_ok("splatapult_test_16splats_sh3.ply", 16, 3) {
+        // log scale -2.996 → 0.05; logit 100 → 1.
+        assert!((l.cloud.scales[0][0] - (-2.996f32).exp()).abs() < 1e-4);
+        assert!((l.cloud.opacities[0] - 1.0).abs() < 1e-6);
+    }
+    if let Some(l) = load_ok("jsplat_unitCube-ascii.ply", 20, 0) {
+        let b = l.cloud.bounds().unwrap();
+        let extent: Vec<f32> = (0..3).map(|i| b.max[i] - b.min[i]).collect();
+        assert!(
+            extent.iter().all(|e| (e - 10.0).abs() < 1e-3),
+            "10-unit cube: {extent:?}"
+        );
+    }
+}
+
+#[test]
+fn compressed_ply_is_a_clear_unsupported_error() {
+    for name in [
+        "playcanvas_guitar.compressed.ply",
+        "playcanvas_biker.compressed.ply",
+    ] {
+        let Some(p) = real(name) else { continue };
+        let e = load_path(&p, &LoadOptions::default()).unwrap_err();
+        assert!(matches!(e, LoadError::Ply { .. }), "{e}");
+        assert!(e.to_string().contains("compressed PLY"), "{e}");
+    }
+}
+
+#[test]
+fn bevy_conformance_matrix_legacy_draft() {
+    for name in [
+        "bevy_khr_conformance_matrix.glb",
+        "bevy_khr_conformance_matrix.gltf",
+    ] {
+        let Some(l) = load_ok(name, 15, 3) else {
+            continue;
+        };
+        assert_eq!(l.report.scale_space, Some(ScaleSeen::Log));
+        assert!(has_warning(&l, "legacy draft: log-space scale"), "{name}");
+        assert!(has_warning(&l, "different SH degrees"), "{name}");
+        // Every component type decodes to the same splat: position (1,2,3) everywhere.
+        assert!(l.cloud.positions.iter().all(|p| *p == [1.0, 2.0, 3.0]));
+        // rotation f32 / i8 norm / i16 norm decode to the same quaternion.
+        assert!(l.cloud.rotations.iter().all(|q| *q == [1.0, 0.0, 0.0, 0.0]));
+        // opacity f32 / u8 norm / u16 norm (meshes 8..=10; mesh 8 stores 0.75).
+        assert!((l.cloud.opacities[9] - 64.0 / 255.0).abs() < 1e-6);
+        assert!((l.cloud.opacities[10] - 0.25).abs() < 1.0 / 65535.0);
+        let v = validate_path(&real(name).unwrap(), &LoadOptions::default());
+        assert_eq!(v.status(), Status::Invalid, "legacy scale violates the RC");
+    }
+}
+
+#[test]
+fn bevy_extensible_fallback_unknown_values() {
+    let Some(l) = load_ok("bevy_khr_extensible_fallback.gltf", 1, 0) else {
+        return;
+    };
+    assert!(has_warning(&l, "unknown value \"customShape\""));
+    assert!(has_warning(&l, "unknown value \"custom_space_display\""));
+    assert!(has_warning(&l, "derived from COLOR_0"));
+    assert_eq!(
+        l.cloud.meta.kernel,
+        splatgl::cloud::Known::Unknown("customShape".into())
+    );
+}
+
+#[test]
+fn spz_and_legacy_compression_are_named_errors() {
+    for (name, ext) in [
+        (
+            "cesium_native_spz2_basic.glb",
+            "KHR_gaussian_splatting_compression_spz_2",
+        ),
+        (
+            "sharpgltf_tower_legacy_spz_v2.glb",
+            "KHR_spz_gaussian_splats_compression",
+        ),
+        (
+            "tiles_tools_UnitSH_legacy.glb",
+            "KHR_spz_gaussian_splats_compression",
+        ),
+    ] {
+        let Some(p) = real(name) else { continue };
+        let e = load_path(&p, &LoadOptions::default()).unwrap_err();
+        assert!(e.to_string().contains(ext), "{name}: {e}");
+    }
+}
+
+#[test]
+fn validate_flags_cesium_profile() {
+    let Some(p) = real("cesium_native_spz2_basic.glb") else {
+        return;
+    };
+    let r = validate_path(&p, &LoadOptions::default());
+    assert_eq!(r.status(), Status::Invalid);
+    let msgs: Vec<String> = r
+        .findings
+        .iter()
+        .map(|f| format!("{} {}", f.path, f.message))
+        .collect();
+    for needle in [
+        "'kernel' is missing",
+        "'colorSpace' is missing",
+        "compression_spz_2",
+    ] {
+        assert!(
+            msgs.iter().any(|m| m.contains(needle)),
+            "{needle} in {msgs:#?}"
+        );
+    }
+}
