@@ -230,11 +230,29 @@ impl Camera {
         .validated()
     }
 
-    /// A camera that frames `points` (non-finite ones ignored): it looks at the centre of the
-    /// box spanned by the 1st..99th percentile of each coordinate (robust to stray splats) from
-    /// direction `(0, 0.35, 1)` (glTF is +Y up), far enough that the box's bounding sphere
-    /// fits the smaller field of view. `None` when there is no finite point.
+    /// A camera that frames `points` in glTF's convention (+Y up): see [`Self::frame_points_along`]
+    /// with `forward = (0, −0.35, −1)`, `up = +Y` (looking from +Z, slightly from above).
     pub fn frame_points(points: &[[f32; 3]], fov_y: f32, width: u32, height: u32) -> Option<Self> {
+        let fwd = Vec3::new(0.0, -0.35, -1.0);
+        Self::frame_points_along(points, fwd, Vec3::Y, fov_y, width, height)
+    }
+
+    /// A camera looking along `forward` with `up` roughly up that frames `points` (non-finite
+    /// ones ignored): it looks at the centre of the box spanned by the 1st..99th percentile of
+    /// each coordinate (robust to stray splats), far enough that the box's bounding sphere fits
+    /// the smaller field of view (10 % margin). For INRIA PLY scenes (COLMAP axes, usually −Y
+    /// up) the CLI uses `forward = (0, 0.35, −1)`, `up = −Y`. `None` when there is no finite point or `forward ∥ up`.
+    pub fn frame_points_along(
+        points: &[[f32; 3]],
+        forward: Vec3,
+        up: Vec3,
+        fov_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        if forward.cross(up).length_squared() <= 1e-12 {
+            return None;
+        }
         let mut axes: [Vec<f32>; 3] = Default::default();
         for p in points.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
             for (a, v) in axes.iter_mut().zip(p) {
@@ -259,9 +277,8 @@ impl Camera {
         let tan_min = tan_y.min(tan_y * width as f32 / height.max(1) as f32);
         // The bounding sphere fits when dist · sin(half fov) ≥ radius; 10 % margin.
         let dist = 1.1 * radius / tan_min.atan().sin();
-        let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
-        let eye = centre + dir * dist;
-        let mut cam = Self::look_at(eye, centre, Vec3::Y, fov_y, width, height);
+        let eye = centre - forward.normalize() * dist;
+        let mut cam = Self::look_at(eye, centre, up, fov_y, width, height);
         cam.far = (dist + 2.0 * radius).max(cam.far);
         Some(cam)
     }

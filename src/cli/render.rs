@@ -44,13 +44,16 @@ pub struct Args {
     #[arg(conflicts_with = "gltf_camera")]
     pub look_at: Option<String>,
     /// Use the N-th glTF camera node of the scene.
+    ///
+    /// Without any camera option the view frames the scene: glTF from +Z with +Y up, PLY
+    /// (COLMAP axes) from +Z with −Y up; the default scene has its own camera.
     #[arg(long, value_name = "N")]
     pub gltf_camera: Option<usize>,
     /// Image width (default 640, or the cameras.json view's, scaled).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: Option<u32>,
     /// Image height (default 480, or the cameras.json view's, scaled).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: Option<u32>,
     /// Vertical field of view in degrees (look-at and automatic framing).
     #[arg(long, default_value_t = 50.0, value_name = "DEG")]
@@ -108,7 +111,7 @@ fn size_or(a: &Args, w: u32, h: u32) -> (u32, u32) {
     }
 }
 
-fn camera(a: &Args, cloud: &splatgl::SplatCloud) -> Result<Camera, String> {
+fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, String> {
     let fov = a.fov.to_radians();
     if !(fov > 0.0 && fov < std::f32::consts::PI) {
         return Err(format!("--fov {} must be in (0, 180)", a.fov));
@@ -152,8 +155,14 @@ fn camera(a: &Args, cloud: &splatgl::SplatCloud) -> Result<Camera, String> {
     if a.scene.is_none() {
         return Ok(splatgl::scene::default_camera(w, h));
     }
-    Camera::frame_points(&cloud.positions, fov, w, h)
-        .ok_or_else(|| "the scene has no finite splat to frame; give --look-at".into())
+    let framed = if ply {
+        // INRIA/COLMAP axes: −Y up. Look from +Z, slightly from above (−Y).
+        let fwd = Vec3::new(0.0, 0.35, -1.0);
+        Camera::frame_points_along(&cloud.positions, fwd, -Vec3::Y, fov, w, h)
+    } else {
+        Camera::frame_points(&cloud.positions, fov, w, h)
+    };
+    framed.ok_or_else(|| "the scene has no finite splat to frame; give --look-at".into())
 }
 
 fn write(img: &Image, a: &Args) -> Result<(), String> {
@@ -186,11 +195,11 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
 
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
-    let cloud = match &a.scene {
+    let (cloud, ply) = match &a.scene {
         Some(p) => load(p)?,
-        None => splatgl::scene::default_scene(),
+        None => (splatgl::scene::default_scene(), false),
     };
-    let cam = camera(a, &cloud)?;
+    let cam = camera(a, &cloud, ply)?;
     let bg = floats(&a.background, "--background", &[3])?;
     let opts = RenderOptions {
         sh_degree: a.sh_degree,
@@ -221,12 +230,13 @@ fn go(a: &Args) -> Result<(), String> {
     Ok(())
 }
 
-fn load(p: &Path) -> Result<splatgl::SplatCloud, String> {
+/// The cloud and whether it came from a PLY (COLMAP axes) rather than glTF (+Y up).
+fn load(p: &Path) -> Result<(splatgl::SplatCloud, bool), String> {
     let l = splatgl::load::load_path(p, &Default::default()).map_err(|e| e.to_string())?;
     for w in &l.report.warnings {
         eprintln!("warning: {w}");
     }
-    Ok(l.cloud)
+    Ok((l.cloud, l.report.format == splatgl::load::Format::Ply))
 }
 
 /// Runs it. Exit status 0 on success, 2 on any error.

@@ -29,6 +29,9 @@ pub enum ImageError {
     /// A malformed PFM file.
     #[error("PFM: {0}")]
     Pfm(String),
+    /// A PNG whose decoded size does not fit in memory.
+    #[error("PNG too large to decode")]
+    PngTooLarge,
     /// Neither PNG nor PFM.
     #[error("{0}: unknown image format (expected .png or .pfm)")]
     UnknownFormat(PathBuf),
@@ -90,9 +93,7 @@ impl Image {
         let mut dec = png::Decoder::new(Cursor::new(bytes));
         dec.set_transformations(png::Transformations::EXPAND);
         let mut reader = dec.read_info()?;
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| ImageError::Pfm("PNG too large".into()))?;
+        let size = reader.output_buffer_size().ok_or(ImageError::PngTooLarge)?;
         let mut buf = vec![0; size];
         let info = reader.next_frame(&mut buf)?;
         let channels = info.color_type.samples();

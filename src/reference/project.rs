@@ -32,6 +32,9 @@ pub struct Projected {
     pub conic: [f32; 3],
     /// Opacity attribute.
     pub opacity: f32,
+    /// A pure optimisation: beyond this m² no pixel can reach α ≥ 1/255, so the exponential
+    /// is skipped: `min(9, 2·ln(255·opacity) + 1e-3)` (the margin covers f32 rounding).
+    pub m2_max: f32,
     /// SH colour (negatives clamped to 0).
     pub color: [f32; 3],
     /// `[x0, x1, y0, y1]`: the pixels `x0..x1` × `y0..y1` (exclusive ends) whose centres lie in
@@ -95,12 +98,13 @@ impl ViewContext {
     /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
     pub fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
         let opacity = cloud.opacities[i];
-        if !(opacity.min(ALPHA_MAX) >= ALPHA_MIN) {
-            return None; // no pixel can reach α ≥ 1/255 (also NaN)
+        let best_alpha = opacity.min(ALPHA_MAX);
+        if best_alpha.is_nan() || best_alpha < ALPHA_MIN {
+            return None; // no pixel can reach α ≥ 1/255
         }
         let mean = DVec3::from_array(cloud.positions[i].map(f64::from));
         let t = self.w2c.transform_point3(mean);
-        if !(t.z > self.cull_z) || !t.is_finite() {
+        if !t.is_finite() || t.z <= self.cull_z {
             return None;
         }
         let sigma = unpack_sym(covariance_from_scale_rotation(
@@ -130,6 +134,7 @@ impl ViewContext {
             cov: [a as f32, b as f32, c as f32],
             conic: [(c / det) as f32, (-b / det) as f32, (a / det) as f32],
             opacity,
+            m2_max: (2.0 * (255.0 * opacity as f64).ln() + 1e-3).min(CUTOFF_M2 as f64) as f32,
             color,
             bbox: [bbox.0.0, bbox.0.1, bbox.1.0, bbox.1.1],
         })

@@ -29,7 +29,7 @@ pub fn bin(splats: &[Projected], width: u32, height: u32) -> Vec<Vec<u32>> {
 pub fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
     let [a, b, c] = s.conic;
     let m2 = a * dx * dx + 2.0 * b * dx * dy + c * dy * dy;
-    if m2 > CUTOFF_M2 {
+    if m2 > CUTOFF_M2 || m2 > s.m2_max {
         return;
     }
     let alpha = (s.opacity * (-0.5 * m2).exp()).min(ALPHA_MAX);
@@ -37,8 +37,8 @@ pub fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
         return;
     }
     let keep = 1.0 - alpha;
-    for ch in 0..3 {
-        px[ch] = s.color[ch] * alpha + px[ch] * keep;
+    for (p, c) in px[..3].iter_mut().zip(s.color) {
+        *p = c * alpha + *p * keep;
     }
     px[3] = alpha + px[3] * keep;
 }
