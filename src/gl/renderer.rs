@@ -10,13 +10,23 @@ use crate::camera::Camera;
 use crate::cloud::SplatCloud;
 
 /// Per-draw settings; change them between draws with [`SplatRenderer::settings_mut`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DrawSettings {
     /// SH degree to evaluate (clamped to the cloud's degree); `None` = the cloud's degree.
     pub sh_degree: Option<u8>,
-    /// Test against the bound depth buffer (`LESS`, never writing depth). Use it when splats are
-    /// composited into a host's 3D scene; off by default.
+    /// Test against the bound depth buffer (`LESS`, never writing depth), so splats hide behind
+    /// the host's opaque geometry. On by default (embedding); without a depth attachment the
+    /// test always passes. The headless renderer turns it off.
     pub depth_test: bool,
+}
+
+impl Default for DrawSettings {
+    fn default() -> Self {
+        DrawSettings {
+            sh_degree: None,
+            depth_test: true,
+        }
+    }
 }
 
 #[derive(Debug)]
