@@ -9,6 +9,9 @@
 //! frame on llvmpipe takes long enough that criterion's minimum sample counts would make the
 //! run minutes long. Each phase ends with `glFinish`, so GPU work is attributed to it.
 //!
+//! `draw CPU ms` is the process's CPU time (all threads) during the draw: on a machine shared
+//! with other jobs it moves far less than wall time.
+//!
 //! Scene: `scene::random_cloud(n, 3, 1.0, seed)` (means uniform in [-1, 1]³, SH degree 3)
 //! with scales × 0.2·(10⁵/n)^(1/3), so the covered screen area is about the same for both sizes;
 //! camera at distance 3.2, 50° vertical fov.
@@ -22,6 +25,19 @@ use splatgl::gl::sort::DistanceSorter;
 use splatgl::gl::{OffscreenTarget, SplatRenderer};
 use splatgl::headless::{HeadlessContext, HeadlessError};
 use splatgl::scene;
+
+/// CPU time of the whole process (all threads, so llvmpipe's rasterizer threads count), which
+/// is far less disturbed than wall time when other jobs share the machine.
+fn cpu_time() -> Duration {
+    let mut u = std::mem::MaybeUninit::<libc::rusage>::zeroed();
+    // SAFETY: getrusage writes a rusage struct into the valid, writable pointer it is given.
+    let u = unsafe {
+        libc::getrusage(libc::RUSAGE_SELF, u.as_mut_ptr());
+        u.assume_init()
+    };
+    let tv = |t: libc::timeval| Duration::new(t.tv_sec as u64, t.tv_usec as u32 * 1000);
+    tv(u.ru_utime) + tv(u.ru_stime)
+}
 
 fn median(v: &mut [Duration]) -> Duration {
     v.sort();
@@ -93,12 +109,13 @@ fn main() {
     let mut sorter = DistanceSorter::default();
     let mut order = Vec::new();
     println!(
-        "{:>9} | {:>8} | {:>9} | {:>9} | {:>9} | {:>9} | {:>12} | {:>10}",
+        "{:>9} | {:>8} | {:>9} | {:>9} | {:>9} | {:>12} | {:>9} | {:>12} | {:>10}",
         "splats",
         "target",
         "sort ms",
         "upload ms",
         "draw ms",
+        "draw CPU ms",
         "frame ms",
         "bytes/frame",
         "upload once"
@@ -114,7 +131,7 @@ fn main() {
         // SAFETY: glFinish has no preconditions.
         unsafe { gl.finish() };
         let upload_once = t.elapsed();
-        let (mut ts, mut tu, mut td) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut ts, mut tu, mut td, mut tc) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for f in 0..frames + 1 {
             // Orbit a little so every frame sorts a new order.
             let a = 0.05 * f as f32;
@@ -133,6 +150,7 @@ fn main() {
             // SAFETY: glFinish has no preconditions.
             unsafe { gl.finish() };
             let t2 = Instant::now();
+            let c2 = cpu_time();
             if float_target {
                 offscreen.begin(gl, [0.0; 4]);
                 renderer.draw_current(gl, &cam).unwrap();
@@ -143,21 +161,29 @@ fn main() {
             // SAFETY: glFinish has no preconditions.
             unsafe { gl.finish() };
             let t3 = Instant::now();
+            let c3 = cpu_time();
             if f > 0 {
                 // Frame 0 warms up (shader variants, caches).
                 ts.push(t1 - t0);
                 tu.push(t2 - t1);
                 td.push(t3 - t2);
+                tc.push(c3 - c2);
             }
         }
-        let (s, u, d) = (median(&mut ts), median(&mut tu), median(&mut td));
+        let (s, u, d, dc) = (
+            median(&mut ts),
+            median(&mut tu),
+            median(&mut td),
+            median(&mut tc),
+        );
         println!(
-            "{:>9} | {:>8} | {:>9.2} | {:>9.2} | {:>9.2} | {:>9.2} | {:>12} | {:>8.0}ms",
+            "{:>9} | {:>8} | {:>9.2} | {:>9.2} | {:>9.2} | {:>12.2} | {:>9.2} | {:>12} | {:>8.0}ms",
             n,
             if float_target { "RGBA16F" } else { "RGBA8" },
             ms(s),
             ms(u),
             ms(d),
+            ms(dc),
             ms(s + u + d),
             4 * order.len(),
             ms(upload_once)

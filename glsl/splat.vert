@@ -121,7 +121,7 @@ void main() {
     cov2d[1][1] += DILATION;
 #endif
 
-    // --- STEP 4: extent (radius of the circle around the 3-sigma ellipse) ---
+    // --- STEP 4: extent (radius of the circle around the 3-sigma ellipse, as in 3DGS) ---
     float det = cov2d[0][0] * cov2d[1][1] - cov2d[0][1] * cov2d[0][1];
     if (!(det > 0.0) || isinf(det)) {
         cull();
@@ -142,13 +142,29 @@ void main() {
     // Erratum d: r pixels are 2r/viewport in NDC; the centre in window pixels is
     // (ndc/2 + 1/2) * viewport size + viewport origin (gl_FragCoord's frame).
     v_center_px = (ndc_pos * 0.5 + 0.5) * u_viewport.zw + u_viewport.xy;
-    // Quads entirely outside the viewport would be clipped anyway: skip their SH work.
-    if (any(lessThan(v_center_px + radius, u_viewport.xy)) ||
-        any(greaterThan(v_center_px - radius, u_viewport.xy + u_viewport.zw))) {
+    // Splats whose 3-sigma box (half-extents 3 sqrt(Sigma'_xx), 3 sqrt(Sigma'_yy)) misses the
+    // viewport would be clipped anyway: skip their SH work.
+    vec2 extent = min(sqrt(CUTOFF_M2 * vec2(cov2d[0][0], cov2d[1][1])) + 0.5, vec2(radius));
+    if (any(lessThan(v_center_px + extent, u_viewport.xy)) ||
+        any(greaterThan(v_center_px - extent, u_viewport.xy + u_viewport.zw))) {
         cull();
         return;
     }
-    clip_space_pos.xy += corner * (2.0 * radius / u_viewport.zw) * clip_space_pos.w;
+    // The quad is the 3-sigma ellipse's bounding rectangle along the eigenvectors of Sigma'
+    // rather than the appendix's square of side 2 * radius: far fewer fragments for elongated
+    // splats. The fragment shader's exact cut decides which pixels count, so any quad that
+    // contains the ellipse gives the same image; the 2% + 0.5 px margin covers f32 rounding in
+    // the eigen-decomposition, and the square still bounds it.
+    float l1 = mid + sqrt(max(mid * mid - det, 0.0));
+    float l2 = det / l1;
+    vec2 axis1 = cov2d[0][0] >= cov2d[1][1] ? vec2(l1 - cov2d[1][1], cov2d[0][1])
+                                            : vec2(cov2d[0][1], l1 - cov2d[0][0]);
+    float axis1_len = length(axis1);
+    axis1 = axis1_len > 0.0 ? axis1 / axis1_len : vec2(1.0, 0.0);
+    vec2 axis2 = vec2(-axis1.y, axis1.x);
+    vec2 half_axes = min(sqrt(CUTOFF_M2 * vec2(l1, l2)) * 1.02 + 0.5, vec2(radius));
+    vec2 offset_px = corner.x * half_axes.x * axis1 + corner.y * half_axes.y * axis2;
+    clip_space_pos.xy += offset_px * (2.0 / u_viewport.zw) * clip_space_pos.w;
 #endif
     gl_Position = clip_space_pos;
 

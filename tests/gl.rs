@@ -228,6 +228,8 @@ fn single_splats_many_anisotropies_and_rotations() {
         [0.25, 0.25, 0.25],
         [0.6, 0.02, 0.2],
         [0.01, 0.3, 0.3],
+        // Needle: the oriented quad must still contain the whole 3σ ellipse.
+        [1.5, 0.004, 0.004],
     ];
     let rotations = [
         Quat::IDENTITY,
