@@ -1066,3 +1066,31 @@ fn embedding_depth_test_and_documented_state() {
         }
     }
 }
+
+#[test]
+fn one_shot_render_function_matches_the_renderer() {
+    // `splatgl::headless::render` is what a CLI `--backend gl` calls.
+    let cloud = scene::default_scene();
+    let c = scene::default_camera(48, 36);
+    let opts = RenderOptions {
+        background: [0.1, 0.1, 0.1],
+        sh_degree: Some(3), // above the cloud's degree 1: clamped, like the reference
+        ..Default::default()
+    };
+    let img = match splatgl::headless::render(&cloud, &c, &opts) {
+        Ok(img) => img,
+        Err(HeadlessError::EglUnavailable(msg)) => {
+            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    assert_eq!((img.width, img.height), (48, 36));
+    let mut r = headless().unwrap();
+    r.upload(&cloud).unwrap();
+    let again = r.render(&c, &opts).unwrap();
+    assert_eq!(img.to_rgba8(), again.to_rgba8());
+    let want = reference_image(&cloud, &c, 1, opts.background, false);
+    let s = score(&img, &want);
+    assert!(s.psnr >= MIN_PSNR, "{s:?}");
+}
