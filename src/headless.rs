@@ -300,7 +300,6 @@ pub struct HeadlessRenderer {
     renderer: SplatRenderer,
     fbo: Option<Fbo8>,
     offscreen: Option<OffscreenTarget>,
-    color_space: ColorSpace,
     positions: Vec<[f32; 3]>,
     sorter: DistanceSorter,
     order: Vec<u32>,
@@ -328,7 +327,6 @@ impl HeadlessRenderer {
             renderer,
             fbo: None,
             offscreen: None,
-            color_space: ColorSpace::default(),
             positions: Vec::new(),
             sorter: DistanceSorter::default(),
             order: Vec::new(),
@@ -356,7 +354,6 @@ impl HeadlessRenderer {
     pub fn upload(&mut self, cloud: &SplatCloud) -> Result<(), HeadlessError> {
         self.ctx.make_current()?;
         self.renderer.upload(self.ctx.gl(), cloud)?;
-        self.color_space = cloud.meta.color_space.effective();
         self.positions.clear();
         self.positions.extend_from_slice(&cloud.positions);
         Ok(())
@@ -383,7 +380,8 @@ impl HeadlessRenderer {
         order: &[u32],
     ) -> Result<Image, HeadlessError> {
         self.ctx.make_current()?;
-        let linear = opts.color_space.unwrap_or(self.color_space) == ColorSpace::LinRec709Display;
+        let linear =
+            opts.color_space.unwrap_or(self.renderer.color_space()) == ColorSpace::LinRec709Display;
         let (w, h) = (camera.width, camera.height);
         if w == 0 || h == 0 {
             return Ok(Image::filled(w, h, [0.0; 4])); // no pixels (a 0-sized FBO is incomplete)

@@ -7,7 +7,7 @@ use super::GlError;
 use super::data::SplatTextures;
 use super::program::{self, Errata, GlslVersion};
 use crate::camera::Camera;
-use crate::cloud::SplatCloud;
+use crate::cloud::{ColorSpace, SplatCloud};
 
 /// Per-draw settings; change them between draws with [`SplatRenderer::settings_mut`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -50,6 +50,15 @@ struct Uniforms {
 ///
 /// Per frame only the order is uploaded (`glBufferSubData`, 4 bytes per splat) and nothing is
 /// allocated on the host.
+///
+/// # Colour spaces
+///
+/// The shader writes the reconstructed colours as they are (premultiplied). For
+/// `srgb_rec709_display` clouds that is final. For `lin_rec709_display` clouds
+/// ([`SplatRenderer::color_space`]) blending must happen on linear values and the result be
+/// sRGB-encoded once at the end: draw into an `SRGB8_ALPHA8` framebuffer (ES always converts;
+/// desktop GL needs `GL_FRAMEBUFFER_SRGB`), or into an [`super::OffscreenTarget`] resolved with
+/// `encode_srgb = true`.
 #[derive(Debug)]
 pub struct SplatRenderer {
     program: glow::Program,
@@ -60,6 +69,7 @@ pub struct SplatRenderer {
     instances: usize,
     textures: Option<SplatTextures>,
     cloud_degree: u8,
+    color_space: ColorSpace,
     settings: DrawSettings,
     errata: Errata,
     tex_width_log2: u32,
@@ -137,6 +147,7 @@ impl SplatRenderer {
                 instances: 0,
                 textures: None,
                 cloud_degree: 0,
+                color_space: ColorSpace::default(),
                 settings: DrawSettings::default(),
                 errata,
                 tex_width_log2,
@@ -152,6 +163,7 @@ impl SplatRenderer {
             old.destroy(gl);
         }
         self.cloud_degree = cloud.sh_degree;
+        self.color_space = cloud.meta.color_space.effective();
         self.instances = 0;
         // SAFETY: (re)allocates the renderer's own order buffer.
         unsafe {
@@ -180,6 +192,12 @@ impl SplatRenderer {
     /// Whether no splats are uploaded.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The uploaded cloud's `colorSpace` (unknown values fall back to the default,
+    /// `srgb_rec709_display`).
+    pub fn color_space(&self) -> ColorSpace {
+        self.color_space
     }
 
     /// SH degree of the uploaded cloud.
