@@ -12,6 +12,10 @@ pub mod camera;
 pub mod cloud;
 pub mod compare;
 pub mod covariance;
+#[cfg(feature = "gl")]
+pub mod gl;
+#[cfg(feature = "gl")]
+pub mod headless;
 pub mod image;
 pub mod load;
 pub mod reference;

@@ -1,0 +1,1096 @@
+//! GL backend (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU reference rasterizer.
+//!
+//! Every test renders small images (≤ 96 px) so the suite stays fast on llvmpipe. Tests skip
+//! (with a message) only when EGL cannot be opened at all; any other GL failure fails them.
+//!
+//! # Error bound on the RGBA8 path
+//!
+//! The GL result differs from the f32/f64 reference through
+//! 1. 8-bit storage between blends: every blend rounds to the nearest 1/255, and the final value
+//!    is rounded once more. An earlier rounding error is only attenuated by later splats, so
+//!    with `L` splats covering a pixel the error is at most `(L + 1) · 0.5/255`; in practice the
+//!    roundings partly cancel.
+//! 2. f32 vs f64 in the projection: a pixel centre that lies on the 3σ ellipse (m² = 9) or on
+//!    the α = 1/255 threshold can be in for one backend and out for the other. The jump is at
+//!    most α at the cut, `0.99 · e^(−4.5) ≈ 0.011` (2.8/255), times |colour − behind|.
+//! 3. f16 SH coefficients: < 1.1e-3 per splat for the coefficient ranges used here.
+//!
+//! 4. Over-bright splats (SH colour > 1, common in trained data): a UNORM framebuffer clamps the
+//!    running sum to 1 after every blend, the reference only at the end (RC: "final C
+//!    clamped"). The excess lost is at most `max colour − 1`, later attenuated, so the RGBA8
+//!    bound gets `+ max(0, c_max − 1)` ([`overbright`]). The RGBA16F target does not clamp.
+//!
+//! [`MAX_ERR_SPARSE`] (≤ 2 splats per pixel) and [`MAX_ERR_DENSE`] follow from these terms;
+//! PSNR must be ≥ 45 dB everywhere.
+
+use glam::{Quat, Vec3};
+use splatgl::SplatCloud;
+use splatgl::camera::Camera;
+use splatgl::cloud::ColorSpace;
+use splatgl::compare::compare;
+use splatgl::gl::Errata;
+use splatgl::headless::{GlApi, HeadlessError, HeadlessRenderer, RenderOptions, TargetKind};
+use splatgl::image::Image;
+use splatgl::reference;
+use splatgl::scene::{self, Rng};
+
+/// Sparse scenes: (1 + 2) · 0.5/255 rounding + the 0.011 cut jump.
+const MAX_ERR_SPARSE: f32 = 1.5 / 255.0 + 0.0111;
+/// Dense scenes (tens of layers): rounding can accumulate; 8/255 + the cut jump.
+const MAX_ERR_DENSE: f32 = 8.0 / 255.0 + 0.0111;
+const MIN_PSNR: f64 = 45.0;
+
+/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
+fn headless_with(errata: Errata) -> Option<HeadlessRenderer> {
+    match HeadlessRenderer::with_errata(errata) {
+        Ok(r) => Some(r),
+        Err(HeadlessError::EglUnavailable(msg)) => {
+            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
+            None
+        }
+        Err(e) => panic!("headless GL failed: {e}"),
+    }
+}
+
+fn headless() -> Option<HeadlessRenderer> {
+    headless_with(Errata::default())
+}
+
+fn ref_opts(degree: u8, background: [f32; 3]) -> reference::RenderOptions {
+    reference::RenderOptions {
+        sh_degree: degree,
+        background,
+        ..Default::default()
+    }
+}
+
+fn srgb_encode(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Measured agreement of two images: (PSNR dB, max RGB error, max alpha error).
+#[derive(Debug, Clone, Copy)]
+struct Score {
+    psnr: f64,
+    max_rgb: f32,
+    max_alpha: f32,
+}
+
+/// Compares a GL read-back with a reference image as displayed (clamped to [0, 1]).
+fn score(gl: &Image, want: &Image) -> Score {
+    let mut want = want.clone();
+    for p in &mut want.pixels {
+        *p = p.map(|v| v.clamp(0.0, 1.0));
+    }
+    let c = compare(gl, &want, 1.0 / 255.0).unwrap();
+    let max_alpha = gl
+        .pixels
+        .iter()
+        .zip(&want.pixels)
+        .map(|(a, b)| (a[3] - b[3].clamp(0.0, 1.0)).abs())
+        .fold(0.0f32, f32::max);
+    Score {
+        psnr: c.psnr,
+        max_rgb: c.max_abs,
+        max_alpha,
+    }
+}
+
+/// Reference image of `cloud` (SH degree `degree`, background `bg`), in display values.
+fn reference_image(
+    cloud: &SplatCloud,
+    cam: &Camera,
+    degree: u8,
+    bg: [f32; 3],
+    linear: bool,
+) -> Image {
+    if !linear {
+        return reference::render(cloud, cam, &ref_opts(degree, bg));
+    }
+    // lin_rec709_display: blend linear (background decoded), encode to sRGB at the end.
+    let bg_lin = bg.map(splatgl::headless::srgb_to_linear);
+    let mut img = reference::render(cloud, cam, &ref_opts(degree, bg_lin));
+    for p in &mut img.pixels {
+        for c in &mut p[..3] {
+            *c = srgb_encode(*c);
+        }
+    }
+    img
+}
+
+/// How far the brightest splat colour seen by `cam` exceeds 1 (0 if none does).
+fn overbright(cloud: &SplatCloud, cam: &Camera, degree: u8) -> f32 {
+    let eye = cam.eye();
+    (0..cloud.len())
+        .map(|i| {
+            let dir = (Vec3::from_array(cloud.positions[i]) - eye).normalize();
+            let c = splatgl::sh::eval_color(cloud.sh_of(i), degree, dir.to_array());
+            c[0].max(c[1]).max(c[2]) - 1.0
+        })
+        .filter(|e| e.is_finite()) // non-finite colours are culled by both backends
+        .fold(0.0f32, f32::max)
+}
+
+/// Renders with GL and the reference, prints the numbers, checks PSNR and the error bound
+/// (`max_err`, plus [`overbright`] on the RGBA8 path).
+fn check(
+    name: &str,
+    r: &mut HeadlessRenderer,
+    cloud: &SplatCloud,
+    cam: &Camera,
+    opts: &RenderOptions,
+    max_err: f32,
+) -> Score {
+    r.upload(cloud).unwrap();
+    let gl = r.render(cam, opts).unwrap();
+    let degree = opts.sh_degree.unwrap_or(cloud.sh_degree);
+    let linear = opts
+        .color_space
+        .unwrap_or(cloud.meta.color_space.effective())
+        == ColorSpace::LinRec709Display;
+    let want = reference_image(cloud, cam, degree, opts.background, linear);
+    let s = score(&gl, &want);
+    let extra = if opts.target == TargetKind::Rgba8 {
+        overbright(cloud, cam, degree.min(cloud.sh_degree))
+    } else {
+        0.0
+    };
+    let max_err = max_err + extra;
+    eprintln!(
+        "[{name}] {:?} {}x{}: PSNR {:.2} dB, max RGB err {:.5} ({:.2}/255), max A err {:.5}, \
+         bound {:.2}/255",
+        opts.target,
+        cam.width,
+        cam.height,
+        s.psnr,
+        s.max_rgb,
+        s.max_rgb * 255.0,
+        s.max_alpha,
+        max_err * 255.0
+    );
+    // The scene must actually show something, or the comparison proves nothing.
+    let covered = want.pixels.iter().filter(|p| p[3] > 0.05).count();
+    assert!(covered > 0, "[{name}] reference image is empty");
+    assert!(
+        s.psnr >= MIN_PSNR,
+        "[{name}] PSNR {:.2} < {MIN_PSNR}",
+        s.psnr
+    );
+    assert!(
+        s.max_rgb <= max_err,
+        "[{name}] max error {} > {max_err}",
+        s.max_rgb
+    );
+    assert!(
+        s.max_alpha <= max_err,
+        "[{name}] max alpha error {} > {max_err}",
+        s.max_alpha
+    );
+    s
+}
+
+fn cam(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
+    Camera::look_at(eye, target, Vec3::Y, fov_deg.to_radians(), w, h)
+}
+
+fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
+    let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
+    sh[0] = rgb.map(|c| (c - 0.5) / splatgl::sh::SH_C0 as f32);
+    sh
+}
+
+fn both_targets() -> [RenderOptions; 2] {
+    [
+        RenderOptions::default(),
+        RenderOptions {
+            target: TargetKind::Rgba16fResolve,
+            ..Default::default()
+        },
+    ]
+}
+
+// ---------------------------------------------------------------------------------------------
+// GL vs reference
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn single_splats_many_anisotropies_and_rotations() {
+    let Some(mut r) = headless() else { return };
+    let c = cam(Vec3::new(0.3, 0.4, 4.0), Vec3::ZERO, 50.0, 64, 64);
+    let scales = [
+        [0.4, 0.05, 0.05],
+        [0.05, 0.5, 0.02],
+        [0.25, 0.25, 0.25],
+        [0.6, 0.02, 0.2],
+        [0.01, 0.3, 0.3],
+        // Needle: the oriented quad must still contain the whole 3σ ellipse.
+        [1.5, 0.004, 0.004],
+    ];
+    let rotations = [
+        Quat::IDENTITY,
+        Quat::from_rotation_z(0.5),
+        Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0),
+        Quat::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 1.2),
+    ];
+    let mut worst = f64::INFINITY;
+    for (i, s) in scales.iter().enumerate() {
+        for (j, q) in rotations.iter().enumerate() {
+            let mut cloud = SplatCloud::new(0);
+            cloud.push(
+                [0.1, -0.1, 0.2],
+                *s,
+                q.to_array(),
+                0.9,
+                &sh_for([0.9, 0.4, 0.1], 0),
+            );
+            let sc = check(
+                &format!("single s{i} q{j}"),
+                &mut r,
+                &cloud,
+                &c,
+                &RenderOptions {
+                    background: [0.1, 0.2, 0.3],
+                    ..Default::default()
+                },
+                MAX_ERR_SPARSE,
+            );
+            worst = worst.min(sc.psnr);
+        }
+    }
+    eprintln!("[single] worst PSNR {worst:.2} dB");
+}
+
+#[test]
+fn sh_degrees_0_to_3_from_several_views() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = scene::random_cloud(80, 3, 1.0, 7);
+    // Stronger view dependence than random_cloud's ±0.3.
+    for (k, c) in cloud.sh.iter_mut().enumerate() {
+        if k % 16 != 0 {
+            *c = c.map(|v| v * 2.0);
+        }
+    }
+    for (v, eye) in [
+        Vec3::new(0.0, 0.0, 4.0),
+        Vec3::new(3.0, 1.5, -2.0),
+        Vec3::new(-1.0, -3.5, 1.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let c = cam(eye, Vec3::ZERO, 45.0, 64, 64);
+        let mut prev: Option<Image> = None;
+        for degree in 0..=3u8 {
+            let opts = RenderOptions {
+                sh_degree: Some(degree),
+                ..Default::default()
+            };
+            check(
+                &format!("sh view{v} deg{degree}"),
+                &mut r,
+                &cloud,
+                &c,
+                &opts,
+                MAX_ERR_DENSE,
+            );
+            // The run-time degree really changes the colours.
+            let img = r.render(&c, &opts).unwrap();
+            if let Some(p) = &prev {
+                assert!(
+                    score(&img, p).max_rgb > 0.02,
+                    "degree {degree} looks like {}",
+                    degree - 1
+                );
+            }
+            prev = Some(img);
+        }
+    }
+}
+
+#[test]
+fn dense_random_cloud_both_targets() {
+    let Some(mut r) = headless() else { return };
+    let cloud = scene::random_cloud(4000, 1, 1.0, 42);
+    let c = cam(Vec3::new(2.0, 1.0, 3.0), Vec3::ZERO, 50.0, 96, 72);
+    for opts in both_targets() {
+        check("dense", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
+    }
+}
+
+#[test]
+fn default_scene_both_targets() {
+    let Some(mut r) = headless() else { return };
+    let cloud = scene::default_scene();
+    let c = scene::default_camera(96, 72);
+    for mut opts in both_targets() {
+        opts.background = [1.0, 1.0, 1.0];
+        check("default scene", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
+    }
+}
+
+#[test]
+fn splats_crossing_the_near_plane() {
+    let Some(mut r) = headless() else { return };
+    // Camera at the origin inside a cloud: means at every depth around the 0.2 cull depth,
+    // large splats reaching behind the camera.
+    let mut cloud = SplatCloud::new(0);
+    let mut rng = Rng::new(3);
+    for _ in 0..300 {
+        let p = [
+            rng.range(-0.6, 0.6),
+            rng.range(-0.6, 0.6),
+            rng.range(-0.3, 1.5),
+        ];
+        let s = [(); 3].map(|_| rng.range(0.02, 0.25));
+        let rgb = [(); 3].map(|_| rng.range(0.1, 0.9));
+        cloud.push(p, s, rng.quat(), rng.range(0.3, 1.0), &sh_for(rgb, 0));
+    }
+    let mut c = cam(Vec3::ZERO, Vec3::Z, 70.0, 64, 64);
+    c.near = 0.05;
+    check(
+        "near plane",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+    // A camera near larger than 0.2 moves the cull depth (max(0.2, near)).
+    c.near = 0.5;
+    check(
+        "near plane 0.5",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+}
+
+#[test]
+fn splats_crossing_the_image_border_and_fov_clamp() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = SplatCloud::new(0);
+    let mut rng = Rng::new(11);
+    // Means on a ring around the view, from just inside to far outside the image, some large
+    // enough that the 1.3·tan(fov) clamp of J matters.
+    for k in 0..60 {
+        let a = k as f32 * 0.37;
+        let rad = 0.8 + 0.05 * k as f32;
+        let p = [rad * a.cos(), rad * a.sin() * 0.75, 0.0];
+        let s = [
+            rng.range(0.05, 0.6),
+            rng.range(0.05, 0.6),
+            rng.range(0.05, 0.6),
+        ];
+        let rgb = [(); 3].map(|_| rng.range(0.1, 0.9));
+        cloud.push(p, s, rng.quat(), 0.8, &sh_for(rgb, 0));
+    }
+    let mut c = cam(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 55.0, 80, 60);
+    check(
+        "border",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+    // Off-centre principal point.
+    c.cx = 30.0;
+    c.cy = 36.0;
+    check(
+        "border off-centre",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+}
+
+#[test]
+fn tiny_sub_pixel_splats() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = SplatCloud::new(0);
+    let mut rng = Rng::new(5);
+    for _ in 0..400 {
+        let p = [
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        ];
+        let s = [(); 3].map(|_| rng.range(0.0005, 0.004));
+        let rgb = [(); 3].map(|_| rng.range(0.3, 1.0));
+        cloud.push(p, s, rng.quat(), 1.0, &sh_for(rgb, 0));
+    }
+    let c = cam(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
+    check(
+        "tiny",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_SPARSE,
+    );
+}
+
+#[test]
+fn lin_rec709_display_both_targets() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = scene::random_cloud(1500, 2, 1.0, 9);
+    cloud.meta.color_space = splatgl::cloud::Known::Known(ColorSpace::LinRec709Display);
+    let c = cam(Vec3::new(-2.0, 1.5, 3.0), Vec3::ZERO, 50.0, 80, 64);
+    for mut opts in both_targets() {
+        opts.background = [0.2, 0.25, 0.3];
+        check("lin_rec709", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
+    }
+    // And it is really different from blending the stored values as sRGB.
+    let lin = r.render(&c, &RenderOptions::default()).unwrap();
+    let srgb = r
+        .render(
+            &c,
+            &RenderOptions {
+                color_space: Some(ColorSpace::SrgbRec709Display),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    assert!(score(&lin, &srgb).max_rgb > 0.05);
+}
+
+#[test]
+fn desktop_gl_330_core_matches_reference() {
+    // The same GLSL files compiled as `#version 330 core` on a desktop GL 3.3 core context.
+    let mut r = match HeadlessRenderer::with_api(GlApi::DesktopCore33, Errata::default()) {
+        Ok(r) => r,
+        Err(HeadlessError::EglUnavailable(msg)) => {
+            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
+            return;
+        }
+        Err(e) => panic!("desktop GL context failed: {e}"),
+    };
+    eprintln!("{}", r.context().describe());
+    assert!(!glow::HasContext::version(r.context().gl()).is_embedded);
+    let mut cloud = scene::random_cloud(1500, 3, 1.0, 31);
+    let c = cam(Vec3::new(1.5, -1.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    for opts in both_targets() {
+        check("desktop 330 core", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
+    }
+    cloud.meta.color_space = splatgl::cloud::Known::Known(ColorSpace::LinRec709Display);
+    for mut opts in both_targets() {
+        opts.background = [0.3, 0.3, 0.3];
+        check(
+            "desktop 330 core lin",
+            &mut r,
+            &cloud,
+            &c,
+            &opts,
+            MAX_ERR_DENSE,
+        );
+    }
+}
+
+#[test]
+fn same_scene_twice_is_bit_identical() {
+    let Some(mut r) = headless() else { return };
+    let cloud = scene::random_cloud(2000, 3, 1.0, 1);
+    let c = cam(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    for opts in both_targets() {
+        r.upload(&cloud).unwrap();
+        let a = r.render(&c, &opts).unwrap();
+        let b = r.render(&c, &opts).unwrap();
+        assert_eq!(a.to_rgba8(), b.to_rgba8());
+        // A fresh context and upload gives the same bytes too.
+        let mut r2 = headless().unwrap();
+        r2.upload(&cloud).unwrap();
+        let d = r2.render(&c, &opts).unwrap();
+        assert_eq!(a.to_rgba8(), d.to_rgba8());
+        r.context().make_current().unwrap();
+    }
+}
+
+#[test]
+fn rgba16f_resolve_measured_against_rgba8() {
+    let Some(mut r) = headless() else { return };
+    // Many low-opacity layers: where 8-bit blending loses most.
+    let mut cloud = scene::random_cloud(3000, 0, 0.6, 21);
+    for o in &mut cloud.opacities {
+        *o *= 0.15;
+    }
+    let c = cam(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 50.0, 64, 64);
+    let s8 = check(
+        "low-alpha RGBA8",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+    let s16 = check(
+        "low-alpha RGBA16F",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions {
+            target: TargetKind::Rgba16fResolve,
+            ..Default::default()
+        },
+        MAX_ERR_DENSE,
+    );
+    eprintln!(
+        "[low-alpha] RGBA8 {:.2} dB / {:.2}/255 vs RGBA16F {:.2} dB / {:.2}/255",
+        s8.psnr,
+        s8.max_rgb * 255.0,
+        s16.psnr,
+        s16.max_rgb * 255.0
+    );
+    assert!(
+        s16.psnr > s8.psnr,
+        "float blending should be closer to the reference"
+    );
+}
+
+#[test]
+fn non_finite_splats_are_skipped_like_the_reference() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = scene::random_cloud(200, 1, 1.0, 77);
+    let n = cloud.len();
+    cloud.positions[3] = [f32::NAN, 0.0, 0.0];
+    cloud.positions[5] = [0.0, f32::INFINITY, 0.0];
+    cloud.scales[7] = [f32::INFINITY, 0.1, 0.1];
+    cloud.scales[9] = [f32::NAN, 0.1, 0.1];
+    cloud.opacities[11] = f32::NAN;
+    cloud.opacities[13] = f32::INFINITY; // seen in real files: alpha = 0.99 on both backends
+    cloud.rotations[15] = [0.0; 4]; // degenerate quaternion
+    cloud.sh[17 * 4] = [f32::NAN, 0.0, 0.0];
+    cloud.sh[19 * 4 + 1] = [f32::INFINITY; 3];
+    assert_eq!(cloud.len(), n);
+    let c = cam(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 64);
+    check(
+        "non-finite",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+}
+
+#[test]
+fn empty_cloud_and_partial_orders() {
+    let Some(mut r) = headless() else { return };
+    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 32, 32);
+    r.upload(&SplatCloud::new(0)).unwrap();
+    let img = r
+        .render(
+            &c,
+            &RenderOptions {
+                background: [0.2, 0.4, 0.6],
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    let want = [0.2f32, 0.4, 0.6].map(|v| (v * 255.0).round() / 255.0);
+    assert!(img.pixels.iter().all(|p| p[..3] == want && p[3] == 0.0));
+    // An order longer than the cloud is an error, not a GPU read out of bounds.
+    let cloud = scene::random_cloud(10, 0, 1.0, 2);
+    r.upload(&cloud).unwrap();
+    let err = r.render_with_order(&c, &RenderOptions::default(), &[0; 11]);
+    assert!(matches!(
+        err,
+        Err(HeadlessError::Gl(splatgl::gl::GlError::OrderTooLong {
+            got: 11,
+            capacity: 10
+        }))
+    ));
+    // A zero-sized camera gives an empty image, not an incomplete-framebuffer error.
+    let mut z = c;
+    z.width = 0;
+    assert!(
+        r.render(&z, &RenderOptions::default())
+            .unwrap()
+            .pixels
+            .is_empty()
+    );
+    // An empty order draws nothing.
+    let img = r
+        .render_with_order(&c, &RenderOptions::default(), &[])
+        .unwrap();
+    assert!(img.pixels.iter().all(|p| p[3] == 0.0));
+}
+
+#[test]
+fn shader_errors_carry_log_and_numbered_source() {
+    let Some(r) = headless() else { return };
+    let gl = r.context().gl();
+    let vs = "#version 300 es\nvoid main() {\n  gl_Position = vec4(0.0);\n}\n";
+    let fs = "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() {\n  o = undefined_thing;\n}\n";
+    let err = splatgl::gl::program::build_program(gl, "broken", vs, fs).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, splatgl::gl::GlError::Compile { .. }), "{msg}");
+    assert!(msg.contains("undefined_thing"), "{msg}");
+    assert!(msg.contains("   5 |   o = undefined_thing;"), "{msg}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Appendix A errata: the literal appendix behaviour differs from the reference, ours matches.
+// ---------------------------------------------------------------------------------------------
+
+/// Renders `cloud` with the correct renderer and with `errata`, returning both scores.
+fn erratum_scores(
+    errata: Errata,
+    cloud: &SplatCloud,
+    c: &Camera,
+    reversed_order: bool,
+) -> Option<(Score, Score)> {
+    let mut good = headless()?;
+    good.upload(cloud).unwrap();
+    let ours = good.render(c, &RenderOptions::default()).unwrap();
+    drop(good);
+    let mut bad = headless_with(errata)?;
+    bad.upload(cloud).unwrap();
+    let literal = if reversed_order {
+        let mut order = Vec::new();
+        splatgl::gl::sort_back_to_front(&cloud.positions, c.eye(), &mut order);
+        order.reverse(); // the appendix's front-to-back
+        bad.render_with_order(c, &RenderOptions::default(), &order)
+            .unwrap()
+    } else {
+        bad.render(c, &RenderOptions::default()).unwrap()
+    };
+    let want = reference::render(cloud, c, &ref_opts(3, [0.0; 3]));
+    let (s_ours, s_lit) = (score(&ours, &want), score(&literal, &want));
+    eprintln!(
+        "[{errata:?}] ours {:.2} dB / {:.2}/255, appendix {:.2} dB / {:.2}/255",
+        s_ours.psnr,
+        s_ours.max_rgb * 255.0,
+        s_lit.psnr,
+        s_lit.max_rgb * 255.0
+    );
+    assert!(s_ours.psnr >= MIN_PSNR && s_ours.max_rgb <= MAX_ERR_DENSE);
+    Some((s_ours, s_lit))
+}
+
+fn anisotropic_rotated_cloud() -> SplatCloud {
+    let mut cloud = SplatCloud::new(0);
+    for (k, x) in [-0.8f32, 0.0, 0.8].into_iter().enumerate() {
+        let q = Quat::from_euler(glam::EulerRot::XYZ, 0.4 * k as f32 + 0.3, 0.9, 0.6);
+        cloud.push(
+            [x, 0.0, 0.0],
+            [0.35, 0.04, 0.1],
+            q.to_array(),
+            0.9,
+            &sh_for([0.9, 0.6, 0.2], 0),
+        );
+    }
+    cloud
+}
+
+#[test]
+fn erratum_a_transposed_rotation() {
+    let cloud = anisotropic_rotated_cloud();
+    let c = cam(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        a_transposed_rotation: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(lit.psnr < 30.0 && lit.max_rgb > 0.2, "{lit:?}");
+}
+
+#[test]
+fn erratum_b_transposed_view() {
+    let cloud = anisotropic_rotated_cloud();
+    // An oblique camera: its rotation is far from symmetric, so V ≠ Vᵀ matters.
+    let c = cam(Vec3::new(2.0, 1.5, 2.0), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        b_transposed_view: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(lit.psnr < 30.0 && lit.max_rgb > 0.2, "{lit:?}");
+}
+
+#[test]
+fn erratum_d_focal_offset_and_centre() {
+    let cloud = anisotropic_rotated_cloud();
+    // 50° fov: P[0][0] ≠ 1, so the appendix's quad size and centre are wrong.
+    let c = cam(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        d_focal_offset: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(lit.psnr < 30.0 && lit.max_rgb > 0.2, "{lit:?}");
+}
+
+#[test]
+fn erratum_e_appendix_sh() {
+    let mut cloud = scene::random_cloud(40, 3, 1.0, 13);
+    for (k, c) in cloud.sh.iter_mut().enumerate() {
+        if k % 16 != 0 {
+            *c = c.map(|v| v * 2.0);
+        }
+    }
+    let c = cam(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        e_appendix_sh: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(lit.psnr < 30.0 && lit.max_rgb > 0.1, "{lit:?}");
+}
+
+#[test]
+fn erratum_e_sign_flips_alone_change_colour() {
+    // Without the sigmoid masking it: only coefficient 1 (Y₁,₋₁ = −C1·y) set. The appendix's
+    // +C1·y gives the opposite colour change; RC's −C1·y matches the reference.
+    let mut cloud = SplatCloud::new(1);
+    let mut sh = sh_for([0.5, 0.5, 0.5], 1);
+    sh[1] = [0.8, 0.0, -0.8];
+    cloud.push(
+        [0.0, 0.0, 0.0],
+        [0.3, 0.3, 0.3],
+        [0.0, 0.0, 0.0, 1.0],
+        0.95,
+        &sh,
+    );
+    let c = cam(Vec3::new(0.0, -3.0, 0.5), Vec3::ZERO, 50.0, 32, 32);
+    let errata = Errata {
+        e_appendix_sh: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(lit.max_rgb > 0.1, "{lit:?}");
+}
+
+#[test]
+fn erratum_g_src_alpha_blend_front_to_back() {
+    let cloud = scene::random_cloud(300, 0, 1.0, 17);
+    let c = cam(Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        g_src_alpha_blend: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, true) else {
+        return;
+    };
+    assert!(lit.psnr < 30.0 && lit.max_rgb > 0.2, "{lit:?}");
+}
+
+#[test]
+fn erratum_f_power_4_cuts_at_2_83_sigma() {
+    // Big opaque white splat on black: the ring 2.83σ..3σ is missing with the appendix's cut.
+    let mut cloud = SplatCloud::new(0);
+    cloud.push(
+        [0.0; 3],
+        [0.5, 0.5, 0.5],
+        [0.0, 0.0, 0.0, 1.0],
+        0.99,
+        &sh_for([1.0; 3], 0),
+    );
+    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 60.0, 64, 64);
+    let errata = Errata {
+        f_power_4: true,
+        ..Default::default()
+    };
+    let Some((ours, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    // α at 2.83σ is 0.99·e⁻⁴ = 0.018: the ring is faint but systematically missing.
+    assert!(
+        lit.max_rgb > 0.015 && ours.max_rgb < lit.max_rgb,
+        "{ours:?} {lit:?}"
+    );
+}
+
+#[test]
+fn erratum_i_no_dilation() {
+    let mut cloud = SplatCloud::new(0);
+    let mut rng = Rng::new(8);
+    for _ in 0..200 {
+        let p = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0];
+        cloud.push(p, [0.003; 3], rng.quat(), 1.0, &sh_for([1.0, 1.0, 1.0], 0));
+    }
+    let c = cam(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
+    let errata = Errata {
+        i_no_dilation: true,
+        ..Default::default()
+    };
+    let Some((_, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(lit.psnr < 35.0 && lit.max_rgb > 0.2, "{lit:?}");
+}
+
+#[test]
+fn erratum_k_fov_clamp_and_alpha_cap() {
+    // Large splats whose means lie far outside the view (x/z well beyond 1.3·tan(half fov)),
+    // reaching into the image, plus opaque ones (α would exceed 0.99 without the cap).
+    let mut cloud = SplatCloud::new(0);
+    for (k, x) in [-3.2f32, 3.4, 0.0].into_iter().enumerate() {
+        let s = if x == 0.0 { [0.2; 3] } else { [1.6, 0.5, 0.5] };
+        let q = Quat::from_rotation_z(0.3 * k as f32);
+        cloud.push(
+            [x, 0.2, 0.0],
+            s,
+            q.to_array(),
+            1.0,
+            &sh_for([0.9, 0.8, 0.3], 0),
+        );
+    }
+    let c = cam(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 50.0, 64, 48);
+    let errata = Errata {
+        k_no_clamp_no_cap: true,
+        ..Default::default()
+    };
+    let Some((ours, lit)) = erratum_scores(errata, &cloud, &c, false) else {
+        return;
+    };
+    assert!(
+        lit.max_rgb > 0.05 && ours.max_rgb < lit.max_rgb,
+        "{ours:?} {lit:?}"
+    );
+}
+
+#[test]
+fn erratum_j_one_vertex_attribute() {
+    // The appendix's 21 attributes exceed GLES 3.0's guaranteed 16; ours uses one.
+    let Some(r) = headless() else { return };
+    let gl = r.context().gl();
+    use glow::HasContext;
+    let program = r.renderer().program();
+    // SAFETY: queries on the current context and a program the renderer owns (indices below
+    // GL_ACTIVE_ATTRIBUTES).
+    let (max_attribs, names) = unsafe {
+        let n = gl.get_active_attributes(program);
+        let names: Vec<String> = (0..n)
+            .filter_map(|i| gl.get_active_attribute(program, i))
+            .map(|a| a.name)
+            .collect();
+        (gl.get_parameter_i32(glow::MAX_VERTEX_ATTRIBS), names)
+    };
+    eprintln!("GL_MAX_VERTEX_ATTRIBS = {max_attribs}, active attributes = {names:?}");
+    // Built-ins (gl_VertexID) are listed by some drivers but use no attribute slot.
+    let user: Vec<_> = names.iter().filter(|n| !n.starts_with("gl_")).collect();
+    assert_eq!(user, ["a_splat_index"]);
+    // And the appendix's attribute set (quad + 4 splat attributes + 16 SH) does not link here.
+    let mut vs =
+        String::from("#version 300 es\nin vec2 a_quad_vertex;\nin vec3 a_glob_position;\n");
+    vs += "in vec3 a_glob_scale;\nin vec4 a_glob_rotation;\nin float a_glob_opacity;\n";
+    let mut sum = String::from("a_glob_position + a_glob_scale + a_glob_rotation.xyz");
+    for k in 0..16 {
+        vs += &format!("in vec3 a_sh_{k};\n");
+        sum += &format!(" + a_sh_{k}");
+    }
+    vs += &format!(
+        "void main() {{ gl_Position = vec4({sum} + vec3(a_quad_vertex, a_glob_opacity), 1.0); }}\n"
+    );
+    let fs =
+        "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() { o = vec4(1.0); }\n";
+    let err = splatgl::gl::program::build_program(gl, "appendix-21", &vs, fs);
+    match &err {
+        Err(splatgl::gl::GlError::Link { log, .. }) => eprintln!("21-attribute program: {log}"),
+        other => eprintln!(
+            "21-attribute program: {:?}",
+            other.as_ref().map(|_| "linked")
+        ),
+    }
+    if max_attribs < 21 {
+        assert!(matches!(err, Err(splatgl::gl::GlError::Link { .. })));
+    }
+    assert!(max_attribs >= 16, "GLES 3.0 guarantees 16");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Embedding API: the renderer on a host framebuffer, depth test, state left as documented.
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn embedding_depth_test_and_documented_state() {
+    use glow::HasContext;
+    use splatgl::gl::{SplatRenderer, sort_back_to_front};
+    use splatgl::headless::HeadlessContext;
+    let ctx = match HeadlessContext::new() {
+        Ok(c) => c,
+        Err(HeadlessError::EglUnavailable(m)) => {
+            eprintln!("SKIPPED: EGL cannot be opened here ({m})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    let gl = ctx.gl();
+    let (w, h) = (32u32, 32u32);
+    // The "host": an RGBA8 + DEPTH24 framebuffer with a viewport offset inside a larger one.
+    // SAFETY: object creation and binding on the current context; deleted at the end.
+    let (fbo, rbs) = unsafe {
+        let color = gl.create_renderbuffer().unwrap();
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
+        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 2 * w as i32, h as i32);
+        let depth = gl.create_renderbuffer().unwrap();
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+        gl.renderbuffer_storage(
+            glow::RENDERBUFFER,
+            glow::DEPTH_COMPONENT24,
+            2 * w as i32,
+            h as i32,
+        );
+        let fbo = gl.create_framebuffer().unwrap();
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::COLOR_ATTACHMENT0,
+            glow::RENDERBUFFER,
+            Some(color),
+        );
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::DEPTH_ATTACHMENT,
+            glow::RENDERBUFFER,
+            Some(depth),
+        );
+        assert_eq!(
+            gl.check_framebuffer_status(glow::FRAMEBUFFER),
+            glow::FRAMEBUFFER_COMPLETE
+        );
+        (fbo, [color, depth])
+    };
+    let mut cloud = SplatCloud::new(0);
+    cloud.push(
+        [0.0; 3],
+        [0.3; 3],
+        [0.0, 0.0, 0.0, 1.0],
+        0.95,
+        &sh_for([1.0, 1.0, 1.0], 0),
+    );
+    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, w, h);
+    let mut renderer = SplatRenderer::new(gl).unwrap();
+    renderer.upload(gl, &cloud).unwrap();
+    let mut order = Vec::new();
+    sort_back_to_front(&cloud.positions, c.eye(), &mut order);
+    // Right half of the framebuffer is the host's viewport for the splats.
+    let mut centre_red = |depth_clear: f32, depth_test: bool| -> u8 {
+        // SAFETY: clears and reads one pixel of the bound framebuffer.
+        unsafe {
+            gl.viewport(0, 0, 2 * w as i32, h as i32);
+            gl.depth_mask(true);
+            gl.clear_color(0.0, 0.0, 0.0, 0.0);
+            gl.clear_depth_f32(depth_clear);
+            gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+            gl.viewport(w as i32, 0, w as i32, h as i32);
+        }
+        renderer.settings_mut().depth_test = depth_test;
+        renderer.draw(gl, &c, &order).unwrap();
+        let mut px = [0u8; 4];
+        // SAFETY: reads one RGBA8 pixel into a 4-byte buffer.
+        unsafe {
+            gl.read_pixels(
+                (w + w / 2) as i32,
+                (h / 2) as i32,
+                1,
+                1,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelPackData::Slice(Some(&mut px)),
+            );
+        }
+        px[0]
+    };
+    assert!(centre_red(0.0, false) > 200, "drawn without depth test");
+    assert!(centre_red(1.0, true) > 200, "host depth far: splat passes");
+    assert_eq!(
+        centre_red(0.0, true),
+        0,
+        "host geometry in front: splat hidden"
+    );
+    // The left half (outside the viewport) stays untouched.
+    let mut px = [9u8; 4];
+    // SAFETY: as above; then state queries.
+    unsafe {
+        gl.read_pixels(
+            w as i32 / 2,
+            h as i32 / 2,
+            1,
+            1,
+            glow::RGBA,
+            glow::UNSIGNED_BYTE,
+            glow::PixelPackData::Slice(Some(&mut px)),
+        );
+        assert_eq!(px, [0; 4]);
+        // State left as documented in splatgl::gl::state.
+        assert_eq!(gl.get_parameter_i32(glow::CURRENT_PROGRAM), 0);
+        assert_eq!(gl.get_parameter_i32(glow::VERTEX_ARRAY_BINDING), 0);
+        assert_eq!(gl.get_parameter_i32(glow::ARRAY_BUFFER_BINDING), 0);
+        assert_eq!(
+            gl.get_parameter_i32(glow::ACTIVE_TEXTURE),
+            glow::TEXTURE0 as i32
+        );
+        assert_eq!(gl.get_parameter_i32(glow::TEXTURE_BINDING_2D), 0);
+        assert!(gl.is_enabled(glow::BLEND));
+        assert_eq!(gl.get_parameter_i32(glow::BLEND_SRC_RGB), glow::ONE as i32);
+        assert_eq!(
+            gl.get_parameter_i32(glow::BLEND_DST_ALPHA),
+            glow::ONE_MINUS_SRC_ALPHA as i32
+        );
+        assert_eq!(gl.get_parameter_i32(glow::DEPTH_WRITEMASK), 0);
+        assert_eq!(
+            gl.get_parameter_i32(glow::DRAW_FRAMEBUFFER_BINDING),
+            fbo.0.get() as i32
+        );
+        let mut vp = [0i32; 4];
+        gl.get_parameter_i32_slice(glow::VIEWPORT, &mut vp);
+        assert_eq!(vp, [w as i32, 0, w as i32, h as i32]);
+    }
+    renderer.destroy(gl);
+    // SAFETY: deleting the host objects created above.
+    unsafe {
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.delete_framebuffer(fbo);
+        for rb in rbs {
+            gl.delete_renderbuffer(rb);
+        }
+    }
+}
+
+#[test]
+fn one_shot_render_function_matches_the_renderer() {
+    // `splatgl::headless::render` is what a CLI `--backend gl` calls.
+    let cloud = scene::default_scene();
+    let c = scene::default_camera(48, 36);
+    let opts = RenderOptions {
+        background: [0.1, 0.1, 0.1],
+        sh_degree: Some(3), // above the cloud's degree 1: clamped, like the reference
+        ..Default::default()
+    };
+    let img = match splatgl::headless::render(&cloud, &c, &opts) {
+        Ok(img) => img,
+        Err(HeadlessError::EglUnavailable(msg)) => {
+            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    assert_eq!((img.width, img.height), (48, 36));
+    let mut r = headless().unwrap();
+    r.upload(&cloud).unwrap();
+    let again = r.render(&c, &opts).unwrap();
+    assert_eq!(img.to_rgba8(), again.to_rgba8());
+    let want = reference_image(&cloud, &c, 1, opts.background, false);
+    let s = score(&img, &want);
+    assert!(s.psnr >= MIN_PSNR, "{s:?}");
+}
