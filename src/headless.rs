@@ -278,11 +278,7 @@ impl Default for RenderOptions {
 
 /// sRGB decoding (IEC 61966-2-1).
 pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    crate::color::srgb_decode(c as f64) as f32
 }
 
 #[derive(Debug)]

@@ -10,6 +10,7 @@
 
 pub mod camera;
 pub mod cloud;
+pub mod color;
 pub mod compare;
 pub mod covariance;
 #[cfg(feature = "gl")]

@@ -232,7 +232,11 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
                 return cloud.opacities[i];
             }
             let v = (cloud.sh[i * k][ch] as f64 * crate::sh::SH_C0 + 0.5).clamp(0.0, 1.0);
-            (if srgb { srgb_to_linear(v) } else { v }) as f32
+            (if srgb {
+                crate::color::srgb_decode(v)
+            } else {
+                v
+            }) as f32
         });
         attrs.insert("COLOR_0".into(), json!(a));
     }
@@ -271,14 +275,6 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
         doc["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
     }
     (doc, b.bin)
-}
-
-fn srgb_to_linear(v: f64) -> f64 {
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// A `.gltf` file (JSON) with the buffer embedded as a base64 data URI.

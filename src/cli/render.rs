@@ -8,11 +8,24 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Rendering backends. (`gl` joins when the GL backend lands; it will become the default.)
+/// Rendering backends.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Backend {
+    /// GL when a headless EGL context can be made here, else the reference (with a note).
+    Auto,
+    /// OpenGL ES 3 through headless EGL (Mesa surfaceless or a GPU driver).
+    Gl,
     /// The CPU reference rasterizer (normative math, slow but exact).
     Reference,
+}
+
+/// GL framebuffer to blend in.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TargetArg {
+    /// Blend in 8-bit RGBA (sRGB8_ALPHA8 for lin_rec709_display clouds).
+    Rgba8,
+    /// Blend in RGBA16F (the RC's recommendation), then resolve to 8 bits.
+    Rgba16f,
 }
 
 /// Blending order.
@@ -68,8 +81,11 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = SortArg::Distance)]
     pub sort: SortArg,
     /// Renderer.
-    #[arg(long, value_enum, default_value_t = Backend::Reference)]
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
     pub backend: Backend,
+    /// Framebuffer the GL backend blends in.
+    #[arg(long, value_enum, default_value_t = TargetArg::Rgba8)]
+    pub target: TargetArg,
     /// Output: .png (8-bit, or 16-bit with --depth16) or .pfm (32-bit float RGB).
     #[arg(short, long, default_value = "out.png")]
     pub output: PathBuf,
@@ -235,23 +251,102 @@ fn go(a: &Args) -> Result<(), String> {
         ..Default::default()
     };
     let t1 = Instant::now();
-    let (img, stats) = match a.backend {
-        Backend::Reference => splatgl::reference::render_with_stats(&cloud, &cam, &opts),
+    // Auto: GL unless the reference is the only backend that can honour the options (view-
+    // depth sorting) or no GL context can be made here.
+    let use_gl = match a.backend {
+        Backend::Gl => true,
+        Backend::Reference => false,
+        Backend::Auto => a.sort == SortArg::Distance,
+    };
+    let gl = if use_gl {
+        match render_gl(a, &cloud, &cam, &opts) {
+            Ok(img) => Some(img),
+            Err(e) if a.backend == Backend::Gl => return Err(format!("--backend gl: {e}")),
+            Err(e) => {
+                eprintln!("note: GL backend unavailable ({e}); using the reference rasterizer");
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let (img, backend, visible) = match gl {
+        Some(img) => (img, "gl", None),
+        None => {
+            let (img, stats) = render_reference(&cloud, &cam, &opts);
+            (img, "reference", Some(stats.visible))
+        }
     };
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;
     write(&img, a)?;
+    let visible = visible.map_or(String::new(), |v| format!(" ({v} visible)"));
     eprintln!(
-        "splatgl render: {} splats ({} visible), {}x{}, backend {:?}: render {render_ms:.1} ms, \
+        "splatgl render: {} splats{visible}, {}x{}, backend {backend}: render {render_ms:.1} ms, \
          total {:.1} ms -> {}",
-        stats.splats,
-        stats.visible,
+        cloud.len(),
         cam.width,
         cam.height,
-        a.backend,
         t0.elapsed().as_secs_f64() * 1e3,
         a.output.display()
     );
     Ok(())
+}
+
+/// The reference render as it is displayed: for `lin_rec709_display` clouds the background is
+/// taken as a display value (decoded), the splats blend in linear, and the result is
+/// sRGB-encoded once at the end — exactly what the GL backend does.
+fn render_reference(
+    cloud: &splatgl::SplatCloud,
+    cam: &Camera,
+    opts: &RenderOptions,
+) -> (Image, splatgl::reference::RenderStats) {
+    use splatgl::cloud::ColorSpace;
+    use splatgl::color::{srgb_decode, srgb_encode};
+    if cloud.meta.color_space.effective() != ColorSpace::LinRec709Display {
+        return splatgl::reference::render_with_stats(cloud, cam, opts);
+    }
+    let mut o = *opts;
+    o.background = opts.background.map(|v| srgb_decode(v as f64) as f32);
+    let (mut img, stats) = splatgl::reference::render_with_stats(cloud, cam, &o);
+    for p in &mut img.pixels {
+        for c in &mut p[..3] {
+            *c = srgb_encode(*c as f64) as f32;
+        }
+    }
+    (img, stats)
+}
+
+#[cfg(feature = "gl")]
+fn render_gl(
+    a: &Args,
+    cloud: &splatgl::SplatCloud,
+    cam: &Camera,
+    opts: &RenderOptions,
+) -> Result<Image, String> {
+    use splatgl::headless::{RenderOptions as GlOptions, TargetKind};
+    if a.sort != SortArg::Distance {
+        return Err("--sort view-depth is only implemented by --backend reference".into());
+    }
+    let o = GlOptions {
+        target: match a.target {
+            TargetArg::Rgba8 => TargetKind::Rgba8,
+            TargetArg::Rgba16f => TargetKind::Rgba16fResolve,
+        },
+        background: opts.background,
+        sh_degree: Some(opts.sh_degree),
+        color_space: None,
+    };
+    splatgl::headless::render(cloud, cam, &o).map_err(|e| e.to_string())
+}
+
+#[cfg(not(feature = "gl"))]
+fn render_gl(
+    _a: &Args,
+    _cloud: &splatgl::SplatCloud,
+    _cam: &Camera,
+    _opts: &RenderOptions,
+) -> Result<Image, String> {
+    Err("this splatgl was built without the `gl` feature".into())
 }
 
 /// The cloud and whether it came from a PLY (COLMAP axes) rather than glTF (+Y up).

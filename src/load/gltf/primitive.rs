@@ -489,16 +489,11 @@ pub fn read(
 fn dc_from_color0(c: [f32; 3], srgb: bool) -> [f32; 3] {
     c.map(|v| {
         let v = v.clamp(0.0, 1.0) as f64;
-        let v = if srgb { linear_to_srgb(v) } else { v };
+        let v = if srgb {
+            crate::color::srgb_encode(v)
+        } else {
+            v
+        };
         ((v - 0.5) / crate::sh::SH_C0) as f32
     })
-}
-
-/// The sRGB transfer function (linear → encoded).
-pub fn linear_to_srgb(v: f64) -> f64 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
 }
