@@ -1094,3 +1094,53 @@ fn one_shot_render_function_matches_the_renderer() {
     let s = score(&img, &want);
     assert!(s.psnr >= MIN_PSNR, "{s:?}");
 }
+
+/// Every real file that loads renders through GL without a GL error (`glGetError` is checked
+/// after the upload and after the draw) and within the suite's PSNR of the reference.
+#[test]
+fn real_files_render_without_gl_errors() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!("skipping: {} not found", dir.display());
+        return;
+    };
+    let Some(mut r) = headless() else { return };
+    let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    let mut rendered = 0;
+    for path in paths {
+        let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
+            continue;
+        };
+        let cloud = l.cloud;
+        let c = Camera::frame_points(&cloud.positions, 0.9, 80, 60).expect("finite means");
+        r.upload(&cloud)
+            .unwrap_or_else(|e| panic!("{}: upload: {e}", path.display()));
+        let img = r
+            .render(&c, &RenderOptions::default())
+            .unwrap_or_else(|e| panic!("{}: render: {e}", path.display()));
+        assert!(
+            img.pixels.iter().any(|p| p[3] > 0.05),
+            "{}: nothing drawn",
+            path.display()
+        );
+        let mut want = reference::render(&cloud, &c, &ref_opts(3, [0.0; 3]));
+        if cloud.meta.color_space.effective() == ColorSpace::LinRec709Display {
+            for p in &mut want.pixels {
+                for v in &mut p[..3] {
+                    *v = srgb_encode(*v);
+                }
+            }
+        }
+        let s = score(&img, &want);
+        eprintln!(
+            "{}: {} splats, PSNR {:.2} dB vs reference",
+            path.display(),
+            cloud.len(),
+            s.psnr
+        );
+        assert!(s.psnr >= MIN_PSNR, "{}: PSNR {:.2}", path.display(), s.psnr);
+        rendered += 1;
+    }
+    assert!(rendered >= 3, "the real files that load must render");
+}
