@@ -51,6 +51,21 @@ impl Comp {
     fn normalized(self) -> bool {
         matches!(self, Comp::I8N | Comp::U8N | Comp::I16N | Comp::U16N)
     }
+    /// The value as stored: the float, or the quantized integer (what glTF `min`/`max` hold).
+    fn stored(self, v: f32) -> f64 {
+        let q = |scale: f32, lo: f32, hi: f32| (v * scale).round().clamp(lo, hi) as f64;
+        match self {
+            Comp::F32 => v as f64,
+            Comp::I8 => q(1.0, -128.0, 127.0),
+            Comp::I8N => q(127.0, -127.0, 127.0),
+            Comp::U8 => q(1.0, 0.0, 255.0),
+            Comp::U8N => q(255.0, 0.0, 255.0),
+            Comp::I16 => q(1.0, -32768.0, 32767.0),
+            Comp::I16N => q(32767.0, -32767.0, 32767.0),
+            Comp::U16 => q(1.0, 0.0, 65535.0),
+            Comp::U16N => q(65535.0, 0.0, 65535.0),
+        }
+    }
     /// Encodes `v` (quantizing and clamping integer types).
     fn encode(self, v: f32, out: &mut Vec<u8>) {
         let q = |scale: f32, lo: f32, hi: f32| (v * scale).round().clamp(lo, hi);
@@ -74,7 +89,8 @@ impl Comp {
 #[derive(Debug, Clone)]
 pub struct GltfWriteOptions {
     /// POSITION component type (non-float types need `KHR_mesh_quantization`, added
-    /// automatically).
+    /// automatically). No dequantization node matrix is written: with normalized types the
+    /// positions must already lie in [−1, 1] (signed) or [0, 1] (unsigned).
     pub position: Comp,
     /// ROTATION: F32, I8N or I16N per the RC.
     pub rotation: Comp,
@@ -130,7 +146,8 @@ impl Builder {
     ) -> usize {
         self.align();
         let esize = dims * comp.size();
-        let stride = if self.padding > 0 {
+        // Vertex attribute elements start on 4-byte boundaries (glTF 2.0): pad small elements.
+        let stride = if self.padding > 0 || esize % 4 != 0 {
             (esize + self.padding).div_ceil(4) * 4
         } else {
             0
@@ -186,9 +203,18 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
     };
     let mut attrs = serde_json::Map::new();
     let pos = b.add(n, 3, o.position, |i, k| cloud.positions[i][k]);
-    if let Some(bounds) = cloud.bounds() {
-        b.accessors[pos]["min"] = json!(bounds.min);
-        b.accessors[pos]["max"] = json!(bounds.max);
+    if n > 0 {
+        // min/max hold the stored values (quantized integers for integer types).
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in &cloud.positions {
+            for k in 0..3 {
+                let v = o.position.stored(p[k]);
+                lo[k] = lo[k].min(v);
+                hi[k] = hi[k].max(v);
+            }
+        }
+        b.accessors[pos]["min"] = json!(lo);
+        b.accessors[pos]["max"] = json!(hi);
     }
     attrs.insert("POSITION".into(), json!(pos));
     let p = "KHR_gaussian_splatting:";
@@ -196,10 +222,14 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
     attrs.insert(format!("{p}ROTATION"), json!(rot));
     let sc = b.add(n, 3, o.scale, |i, k| cloud.scales[i][k]);
     attrs.insert(format!("{p}SCALE"), json!(sc));
-    let op = if o.sparse_opacity {
-        let idx: Vec<u32> = (0..n as u32)
-            .filter(|&i| cloud.opacities[i as usize] != 0.0)
-            .collect();
+    let nonzero: Vec<u32> = (0..n as u32)
+        .filter(|&i| cloud.opacities[i as usize] != 0.0)
+        .collect();
+    let op = if o.sparse_opacity && nonzero.is_empty() {
+        // All zero: an accessor without bufferView is zero-filled (sparse.count must be ≥ 1).
+        b.push_accessor(n, 1, o.opacity, None)
+    } else if o.sparse_opacity {
+        let idx = nonzero;
         let mut vals = Vec::new();
         for &i in &idx {
             o.opacity.encode(cloud.opacities[i as usize], &mut vals);

@@ -624,7 +624,7 @@ fn cli_renders_the_default_scene_and_compares() {
     let p = |p: &std::path::Path| p.to_str().unwrap().to_owned();
     let size = ["--width", "64", "--height", "48"];
     for (out, extra) in [(&png, None), (&pfm, None), (&png16, Some("--depth16"))] {
-        let mut args = vec!["render", "-o"];
+        let mut args = vec!["render", "--backend", "reference", "-o"];
         let out = p(out);
         args.push(&out);
         args.extend(size);

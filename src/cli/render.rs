@@ -11,7 +11,9 @@ use std::time::Instant;
 /// Rendering backends.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Backend {
-    /// GL when a headless EGL context can be made here, else the reference (with a note).
+    /// GL for 8-bit PNG output when a headless EGL context can be made here (else the
+    /// reference, with a note); the reference for `.pfm`, `--depth16` and `--sort view-depth`,
+    /// which need more than an 8-bit framebuffer or a distance sort.
     Auto,
     /// OpenGL ES 3 through headless EGL (Mesa surfaceless or a GPU driver).
     Gl,
@@ -256,7 +258,13 @@ fn go(a: &Args) -> Result<(), String> {
     let use_gl = match a.backend {
         Backend::Gl => true,
         Backend::Reference => false,
-        Backend::Auto => a.sort == SortArg::Distance,
+        Backend::Auto => {
+            let exact_output = a.depth16
+                || a.output
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("pfm"));
+            a.sort == SortArg::Distance && !exact_output
+        }
     };
     let gl = if use_gl {
         match render_gl(a, &cloud, &cam, &opts) {

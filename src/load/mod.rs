@@ -142,10 +142,14 @@ impl LoadReport {
     /// location and how many more there are, in first-seen order.
     pub fn summarized_warnings(&self) -> Vec<String> {
         let mut groups: Vec<(&Warning, usize)> = Vec::new();
+        let mut index: std::collections::HashMap<&str, usize> = Default::default();
         for w in &self.warnings {
-            match groups.iter_mut().find(|(g, _)| g.message == w.message) {
-                Some((_, n)) => *n += 1,
-                None => groups.push((w, 1)),
+            match index.get(w.message.as_str()) {
+                Some(&g) => groups[g].1 += 1,
+                None => {
+                    index.insert(&w.message, groups.len());
+                    groups.push((w, 1));
+                }
             }
         }
         groups

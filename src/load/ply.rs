@@ -53,10 +53,20 @@ pub enum PlyError {
         element: String,
         /// Rows claimed.
         count: u64,
-        /// Bytes needed (or a lower bound, for ASCII and list rows).
+        /// Bytes needed (a lower bound for ASCII: two bytes per value).
         needed: u64,
         /// Bytes present.
         available: u64,
+    },
+    /// The data ends before all rows the header claims (rows of variable size, or ASCII).
+    #[error("element '{element}': header claims {count} rows but the data ends after {rows_read}")]
+    EndsEarly {
+        /// Element name.
+        element: String,
+        /// Rows claimed.
+        count: u64,
+        /// Complete rows present.
+        rows_read: u64,
     },
     /// A value that cannot be used.
     #[error("element 'vertex' index {index}: property '{property}': {message}")]
@@ -401,6 +411,9 @@ fn convert_row(
             return Err(bad(l.pos[k], "position is not finite"));
         }
         pos[k] = v as f32;
+        if !pos[k].is_finite() {
+            return Err(bad(l.pos[k], "position overflows f32"));
+        }
         let s = get(l.scale[k]);
         if s.is_nan() {
             return Err(bad(l.scale[k], "log scale is NaN"));
@@ -417,6 +430,9 @@ fn convert_row(
             None => d as f32,
             Some(div) => ((d / div - 0.5) / crate::sh::SH_C0) as f32,
         };
+        if !sh[0][k].is_finite() {
+            return Err(bad(l.dc[k], "colour coefficient overflows f32"));
+        }
     }
     let k_rest = l.rest.len() / 3;
     for (j, &col) in l.rest.iter().enumerate() {
@@ -426,6 +442,9 @@ fn convert_row(
         }
         let (ch, coef) = (j / k_rest, j % k_rest);
         sh[1 + coef][ch] = v as f32;
+        if !sh[1 + coef][ch].is_finite() {
+            return Err(bad(col, "SH coefficient overflows f32"));
+        }
     }
     let o = get(l.opacity);
     if o.is_nan() {
@@ -493,11 +512,10 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
 fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyError> {
     let mut pos = 0usize;
     for el in before {
-        let truncated = |pos: usize| PlyError::Truncated {
+        let ends = |rows_read: u64| PlyError::EndsEarly {
             element: el.name.clone(),
             count: el.count,
-            needed: el.count,
-            available: (body.len() - pos.min(body.len())) as u64,
+            rows_read,
         };
         if el.props.is_empty() {
             if el.count > 0 {
@@ -512,7 +530,12 @@ fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyEr
             let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
             let needed = el.count.saturating_mul(row as u64);
             if needed > (body.len() - pos) as u64 {
-                return Err(truncated(pos));
+                return Err(PlyError::Truncated {
+                    element: el.name.clone(),
+                    count: el.count,
+                    needed,
+                    available: (body.len() - pos) as u64,
+                });
             }
             pos += needed as usize;
             continue;
@@ -520,14 +543,19 @@ fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyEr
         // Rows with lists: walk them (each row takes at least one byte, so the count is
         // bounded by the data before the walk starts).
         if el.count > (body.len() - pos) as u64 {
-            return Err(truncated(pos));
+            return Err(PlyError::Truncated {
+                element: el.name.clone(),
+                count: el.count,
+                needed: el.count,
+                available: (body.len() - pos) as u64,
+            });
         }
-        for _ in 0..el.count {
+        for r in 0..el.count {
             for p in &el.props {
                 let n = match p.list {
                     Some(ct) => {
                         if pos + ct.size() > body.len() {
-                            return Err(truncated(pos));
+                            return Err(ends(r));
                         }
                         let n = ct.read(&body[pos..], be);
                         pos += ct.size();
@@ -543,7 +571,7 @@ fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyEr
                 };
                 let len = n.saturating_mul(p.ty.size());
                 if len > body.len() - pos {
-                    return Err(truncated(pos));
+                    return Err(ends(r));
                 }
                 pos += len;
             }
@@ -625,13 +653,12 @@ fn load_ascii(
     })?;
     let mut lines = text.lines().enumerate();
     for el in &header.elements[..vi] {
-        for _ in 0..el.count {
+        for r in 0..el.count {
             if lines.next().is_none() {
-                return Err(PlyError::Truncated {
+                return Err(PlyError::EndsEarly {
                     element: el.name.clone(),
                     count: el.count,
-                    needed: el.count,
-                    available: body.len() as u64,
+                    rows_read: r,
                 });
             }
         }
@@ -654,11 +681,10 @@ fn load_ascii(
     let mut sh = vec![[0.0f32; 3]; k];
     let mut non_unit = 0;
     for i in 0..n {
-        let (ln, line) = lines.next().ok_or_else(|| PlyError::Truncated {
+        let (ln, line) = lines.next().ok_or_else(|| PlyError::EndsEarly {
             element: "vertex".into(),
             count: vertex.count,
-            needed: vertex.count,
-            available: i as u64,
+            rows_read: i as u64,
         })?;
         let line_no = header.lines + ln + 1;
         let mut it = line.split_ascii_whitespace();

@@ -18,6 +18,8 @@ pub struct Decoded {
     pub component: DataType,
     /// Whether integer values were normalized.
     pub normalized: bool,
+    /// A glTF 2.0 alignment rule the layout breaks (data still decoded).
+    pub misaligned: Option<String>,
 }
 
 impl Decoded {
@@ -117,13 +119,14 @@ fn view_bytes<'b>(
         })
 }
 
-/// Decodes accessor `acc`. `path` names the attribute in findings; `alloc_limit` caps the
-/// element count of accessors that have no buffer view (zero-filled or sparse-only).
+/// Decodes accessor `acc`. `path` names the attribute in findings. `budget` is the number of
+/// decoded values the whole document may still produce (bounded by the input size); it is
+/// checked before allocating and charged after.
 pub fn decode(
     acc: &gltf::Accessor,
     buffers: &[Vec<u8>],
     path: &str,
-    alloc_limit: usize,
+    budget: &std::cell::Cell<u64>,
 ) -> Result<Decoded, Finding> {
     let fail = |msg: String| Finding::fatal(path, format!("accessors[{}]: {msg}", acc.index()));
     let dims = dims_of(acc.dimensions()).ok_or_else(|| {
@@ -136,24 +139,43 @@ pub fn decode(
     let csize = t.size();
     let esize = dims * csize;
     let count = acc.count();
+    let values = count as u128 * dims as u128;
+    if values > budget.get() as u128 {
+        return Err(fail(format!(
+            "count {count} would decode to more values than this file can justify ({} left of its budget)",
+            budget.get()
+        )));
+    }
+    budget.set(budget.get() - values as u64);
+    let mut misaligned = None;
     let mut data = match acc.view() {
         Some(view) => {
             let bytes = view_bytes(&view, buffers, path)?;
             let stride = view.stride().unwrap_or(esize);
+            // glTF 2.0 §3.6.2.4: offsets are multiples of the component size, and vertex
+            // attribute elements start on 4-byte boundaries.
+            let offset = view.offset() as u128 + acc.offset() as u128;
+            if offset % csize as u128 != 0 {
+                misaligned = Some(format!(
+                    "byte offset {offset} is not a multiple of the component size {csize}"
+                ));
+            } else if offset % 4 != 0 || stride % 4 != 0 {
+                misaligned = Some(format!(
+                    "vertex attribute elements must start on 4-byte boundaries (offset {offset}, stride {stride})"
+                ));
+            }
             if stride < esize {
                 return Err(fail(format!(
                     "byteStride {stride} is smaller than the element size {esize}"
                 )));
             }
             let start = acc.offset();
+            // u128: no count, stride or offset from the file can overflow this.
             let needed = match count {
                 0 => 0,
-                n => (n as u64 - 1)
-                    .checked_mul(stride as u64)
-                    .and_then(|v| v.checked_add(start as u64 + esize as u64))
-                    .unwrap_or(u64::MAX),
+                n => (n as u128 - 1) * stride as u128 + start as u128 + esize as u128,
             };
-            if needed > bytes.len() as u64 {
+            if needed > bytes.len() as u128 {
                 return Err(fail(format!(
                     "count {count} × stride {stride} from offset {start} needs {needed} bytes; bufferViews[{}] has {}",
                     view.index(),
@@ -169,14 +191,7 @@ pub fn decode(
             }
             out
         }
-        None => {
-            if count > alloc_limit {
-                return Err(fail(format!(
-                    "count {count} without a bufferView exceeds the limit of {alloc_limit} for this file"
-                )));
-            }
-            vec![0.0; count * dims]
-        }
+        None => vec![0.0; count * dims],
     };
     if let Some(sparse) = acc.sparse() {
         apply_sparse(&sparse, &mut data, dims, t, norm, count, buffers, path)
@@ -187,6 +202,7 @@ pub fn decode(
         dims,
         component: t,
         normalized: norm,
+        misaligned,
     })
 }
 
@@ -214,14 +230,14 @@ fn apply_sparse(
     };
     let ib = view_bytes(&idx.view(), buffers, path).map_err(|f| f.message)?;
     let ioff = idx.offset();
-    if ioff as u64 + (n as u64) * isize as u64 > ib.len() as u64 {
+    if ioff as u128 + n as u128 * isize as u128 > ib.len() as u128 {
         return Err(format!("{n} indices do not fit their bufferView"));
     }
     let vals = sparse.values();
     let vb = view_bytes(&vals.view(), buffers, path).map_err(|f| f.message)?;
     let voff = vals.offset();
     let esize = dims * t.size();
-    if voff as u64 + (n as u64) * esize as u64 > vb.len() as u64 {
+    if voff as u128 + n as u128 * esize as u128 > vb.len() as u128 {
         return Err(format!("{n} values do not fit their bufferView"));
     }
     let mut prev: Option<usize> = None;

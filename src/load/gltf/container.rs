@@ -27,6 +27,8 @@ pub struct Parsed {
     pub buffers: Vec<Vec<u8>>,
     /// Size of the input, for allocation limits.
     pub input_len: usize,
+    /// Bytes read from external buffer files (also part of the allocation budget).
+    pub external_bytes: u64,
 }
 
 fn container(msg: impl Into<String>) -> GltfError {
@@ -41,16 +43,15 @@ pub fn parse(
     path: Option<&Path>,
     findings: &mut Vec<Finding>,
 ) -> Result<Parsed, GltfError> {
-    let (json_bytes, bin): (std::borrow::Cow<[u8]>, Option<Vec<u8>>) = match format {
+    let (json_bytes, bin): (&[u8], Option<Vec<u8>>) = match format {
         Format::Glb => {
-            let glb =
-                gltf::binary::Glb::from_slice(bytes).map_err(|e| container(format!("GLB: {e}")))?;
-            (glb.json, glb.bin.map(|b| b.into_owned()))
+            let (json, bin) = split_glb(bytes)?;
+            (json, bin.map(<[u8]>::to_vec))
         }
-        _ => (std::borrow::Cow::Borrowed(bytes), None),
+        _ => (bytes, None),
     };
     let json: Value =
-        serde_json::from_slice(&json_bytes).map_err(|e| container(format!("JSON: {e}")))?;
+        serde_json::from_slice(json_bytes).map_err(|e| container(format!("JSON: {e}")))?;
     if !json.is_object() {
         return Err(container("JSON: the top level is not an object"));
     }
@@ -59,15 +60,63 @@ pub fn parse(
         doc: None,
         buffers: Vec::new(),
         input_len: bytes.len(),
+        external_bytes: 0,
     };
     check_required_extensions(&parsed.json, findings);
     let Some(root) = schema_root(&parsed.json, findings) else {
         return Ok(parsed);
     };
     let doc = gltf::Document::from_json_without_validation(root);
-    parsed.buffers = resolve_buffers(&doc, bin, path, findings);
+    (parsed.buffers, parsed.external_bytes) = resolve_buffers(&doc, bin, path, findings);
     parsed.doc = Some(doc);
     Ok(parsed)
+}
+
+/// GLB framing (glTF 2.0 §4.4): 12-byte header, a JSON chunk, an optional BIN chunk; unknown
+/// chunks are skipped. Every length is checked against the bytes present.
+pub fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), GltfError> {
+    let u32_at = |b: &[u8], o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+    if bytes.len() < 12 || &bytes[..4] != b"glTF" {
+        return Err(container("GLB: no 12-byte 'glTF' header"));
+    }
+    let version = u32_at(bytes, 4);
+    if version != 2 {
+        return Err(container(format!("GLB: version {version}, expected 2")));
+    }
+    let length = u32_at(bytes, 8) as usize;
+    if length > bytes.len() || length < 20 {
+        return Err(container(format!(
+            "GLB: header length {length} does not fit the {} bytes present (minimum 20)",
+            bytes.len()
+        )));
+    }
+    let data = &bytes[..length];
+    let (mut pos, mut json, mut bin) = (12usize, None, None);
+    let mut index = 0;
+    while pos < length {
+        if length - pos < 8 {
+            return Err(container(format!("GLB: chunk {index} header is truncated")));
+        }
+        let (clen, ctype) = (u32_at(data, pos) as usize, u32_at(data, pos + 4));
+        let start = pos + 8;
+        if clen > length - start {
+            return Err(container(format!(
+                "GLB: chunk {index} claims {clen} bytes but only {} remain",
+                length - start
+            )));
+        }
+        let chunk = &data[start..start + clen];
+        match (index, ctype) {
+            (0, 0x4E4F_534A) => json = Some(chunk),
+            (0, _) => return Err(container("GLB: the first chunk is not JSON")),
+            (1, 0x004E_4942) => bin = Some(chunk),
+            _ => {} // unknown chunk types are ignored (glTF 2.0)
+        }
+        pos = start + clen;
+        index += 1;
+    }
+    let json = json.ok_or_else(|| container("GLB: no JSON chunk"))?;
+    Ok((json, bin))
 }
 
 fn check_required_extensions(json: &Value, findings: &mut Vec<Finding>) {
@@ -167,10 +216,13 @@ fn schema_root(json: &Value, findings: &mut Vec<Finding>) -> Option<gltf::json::
         // (zero-filled or sparse-only); the decoder handles it.
         let soft = p.ends_with(".min")
             || p.ends_with(".max")
+            || (p.ends_with(".attributes[\"POSITION\"]")
+                && matches!(err, gltf::json::validation::Error::Missing)
+                && !is_splat_primitive(json, &p))
             || (p.ends_with(".bufferView")
                 && p.starts_with("accessors[")
                 && matches!(err, gltf::json::validation::Error::Missing));
-        if soft && p.ends_with(".bufferView") {
+        if soft && (p.ends_with(".bufferView") || p.ends_with(".attributes[\"POSITION\"]")) {
             return;
         }
         let msg = match err {
@@ -214,16 +266,45 @@ fn node_graph_problem(root: &gltf::json::Root) -> Option<Finding> {
             parent[c] = Some(i);
         }
     }
-    // With at most one parent each, a cycle means a chain that never reaches a root.
+    // With at most one parent each, a cycle means a chain that never reaches a root. Each node
+    // is walked once: 0 = unknown, 1 = on the current chain, 2 = reaches a root.
+    let mut state = vec![0u8; n];
     for start in 0..n {
-        let (mut cur, mut steps) = (start, 0);
-        while let Some(p) = parent[cur] {
-            cur = p;
-            steps += 1;
-            if steps > n {
+        let mut chain = Vec::new();
+        let mut cur = start;
+        loop {
+            match state[cur] {
+                2 => break,
+                1 => {
+                    return Some(Finding::fatal(
+                        format!("nodes[{start}]"),
+                        "node hierarchy contains a cycle",
+                    ));
+                }
+                _ => {}
+            }
+            state[cur] = 1;
+            chain.push(cur);
+            match parent[cur] {
+                Some(p) => cur = p,
+                None => break,
+            }
+        }
+        for c in chain {
+            state[c] = 2;
+        }
+    }
+    // glTF 2.0: a scene's nodes are distinct root nodes (else instances would repeat).
+    for (si, scene) in root.scenes.iter().enumerate() {
+        let mut seen = std::collections::HashSet::new();
+        for (k, nd) in scene.nodes.iter().enumerate() {
+            let v = nd.value();
+            if v < n && (parent[v].is_some() || !seen.insert(v)) {
                 return Some(Finding::fatal(
-                    format!("nodes[{start}]"),
-                    "node hierarchy contains a cycle",
+                    format!("scenes[{si}].nodes[{k}]"),
+                    format!(
+                        "node {v} is listed twice or is not a root node (glTF 2.0: scene nodes are distinct roots)"
+                    ),
                 ));
             }
         }
@@ -236,8 +317,9 @@ fn resolve_buffers(
     mut bin: Option<Vec<u8>>,
     path: Option<&Path>,
     findings: &mut Vec<Finding>,
-) -> Vec<Vec<u8>> {
+) -> (Vec<Vec<u8>>, u64) {
     let mut out = Vec::new();
+    let mut external = 0u64;
     for buf in doc.buffers() {
         let jp = format!("buffers[{}]", buf.index());
         let data = match buf.source() {
@@ -245,7 +327,13 @@ fn resolve_buffers(
                 Some(b) => Ok(b),
                 None => Err("refers to the GLB BIN chunk, which is missing (or used twice)".into()),
             },
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, path),
+            gltf::buffer::Source::Uri(uri) => {
+                let r = read_uri(uri, path, buf.length());
+                if let (Ok(d), false) = (&r, uri.starts_with("data:")) {
+                    external += d.len() as u64;
+                }
+                r
+            }
         };
         match data {
             Ok(d) if d.len() < buf.length() => {
@@ -269,10 +357,12 @@ fn resolve_buffers(
             }
         }
     }
-    out
+    (out, external)
 }
 
-fn read_uri(uri: &str, path: Option<&Path>) -> Result<Vec<u8>, String> {
+/// Reads a buffer URI: a base64 data URI, or a relative file read up to `len` bytes (a regular
+/// file only, so `/dev/zero` or a FIFO cannot make the read endless).
+fn read_uri(uri: &str, path: Option<&Path>, len: usize) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest
             .split_once(";base64,")
@@ -290,7 +380,17 @@ fn read_uri(uri: &str, path: Option<&Path>) -> Result<Vec<u8>, String> {
         .and_then(Path::parent)
         .ok_or_else(|| format!("external buffer {uri:?} needs the glTF file's path"))?;
     let file = base.join(percent_decode(uri));
-    std::fs::read(&file).map_err(|e| format!("external buffer {}: {e}", file.display()))
+    let err = |e: std::io::Error| format!("external buffer {}: {e}", file.display());
+    let f = std::fs::File::open(&file).map_err(err)?;
+    if !f.metadata().map_err(err)?.is_file() {
+        return Err(format!(
+            "external buffer {}: not a regular file",
+            file.display()
+        ));
+    }
+    let mut data = Vec::new();
+    std::io::Read::read_to_end(&mut std::io::Read::take(f, len as u64), &mut data).map_err(err)?;
+    Ok(data)
 }
 
 fn percent_decode(s: &str) -> String {
@@ -310,4 +410,21 @@ fn percent_decode(s: &str) -> String {
         i += 1;
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Whether the primitive a path like `meshes[0].primitives[1]...` points into carries the
+/// extension (gltf-json reports a missing POSITION for every primitive; glTF 2.0 requires it
+/// only where the primitive is used as splats here).
+fn is_splat_primitive(json: &Value, path: &str) -> bool {
+    let num = |key: &str| -> Option<usize> {
+        let rest = &path[path.find(key)? + key.len()..];
+        rest[..rest.find(']')?].parse().ok()
+    };
+    let (Some(m), Some(p)) = (num("meshes["), num("primitives[")) else {
+        return false;
+    };
+    json["meshes"][m]["primitives"][p]
+        .get("extensions")
+        .and_then(|e| e.get(EXT))
+        .is_some()
 }

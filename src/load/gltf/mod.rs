@@ -80,6 +80,11 @@ pub fn walk(
     let json = &parsed.json;
     uses_extension_check(json, &mut w.findings);
 
+    // Everything decoded or instantiated is charged to one budget of f32 values, bounded by the
+    // input: 16M values (64 MiB) plus 4 values per input byte (file and external buffers).
+    let input: u64 = parsed.input_len as u64 + parsed.external_bytes;
+    let budget = std::cell::Cell::new((16u64 << 20) + 4 * input);
+
     // Pass 1: every splat primitive of every mesh, decoded and checked once.
     let mut decoded: HashMap<(usize, usize), primitive::LocalSplats> = HashMap::new();
     let meshes = json
@@ -130,7 +135,11 @@ pub fn walk(
                 buffers: &parsed.buffers,
                 path: ppath,
                 scale_space: opts.scale_space,
-                alloc_limit: 4 * parsed.input_len + 1024,
+                budget: &budget,
+                quantization: json
+                    .get("extensionsUsed")
+                    .and_then(Value::as_array)
+                    .is_some_and(|a| a.iter().any(|v| v == "KHR_mesh_quantization")),
             };
             match primitive::read(&ctx, prim, &meta, &mut w.findings) {
                 Some(ls) => {
@@ -160,7 +169,21 @@ pub fn walk(
             let Some(ls) = decoded.get(&(mesh, pi)) else {
                 continue;
             };
-            let global = transform::apply(&ls.cloud, m, node, &mut w.findings);
+            let per_splat = 11 + 3 * ls.cloud.coeffs_per_splat() as u64;
+            let values = ls.cloud.len() as u64 * per_splat;
+            if values > budget.get() {
+                w.findings.push(Finding::fatal(
+                    format!("nodes[{node}]"),
+                    format!(
+                        "instancing meshes[{mesh}] here would exceed the output this {input}-byte input can justify (16M + 4 values per input byte)"
+                    ),
+                ));
+                return Ok(w);
+            }
+            budget.set(budget.get() - values);
+            let Some(global) = transform::apply(&ls.cloud, m, node, &mut w.findings) else {
+                return Ok(w);
+            };
             w.scale_seen = Some(ScaleSeen::merge(w.scale_seen, ls.scale_seen));
             w.non_unit += ls.non_unit;
             match &mut cloud {
@@ -233,13 +256,19 @@ fn scene_nodes<'d>(
     json: &Value,
     findings: &mut Vec<Finding>,
 ) -> Vec<(gltf::Node<'d>, DMat4)> {
-    fn visit<'d>(node: gltf::Node<'d>, parent: DMat4, out: &mut Vec<(gltf::Node<'d>, DMat4)>) {
-        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-        let m = parent * local;
-        let children: Vec<_> = node.children().collect();
-        out.push((node, m));
-        for c in children {
-            visit(c, m, out);
+    // Depth first with an explicit stack: a deep node chain cannot overflow the call stack.
+    // (The hierarchy was checked to be a forest, so this terminates.)
+    fn visit<'d>(root: gltf::Node<'d>, out: &mut Vec<(gltf::Node<'d>, DMat4)>) {
+        let mut stack = vec![(root, DMat4::IDENTITY)];
+        while let Some((node, parent)) = stack.pop() {
+            let local =
+                DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+            let m = parent * local;
+            let children: Vec<_> = node.children().collect();
+            out.push((node, m));
+            for c in children.into_iter().rev() {
+                stack.push((c, m));
+            }
         }
     }
     let mut out = Vec::new();
@@ -247,7 +276,7 @@ fn scene_nodes<'d>(
     match scene {
         Some(s) => {
             for n in s.nodes() {
-                visit(n, DMat4::IDENTITY, &mut out);
+                visit(n, &mut out);
             }
         }
         None => {
@@ -267,7 +296,7 @@ fn scene_nodes<'d>(
             }
             for node in doc.nodes() {
                 if !is_child[node.index()] {
-                    visit(node, DMat4::IDENTITY, &mut out);
+                    visit(node, &mut out);
                 }
             }
         }
@@ -289,9 +318,21 @@ pub fn cameras(
         let f = findings.into_iter().find(|f| f.blocks_loading);
         return Err(f.map_or(GltfError::NoSplats, GltfError::Invalid));
     };
+    if let Some(f) = findings.iter().find(|f| f.blocks_loading) {
+        return Err(GltfError::Invalid(f.clone()));
+    }
     let mut out = Vec::new();
     for (node, m) in scene_nodes(doc, &parsed.json, &mut findings) {
         let Some(cam) = node.camera() else { continue };
+        // The gltf crate unwraps the object named by `type`; make sure it is there.
+        let cj = &parsed.json["cameras"][cam.index()];
+        let ty = cj.get("type").and_then(Value::as_str).unwrap_or("");
+        if cj.get(ty).is_none_or(|o| !o.is_object()) {
+            return Err(GltfError::Invalid(Finding::fatal(
+                format!("cameras[{}]", cam.index()),
+                format!("type {ty:?} but no {ty:?} object"),
+            )));
+        }
         if let gltf::camera::Projection::Perspective(p) = cam.projection() {
             out.push(crate::camera::GltfPerspective {
                 yfov: p.yfov(),

@@ -30,8 +30,10 @@ pub struct Ctx<'a> {
     pub path: String,
     /// Options.
     pub scale_space: ScaleSpace,
-    /// Cap for accessors without a buffer view.
-    pub alloc_limit: usize,
+    /// Whether `KHR_mesh_quantization` is in `extensionsUsed` (quantized POSITION allowed).
+    pub quantization: bool,
+    /// Values the document may still decode (see [`decode`]).
+    pub budget: &'a std::cell::Cell<u64>,
 }
 
 fn attr_path(base: &str, name: &str) -> String {
@@ -121,6 +123,19 @@ fn unknown_of<T>(k: &Known<T>) -> Option<&str> {
     }
 }
 
+/// POSITION with `KHR_mesh_quantization`: float, or 8/16-bit integers, normalized or not.
+const POSITION_QUANTIZED: &[(DataType, bool)] = &[
+    (DataType::F32, false),
+    (DataType::I8, false),
+    (DataType::I8, true),
+    (DataType::U8, false),
+    (DataType::U8, true),
+    (DataType::I16, false),
+    (DataType::I16, true),
+    (DataType::U16, false),
+    (DataType::U16, true),
+];
+
 /// What the RC allows per attribute: (dims, allowed (type, normalized) pairs).
 fn allowed(name: &str) -> (usize, &'static [(DataType, bool)]) {
     use DataType::*;
@@ -186,7 +201,7 @@ pub fn read(
             ));
             return None;
         };
-        match decode(&acc, ctx.buffers, &ap, ctx.alloc_limit) {
+        match decode(&acc, ctx.buffers, &ap, ctx.budget) {
             Ok(d) => Some(Some(d)),
             Err(e) => {
                 f.push(e);
@@ -253,7 +268,16 @@ pub fn read(
     let n = position.count();
     type Check<'d> = (String, &'d Decoded, usize, &'static [(DataType, bool)]);
     let mut typed: Vec<Check> = vec![
-        (attr_path(path, "POSITION"), &position, 3, &[]),
+        (
+            attr_path(path, "POSITION"),
+            &position,
+            3,
+            if ctx.quantization {
+                POSITION_QUANTIZED
+            } else {
+                &[(DataType::F32, false)]
+            },
+        ),
         (
             attr_path(path, &format!("{PREFIX}ROTATION")),
             &rotation,
@@ -299,8 +323,11 @@ pub fn read(
             ));
             blocked = true;
         } else if !ok.is_empty() && !ok.contains(&(d.component, d.normalized)) {
-            let is_legacy_scale =
-                p.ends_with("SCALE\"]") && matches!(d.component, DataType::I8 | DataType::I16);
+            // Signed SCALE is the review draft's log space: reported by the scale-space check
+            // below, unless the caller insists on linear.
+            let is_legacy_scale = p.ends_with("SCALE\"]")
+                && matches!(d.component, DataType::I8 | DataType::I16)
+                && ctx.scale_space != ScaleSpace::Linear;
             if !is_legacy_scale {
                 f.push(Finding::error(
                     p.clone(),
@@ -310,6 +337,9 @@ pub fn read(
                     ),
                 ));
             }
+        }
+        if let Some(m) = &d.misaligned {
+            f.push(Finding::error(p.clone(), format!("glTF 2.0 layout: {m}")));
         }
         if let Some(i) = d.data.iter().position(|v| !v.is_finite()) {
             f.push(Finding::fatal(p.clone(), "value is not finite").at((i / d.dims) as u64));
@@ -449,6 +479,10 @@ pub fn read(
         } else {
             s.map(|v| v.max(0.0))
         };
+        if !s.iter().all(|v| v.is_finite()) {
+            f.push(Finding::fatal(&scale_path, "exp(log-space scale) overflows f32").at(i as u64));
+            return None;
+        }
         sh[0] = match (&sh0, &color0) {
             (Some(d), _) => d.get(i),
             (None, Some(c)) => dc_from_color0(c.get::<3>(i), srgb),

@@ -31,11 +31,17 @@ fn check_decomposable(m: DMat3, node: usize, findings: &mut Vec<Finding>) {
     }
 }
 
-/// Returns the cloud in global space under `m` (the node's global matrix).
-pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Finding>) -> SplatCloud {
+/// Returns the cloud in global space under `m` (the node's global matrix), or `None` after a
+/// blocking finding when the transform produces non-finite values.
+pub fn apply(
+    local: &SplatCloud,
+    m: DMat4,
+    node: usize,
+    findings: &mut Vec<Finding>,
+) -> Option<SplatCloud> {
     let mut out = local.clone();
     if m == DMat4::IDENTITY {
-        return out;
+        return Some(out);
     }
     let m3 = DMat3::from_mat4(m);
     check_decomposable(m3, node, findings);
@@ -77,5 +83,24 @@ pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Findi
             }
         }
     }
-    out
+    let bad = out
+        .positions
+        .iter()
+        .position(|p| !p.iter().all(|v| v.is_finite()))
+        .or_else(|| {
+            out.scales
+                .iter()
+                .position(|s| !s.iter().all(|v| v.is_finite()))
+        });
+    if let Some(i) = bad {
+        findings.push(
+            Finding::fatal(
+                format!("nodes[{node}]"),
+                "the global transform makes a splat's position or scale non-finite",
+            )
+            .at(i as u64),
+        );
+        return None;
+    }
+    Some(out)
 }
