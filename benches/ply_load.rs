@@ -34,7 +34,7 @@ fn cloud(n: usize) -> SplatCloud {
 }
 
 fn bench(c: &mut Criterion) {
-    let bytes = splatgl::load::ply::write_inria(&cloud(1_000_000));
+    let bytes = splatgl::write::to_inria_ply(&cloud(1_000_000));
     let mut g = c.benchmark_group("ply_1M_sh3");
     g.sample_size(10);
     g.measurement_time(std::time::Duration::from_secs(5));

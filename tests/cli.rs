@@ -48,7 +48,7 @@ fn validate_exit_codes() {
 #[test]
 fn info_json_keys() {
     let cloud = common::random_cloud(2, 33, 1);
-    let p = tmp("c.ply", &splatgl::load::ply::write_inria(&cloud));
+    let p = tmp("c.ply", &splatgl::write::to_inria_ply(&cloud));
     let (code, out, err) = splatgl(&["info", "--json", p.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();

@@ -175,7 +175,7 @@ fn external_buffer_file() {
 fn ply_roundtrip_all_degrees() {
     for degree in 0..=3 {
         let c = quantizable(20 + degree as u64, degree);
-        let bytes = splatgl::load::ply::write_inria(&c);
+        let bytes = splatgl::write::to_inria_ply(&c);
         let l = load_bytes(&bytes, Some(Path::new("x.ply")), &LoadOptions::default()).unwrap();
         let got = l.cloud;
         assert_eq!(got.sh, c.sh, "f_rest channel-major ↔ degree-major");

@@ -32,7 +32,7 @@ fn ply_header(body: &str) -> Vec<u8> {
 }
 
 fn good_ply() -> Vec<u8> {
-    splatgl::load::ply::write_inria(&random_cloud(1, 4, 1))
+    splatgl::write::to_inria_ply(&random_cloud(1, 4, 1))
 }
 
 /// Overwrites float property `prop` (column index in the INRIA layout of degree 1) of row `row`.

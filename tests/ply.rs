@@ -45,7 +45,7 @@ fn header(format: &str, n: usize, props: &[(&str, &str)]) -> String {
 #[test]
 fn big_endian_and_ascii_match_little_endian() {
     let c = random_cloud(5, 40, 2);
-    let le = splatgl::load::ply::write_inria(&c);
+    let le = splatgl::write::to_inria_ply(&c);
     let want = load(&le);
     let (props, rows) = parse_le(&le);
     let typed: Vec<(&str, &str)> = props.iter().map(|p| ("float", p.as_str())).collect();
@@ -70,8 +70,8 @@ fn big_endian_and_ascii_match_little_endian() {
 #[test]
 fn doubles_extra_properties_and_preceding_elements() {
     let c = random_cloud(6, 10, 0);
-    let want = load(&splatgl::load::ply::write_inria(&c));
-    let (props, rows) = parse_le(&splatgl::load::ply::write_inria(&c));
+    let want = load(&splatgl::write::to_inria_ply(&c));
+    let (props, rows) = parse_le(&splatgl::write::to_inria_ply(&c));
     // A leading element with a list, every value as double, plus normals and a uchar extra.
     let mut h = String::from("ply\nformat binary_little_endian 1.0\nelement camera 2\n");
     h += "property list uchar int ids\nproperty float fov\n";

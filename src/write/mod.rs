@@ -1,8 +1,11 @@
-//! Writers: a [`SplatCloud`] as glTF 2.0 with `KHR_gaussian_splatting` (RC), as `.glb` or
+//! Writers: a [`SplatCloud`] as INRIA PLY ([`to_inria_ply`]), or as glTF 2.0 with `KHR_gaussian_splatting` (RC), as `.glb` or
 //! `.gltf` with an embedded data-URI buffer. Every component type the RC allows can be chosen
 //! per attribute, with optional padding (byteStride) and a sparse OPACITY accessor, so the
 //! tests can round-trip every decoding path of the loader. The output passes
 //! `splatgl validate`.
+
+mod ply;
+pub use ply::to_inria_ply;
 
 use crate::cloud::{ColorSpace, Kernel, Projection, SortingMethod, SplatCloud};
 use base64::Engine;
