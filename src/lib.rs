@@ -14,6 +14,7 @@ pub mod covariance;
 pub mod image;
 pub mod load;
 pub mod sh;
+pub mod sort;
 pub mod validate;
 pub mod write;
 
