@@ -216,17 +216,20 @@ fn per_frame(c: &mut Criterion) {
         let mut sorter = Sorter::new();
         let mut upload = vec![0u32; n];
         let mut frame = 0u32;
-        g.bench_function(BenchmarkId::new(format!("{}/per-frame", scene.name), n), |b| {
-            b.iter(|| {
-                // A moving camera: a different eye every frame.
-                frame = frame.wrapping_add(1);
-                let mut eye = scene.eye;
-                eye[0] += frame as f32 * 1e-3;
-                let order = sorter.sort_by_distance(&scene.positions, eye);
-                upload.copy_from_slice(order);
-                black_box(upload[n / 2])
-            })
-        });
+        g.bench_function(
+            BenchmarkId::new(format!("{}/per-frame", scene.name), n),
+            |b| {
+                b.iter(|| {
+                    // A moving camera: a different eye every frame.
+                    frame = frame.wrapping_add(1);
+                    let mut eye = scene.eye;
+                    eye[0] += frame as f32 * 1e-3;
+                    let order = sorter.sort_by_distance(&scene.positions, eye);
+                    upload.copy_from_slice(order);
+                    black_box(upload[n / 2])
+                })
+            },
+        );
     }
     // Bandwidth baselines: one 2-thread copy of 1M u64 (one radix pass moves as much:
     // 8 MB read + 8 MB written) and one random scatter of the same.
@@ -245,7 +248,9 @@ fn per_frame(c: &mut Criterion) {
 
 /// Order errors of the quantized modes at 1M, against the full-precision order.
 fn print_quantized_errors() {
-    eprintln!("quantized order error at N = 1M (distance keys, misordered = a nearer splat drawn before a farther one)");
+    eprintln!(
+        "quantized order error at N = 1M (distance keys, misordered = a nearer splat drawn before a farther one)"
+    );
     for scene in [uniform(1_000_000), clustered(1_000_000)] {
         let dist: Vec<f32> = scene
             .positions

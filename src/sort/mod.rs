@@ -264,11 +264,19 @@ impl Sorter {
         let n = keys.len();
         let t = chunk_count(n);
         match self.precision {
-            Precision::Full => self.sort_u32(n, t, 32, |i| far_first_key(keys[i])),
+            Precision::Full => self.sort_u32(n, t, 32, |start, block| {
+                for (k, &f) in block.iter_mut().zip(&keys[start..]) {
+                    *k = far_first_key(f);
+                }
+            }),
             Precision::Quantized { bits } => {
                 let bits = bits.clamp(8, 24);
                 let q = visible_range(&mut self.scratch.ranges, keys, t, bits, false);
-                self.sort_u32(n, t, bits, |i| quantized_key(keys[i], q.lo, q.scale, q.top));
+                self.sort_u32(n, t, bits, |start, block| {
+                    for (k, &f) in block.iter_mut().zip(&keys[start..]) {
+                        *k = quantized_key(f, q.lo, q.scale, q.top);
+                    }
+                });
             }
         }
         self.outcome = Outcome::Sorted;
@@ -324,11 +332,15 @@ impl Sorter {
         let n = positions.len();
         let t = chunk_count(n);
         match (self.precision, mode) {
-            (Precision::Full, SortMode::Distance) => self.sort_u32(n, t, 32, |i| {
-                far_first_key(squared_distance(positions[i], eye))
+            (Precision::Full, SortMode::Distance) => self.sort_u32(n, t, 32, |start, block| {
+                for (k, &p) in block.iter_mut().zip(&positions[start..]) {
+                    *k = far_first_key(squared_distance(p, eye));
+                }
             }),
-            (Precision::Full, SortMode::ViewDepth) => self.sort_u32(n, t, 32, |i| {
-                far_first_key(view_depth(positions[i], eye, forward))
+            (Precision::Full, SortMode::ViewDepth) => self.sort_u32(n, t, 32, |start, block| {
+                for (k, &p) in block.iter_mut().zip(&positions[start..]) {
+                    *k = far_first_key(view_depth(p, eye, forward));
+                }
             }),
             (Precision::Quantized { bits }, _) => {
                 let bits = bits.clamp(8, 24);
@@ -353,7 +365,11 @@ impl Sorter {
                     mode == SortMode::ViewDepth,
                 );
                 let fk = &fkeys[..n];
-                self.sort_u32(n, t, bits, |i| quantized_key(fk[i], q.lo, q.scale, q.top));
+                self.sort_u32(n, t, bits, |start, block| {
+                    for (k, &f) in block.iter_mut().zip(&fk[start..]) {
+                        *k = quantized_key(f, q.lo, q.scale, q.top);
+                    }
+                });
                 self.scratch.fkeys = fkeys;
             }
         }
@@ -370,12 +386,13 @@ impl Sorter {
         self.order()
     }
 
-    /// Keys `key(i)` of `bits` bits → `out[..n]` in ascending key order (ties by index).
-    fn sort_u32(&mut self, n: usize, t: usize, bits: u32, key: impl Fn(usize) -> u32 + Sync) {
+    /// Keys of `bits` bits (`fill(first, block)` writes those of `first..first + block.len()`)
+    /// → `out[..n]` in ascending key order (ties by index).
+    fn sort_u32(&mut self, n: usize, t: usize, bits: u32, fill: impl Fn(usize, &mut [u32]) + Sync) {
         let digits = Digits::new(bits, self.max_digit_bits);
         let rb = &mut self.scratch.radix;
         rb.prepare(n, t);
-        count_all(&mut rb.keys[..n], &mut rb.hist, t, &digits, key);
+        count_all(&mut rb.keys[..n], &mut rb.hist, t, &digits, fill);
         rb.sort(n, t, &digits);
         self.n = n;
     }

@@ -32,6 +32,11 @@ pub(crate) const MAX_PASSES: usize = 4;
 /// Below this many elements per chunk, use fewer chunks (rayon overhead beats the gain).
 const MIN_CHUNK: usize = 1 << 15;
 
+/// Histograms per chunk: one per pass plus 3 spare tables for counting the top digit.
+pub(crate) const STRIDE: usize = MAX_PASSES + 3;
+/// Keys filled (then counted) at a time: 16 KiB, fits L1.
+pub(crate) const BLOCK: usize = 4096;
+
 /// One histogram (or one table of running offsets).
 pub(crate) type Hist = [u32; BUCKETS];
 
@@ -85,7 +90,7 @@ pub(crate) struct RadixBuffers {
     b: Vec<u64>,
     /// The result: indices in ascending key order.
     pub out: Vec<u32>,
-    /// `hist[c * MAX_PASSES + p]`: counts of pass `p`'s digit in chunk `c`.
+    /// `hist[c * STRIDE + p]`: counts of pass `p`'s digit in chunk `c`.
     pub hist: Vec<Hist>,
 }
 
@@ -107,10 +112,10 @@ impl RadixBuffers {
     pub(crate) fn prepare(&mut self, n: usize, t: usize) {
         grow(&mut self.keys, n);
         grow(&mut self.out, n);
-        if self.hist.len() < t * MAX_PASSES {
-            self.hist.resize(t * MAX_PASSES, [0; BUCKETS]);
+        if self.hist.len() < t * STRIDE {
+            self.hist.resize(t * STRIDE, [0; BUCKETS]);
         }
-        for h in &mut self.hist[..t * MAX_PASSES] {
+        for h in &mut self.hist[..t * STRIDE] {
             h.fill(0);
         }
     }
@@ -126,7 +131,7 @@ impl RadixBuffers {
         for p in 0..digits.passes {
             let constant = (0..BUCKETS).any(|d| {
                 (0..t)
-                    .map(|c| self.hist[c * MAX_PASSES + p][d] as usize)
+                    .map(|c| self.hist[c * STRIDE + p][d] as usize)
                     .sum::<usize>()
                     == n
             });
@@ -148,7 +153,7 @@ impl RadixBuffers {
             grow(&mut self.b, n);
         }
         let keys = &self.keys[..n];
-        let hist = &mut self.hist[..t * MAX_PASSES];
+        let hist = &mut self.hist[..t * STRIDE];
         let (a, b) = (&mut self.a, &mut self.b);
 
         for (k, &p) in live[..n_live].iter().enumerate() {
@@ -204,25 +209,41 @@ pub(crate) fn grow<T: Copy + Default>(v: &mut Vec<T>, n: usize) {
     }
 }
 
-/// Per-chunk counts of pass `p`'s digit over `src`.
+/// Per-chunk counts of pass `p`'s digit over `src` (4 interleaved tables, summed, so that runs
+/// of equal digits do not serialise on one counter).
 fn count_pass(src: &[u64], hist: &mut [Hist], t: usize, digits: &Digits, p: usize) {
     let n = src.len();
-    hist.par_chunks_mut(MAX_PASSES)
-        .enumerate()
-        .for_each(|(c, h)| {
-            let h = &mut h[p];
-            h.fill(0);
-            for &e in &src[chunk_range(c, t, n)] {
-                h[digits.digit((e >> 32) as u32, p)] += 1;
-            }
-        });
+    hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
+        let (main, extra) = h.split_at_mut(MAX_PASSES);
+        let h = &mut main[p];
+        let [e0, e1, e2] = extra else {
+            unreachable!("STRIDE = MAX_PASSES + 3")
+        };
+        for table in [&mut *h, &mut *e0, &mut *e1, &mut *e2] {
+            table.fill(0);
+        }
+        let digit = |e: u64| digits.digit((e >> 32) as u32, p);
+        let mut quads = src[chunk_range(c, t, n)].chunks_exact(4);
+        for q in &mut quads {
+            h[digit(q[0])] += 1;
+            e0[digit(q[1])] += 1;
+            e1[digit(q[2])] += 1;
+            e2[digit(q[3])] += 1;
+        }
+        for &e in quads.remainder() {
+            h[digit(e)] += 1;
+        }
+        for d in 0..BUCKETS {
+            h[d] += e0[d] + e1[d] + e2[d];
+        }
+    });
 }
 
 /// Turns pass `p`'s per-chunk counts into each chunk's first destination per digit.
 fn offsets(hist: &mut [Hist], t: usize, p: usize) {
     let mut sum = 0u32;
     for d in 0..BUCKETS {
-        for h in hist.iter_mut().skip(p).step_by(MAX_PASSES).take(t) {
+        for h in hist.iter_mut().skip(p).step_by(STRIDE).take(t) {
             let count = h[d];
             h[d] = sum;
             sum += count;
@@ -265,68 +286,69 @@ fn scatter<S, D>(
     let n = src.len();
     assert_eq!(dst.len(), n, "scatter: destination length");
     let dst = SharedMut(dst.as_mut_ptr());
-    hist.par_chunks_mut(MAX_PASSES)
-        .enumerate()
-        .for_each(|(c, h)| {
-            let off = &mut h[p];
-            let range = chunk_range(c, t, n);
-            let base = range.start;
-            for (i, &s) in src[range].iter().enumerate() {
-                let d = digit(s, base + i);
-                let o = off[d] as usize;
-                off[d] += 1;
-                // SAFETY: `offsets` gave chunk `c` the positions
-                // `[Σ_{d'<d} total[d'] + Σ_{c'<c} count[c'][d], … + count[c][d])` for digit
-                // `d`; they partition `0..n` over all chunks and digits, so `o < n` and no
-                // other task writes position `o`.
-                debug_assert!(o < n);
-                unsafe { dst.get().add(o).write(make(s, base + i)) };
-            }
-        });
+    hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
+        let off = &mut h[p];
+        let range = chunk_range(c, t, n);
+        let base = range.start;
+        for (i, &s) in src[range].iter().enumerate() {
+            let d = digit(s, base + i);
+            let o = off[d] as usize;
+            off[d] += 1;
+            // SAFETY: `offsets` gave chunk `c` the positions
+            // `[Σ_{d'<d} total[d'] + Σ_{c'<c} count[c'][d], … + count[c][d])` for digit
+            // `d`; they partition `0..n` over all chunks and digits, so `o < n` and no
+            // other task writes position `o`.
+            debug_assert!(o < n);
+            unsafe { dst.get().add(o).write(make(s, base + i)) };
+        }
+    });
 }
 
-/// Fills `keys[..n]` with `key(i)` and counts every pass's digit per chunk, in parallel.
-/// Returns nothing; the counts land in `hist`.
+/// Fills `keys` (in blocks of [`BLOCK`] keys: `fill(first_index, block)`) and counts every
+/// pass's digit per chunk, in parallel. Counting a block right after filling it reads it from
+/// L1; the key computation itself is a plain loop the compiler can vectorise.
 pub(crate) fn count_all(
     keys: &mut [u32],
     hist: &mut [Hist],
     t: usize,
     digits: &Digits,
-    key: impl Fn(usize) -> u32 + Sync,
+    fill: impl Fn(usize, &mut [u32]) + Sync,
 ) {
     let n = keys.len();
     let len = n.div_ceil(t.max(1)).max(1);
+    let top = digits.passes - 1;
     keys.par_chunks_mut(len)
-        .zip(hist.par_chunks_mut(MAX_PASSES))
+        .zip(hist.par_chunks_mut(STRIDE))
         .enumerate()
         .for_each(|(c, (ks, h))| {
-            let base = c * len;
-            match digits.passes {
-                1 => {
-                    for (i, k) in ks.iter_mut().enumerate() {
-                        let v = key(base + i);
-                        *k = v;
-                        h[0][digits.digit(v, 0)] += 1;
+            let (main, extra) = h.split_at_mut(MAX_PASSES);
+            let (lower, upper) = main.split_at_mut(top);
+            let h_top = &mut upper[0];
+            let [e0, e1, e2] = extra else {
+                unreachable!("STRIDE = MAX_PASSES + 3")
+            };
+            for (b, block) in ks.chunks_mut(BLOCK).enumerate() {
+                fill(c * len + b * BLOCK, block);
+                for (p, hp) in lower.iter_mut().enumerate() {
+                    for &k in block.iter() {
+                        hp[digits.digit(k, p)] += 1;
                     }
                 }
-                2 => {
-                    let (h0, h1) = h.split_at_mut(1);
-                    for (i, k) in ks.iter_mut().enumerate() {
-                        let v = key(base + i);
-                        *k = v;
-                        h0[0][digits.digit(v, 0)] += 1;
-                        h1[0][digits.digit(v, 1)] += 1;
-                    }
+                // The most significant digit of float keys takes few values: spread its
+                // counts over 4 tables so repeated increments do not wait on each other.
+                let mut quads = block.chunks_exact(4);
+                for q in &mut quads {
+                    h_top[digits.digit(q[0], top)] += 1;
+                    e0[digits.digit(q[1], top)] += 1;
+                    e1[digits.digit(q[2], top)] += 1;
+                    e2[digits.digit(q[3], top)] += 1;
                 }
-                _ => {
-                    for (i, k) in ks.iter_mut().enumerate() {
-                        let v = key(base + i);
-                        *k = v;
-                        for (p, hp) in h.iter_mut().enumerate().take(digits.passes) {
-                            hp[digits.digit(v, p)] += 1;
-                        }
-                    }
+                for &k in quads.remainder() {
+                    h_top[digits.digit(k, top)] += 1;
                 }
+            }
+            for d in 0..BUCKETS {
+                h_top[d] += e0[d] + e1[d] + e2[d];
             }
         });
 }
