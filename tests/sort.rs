@@ -161,6 +161,18 @@ fn key_cases() -> Vec<(&'static str, Vec<f32>)> {
             .map(|_| f32::from_bits(0x4000_0000 | ((rng.below(1 << 8) as u32) << 22)))
             .collect(),
     ));
+    // A dense cluster (most keys in one MSD bucket, sorted by the parallel big-bucket path)
+    // plus far outliers; once with all low digits live, once with a constant top low digit.
+    let mut cluster: Vec<f32> = (0..300_000)
+        .map(|_| f32::from_bits(0x3F80_0000 | rng.below(1 << 20) as u32))
+        .collect();
+    cluster.extend([1.0e6, -3.0, 5.0e5, f32::INFINITY]);
+    cases.push(("dense cluster", cluster));
+    let mut cluster: Vec<f32> = (0..300_000)
+        .map(|_| f32::from_bits(0x3F80_0000 | rng.below(1 << 11) as u32))
+        .collect();
+    cluster.extend([1.0e6, 0.0, 7.0]);
+    cases.push(("dense cluster, constant digit", cluster));
     cases.push((
         "tiny random",
         (0..1000).map(|_| rng.below(10) as f32).collect(),
@@ -203,6 +215,18 @@ fn result_does_not_depend_on_thread_count() {
     let want = reference(&keys);
     for o in &orders {
         assert_eq!(o, &want);
+    }
+    // Every key case, on pools of 1, 2 and 3 threads (different chunkings and groupings).
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        let mut sorter = Sorter::new();
+        for (name, keys) in key_cases() {
+            let got = pool.install(|| sorter.sort_keys(&keys).to_vec());
+            assert_eq!(got, reference(&keys), "case {name}, {threads} threads");
+        }
     }
 }
 

@@ -35,7 +35,7 @@ pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
 
 use keys::{QuantRange, quantized_key};
-use radix::{Digits, RadixBuffers, chunk_count, count_all};
+use radix::{RadixBuffers, chunk_count, fill_keys};
 use rayon::prelude::*;
 
 /// Which key a camera sort uses.
@@ -264,7 +264,7 @@ impl Sorter {
         let n = keys.len();
         let t = chunk_count(n);
         match self.precision {
-            Precision::Full => self.sort_u32(n, t, 32, |start, block| {
+            Precision::Full => self.sort_u32(n, t, |start, block| {
                 for (k, &f) in block.iter_mut().zip(&keys[start..]) {
                     *k = far_first_key(f);
                 }
@@ -272,7 +272,7 @@ impl Sorter {
             Precision::Quantized { bits } => {
                 let bits = bits.clamp(8, 24);
                 let q = visible_range(&mut self.scratch.ranges, keys, t, bits, false);
-                self.sort_u32(n, t, bits, |start, block| {
+                self.sort_u32(n, t, |start, block| {
                     for (k, &f) in block.iter_mut().zip(&keys[start..]) {
                         *k = quantized_key(f, q.lo, q.scale, q.top);
                     }
@@ -332,12 +332,12 @@ impl Sorter {
         let n = positions.len();
         let t = chunk_count(n);
         match (self.precision, mode) {
-            (Precision::Full, SortMode::Distance) => self.sort_u32(n, t, 32, |start, block| {
+            (Precision::Full, SortMode::Distance) => self.sort_u32(n, t, |start, block| {
                 for (k, &p) in block.iter_mut().zip(&positions[start..]) {
                     *k = far_first_key(squared_distance(p, eye));
                 }
             }),
-            (Precision::Full, SortMode::ViewDepth) => self.sort_u32(n, t, 32, |start, block| {
+            (Precision::Full, SortMode::ViewDepth) => self.sort_u32(n, t, |start, block| {
                 for (k, &p) in block.iter_mut().zip(&positions[start..]) {
                     *k = far_first_key(view_depth(p, eye, forward));
                 }
@@ -365,7 +365,7 @@ impl Sorter {
                     mode == SortMode::ViewDepth,
                 );
                 let fk = &fkeys[..n];
-                self.sort_u32(n, t, bits, |start, block| {
+                self.sort_u32(n, t, |start, block| {
                     for (k, &f) in block.iter_mut().zip(&fk[start..]) {
                         *k = quantized_key(f, q.lo, q.scale, q.top);
                     }
@@ -386,14 +386,14 @@ impl Sorter {
         self.order()
     }
 
-    /// Keys of `bits` bits (`fill(first, block)` writes those of `first..first + block.len()`)
-    /// → `out[..n]` in ascending key order (ties by index).
-    fn sort_u32(&mut self, n: usize, t: usize, bits: u32, fill: impl Fn(usize, &mut [u32]) + Sync) {
-        let digits = Digits::new(bits, self.max_digit_bits);
+    /// Keys (`fill(first, block)` writes those of `first..first + block.len()`) → `out[..n]`
+    /// in ascending key order (ties by index).
+    fn sort_u32(&mut self, n: usize, t: usize, fill: impl Fn(usize, &mut [u32]) + Sync) {
         let rb = &mut self.scratch.radix;
         rb.prepare(n, t);
-        count_all(&mut rb.keys[..n], &mut rb.hist, t, &digits, fill);
-        rb.sort(n, t, &digits);
+        let (keys, minmax) = rb.keys_and_minmax(n, t);
+        fill_keys(keys, minmax, t, fill);
+        rb.sort(n, t, self.max_digit_bits);
         self.n = n;
     }
 }
