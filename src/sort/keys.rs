@@ -45,9 +45,10 @@ pub fn far_first_key(f: f32) -> u32 {
 #[inline(always)]
 pub(crate) fn quantized_key(f: f32, lo: f64, scale: f64, top: u32) -> u32 {
     // f64: the bucket of every f32 key is exact to ~2^-28 of a bucket even at 24 bits.
-    let x = (f64::from(f) - lo) * scale;
-    // `as` saturates (negative → 0); NaN compares false and goes farthest.
-    let q = if x < f64::from(top) { x as u32 } else { top };
+    // max/min drop a NaN operand, so `x` is in [0, top] (NaN keys → 0, fixed below).
+    let x = ((f64::from(f) - lo) * scale).max(0.0).min(f64::from(top));
+    // SAFETY: `x` is finite and in [0, top], top < 2^24 ≤ i32::MAX (i32: one SSE2 instruction).
+    let q = unsafe { x.to_int_unchecked::<i32>() } as u32;
     if f.is_nan() { 0 } else { top - q }
 }
 

@@ -119,8 +119,8 @@ pub struct SortScratch {
     radix: RadixBuffers,
     /// Float keys of a quantized sort.
     fkeys: Vec<f32>,
-    /// Per-chunk (min, max) of the visible keys.
-    ranges: Vec<(f32, f32)>,
+    /// Per-chunk (min, max) of the positive and of all finite keys.
+    ranges: Vec<[f32; 4]>,
 }
 
 /// The view a sort was made for (for reuse).
@@ -271,7 +271,7 @@ impl Sorter {
             }),
             Precision::Quantized { bits } => {
                 let bits = bits.clamp(8, 24);
-                let q = visible_range(&mut self.scratch.ranges, keys, t, bits, false);
+                let q = given_keys_range(&mut self.scratch.ranges, keys, t, bits);
                 self.sort_u32(n, t, |start, block| {
                     for (k, &f) in block.iter_mut().zip(&keys[start..]) {
                         *k = quantized_key(f, q.lo, q.scale, q.top);
@@ -346,23 +346,28 @@ impl Sorter {
                 let bits = bits.clamp(8, 24);
                 let mut fkeys = std::mem::take(&mut self.scratch.fkeys);
                 radix::grow(&mut fkeys, n);
-                let fk = &mut fkeys[..n];
-                let len = n.div_ceil(t).max(1);
-                fk.par_chunks_mut(len).enumerate().for_each(|(c, ks)| {
-                    for (j, k) in ks.iter_mut().enumerate() {
-                        let p = positions[c * len + j];
-                        *k = match mode {
-                            SortMode::Distance => squared_distance(p, eye).sqrt(),
-                            SortMode::ViewDepth => view_depth(p, eye, forward),
-                        };
+                let fill = |start: usize, block: &mut [f32]| {
+                    let ps = &positions[start..start + block.len()];
+                    match mode {
+                        SortMode::Distance => {
+                            for (k, &p) in block.iter_mut().zip(ps) {
+                                *k = squared_distance(p, eye).sqrt();
+                            }
+                        }
+                        SortMode::ViewDepth => {
+                            for (k, &p) in block.iter_mut().zip(ps) {
+                                *k = view_depth(p, eye, forward);
+                            }
+                        }
                     }
-                });
+                };
                 let q = visible_range(
                     &mut self.scratch.ranges,
-                    fk,
+                    &mut fkeys[..n],
                     t,
                     bits,
                     mode == SortMode::ViewDepth,
+                    Some(&fill),
                 );
                 let fk = &fkeys[..n];
                 self.sort_u32(n, t, |start, block| {
@@ -398,54 +403,103 @@ impl Sorter {
     }
 }
 
-/// Quantization range over the visible keys (finite; and `> 0` when `positive_only` and any
-/// key is), computed per chunk in parallel.
+/// Running (min, max) of the finite keys `> 0` and of all finite keys, of one block.
+fn scan_block(keys: &[f32], acc: &mut [f32; 4]) {
+    // Eight independent lanes (so the compiler vectorises and no comparison waits on the
+    // previous one); a non-candidate becomes NaN, which every comparison rejects.
+    const L: usize = 8;
+    let mut lanes = [[acc[0]; L], [acc[1]; L], [acc[2]; L], [acc[3]; L]];
+    let mut it = keys.chunks_exact(L);
+    let mut step = |ks: &[f32], lanes: &mut [[f32; L]; 4]| {
+        for (j, &k) in ks.iter().enumerate() {
+            let all = if k.is_finite() { k } else { f32::NAN };
+            let pos = if all > 0.0 { all } else { f32::NAN };
+            lanes[0][j] = if pos < lanes[0][j] { pos } else { lanes[0][j] };
+            lanes[1][j] = if pos > lanes[1][j] { pos } else { lanes[1][j] };
+            lanes[2][j] = if all < lanes[2][j] { all } else { lanes[2][j] };
+            lanes[3][j] = if all > lanes[3][j] { all } else { lanes[3][j] };
+        }
+    };
+    for ks in &mut it {
+        step(ks, &mut lanes);
+    }
+    step(it.remainder(), &mut lanes);
+    for j in 0..L {
+        acc[0] = acc[0].min(lanes[0][j]);
+        acc[1] = acc[1].max(lanes[1][j]);
+        acc[2] = acc[2].min(lanes[2][j]);
+        acc[3] = acc[3].max(lanes[3][j]);
+    }
+}
+
+/// Optionally fills `keys` (`fill(first, block)`, in L1-sized blocks) and returns the
+/// quantization range of the visible keys: the finite keys, or with `positive_only` those
+/// `> 0` when there are any. One parallel pass; `ranges` holds the per-chunk results.
 fn visible_range(
-    ranges: &mut Vec<(f32, f32)>,
-    keys: &[f32],
+    ranges: &mut Vec<[f32; 4]>,
+    keys: &mut [f32],
     t: usize,
     bits: u32,
     positive_only: bool,
+    fill: Option<&(dyn Fn(usize, &mut [f32]) + Sync)>,
 ) -> QuantRange {
     let n = keys.len();
     let len = n.div_ceil(t).max(1);
-    let chunks = n.div_ceil(len);
     ranges.clear();
-    ranges.resize(chunks.max(1), (f32::INFINITY, f32::NEG_INFINITY));
-    let scan = |ranges: &mut [(f32, f32)], floor: f32| {
-        ranges
-            .par_iter_mut()
-            .zip(keys.par_chunks(len))
-            .for_each(|(r, ks)| {
-                let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-                for &k in ks {
-                    if k.is_finite() && k > floor {
-                        lo = lo.min(k);
-                        hi = hi.max(k);
-                    }
+    ranges.resize(n.div_ceil(len).max(1), EMPTY_RANGE);
+    ranges
+        .par_iter_mut()
+        .zip(keys.par_chunks_mut(len))
+        .enumerate()
+        .for_each(|(c, (r, ks))| {
+            for (b, block) in ks.chunks_mut(radix::BLOCK).enumerate() {
+                if let Some(fill) = fill {
+                    fill(c * len + b * radix::BLOCK, block);
                 }
-                *r = (lo, hi);
-            });
-        ranges
-            .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &(l, h)| {
-                (a.min(l), b.max(h))
-            })
+                scan_block(block, r);
+            }
+        });
+    combine(ranges, bits, positive_only)
+}
+
+/// [`visible_range`] of caller-given keys (all finite keys count).
+fn given_keys_range(ranges: &mut Vec<[f32; 4]>, keys: &[f32], t: usize, bits: u32) -> QuantRange {
+    let len = keys.len().div_ceil(t).max(1);
+    ranges.clear();
+    ranges.resize(keys.len().div_ceil(len).max(1), EMPTY_RANGE);
+    ranges
+        .par_iter_mut()
+        .zip(keys.par_chunks(len))
+        .for_each(|(r, ks)| scan_block(ks, r));
+    combine(ranges, bits, false)
+}
+
+/// No keys seen yet.
+const EMPTY_RANGE: [f32; 4] = [
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+];
+
+/// The quantization range from per-chunk [`scan_block`] results.
+fn combine(ranges: &[[f32; 4]], bits: u32, positive_only: bool) -> QuantRange {
+    let empty = EMPTY_RANGE;
+    let [lo_pos, hi_pos, lo, hi] = ranges.iter().fold(empty, |a, r| {
+        [
+            a[0].min(r[0]),
+            a[1].max(r[1]),
+            a[2].min(r[2]),
+            a[3].max(r[3]),
+        ]
+    });
+    let range = if positive_only && lo_pos <= hi_pos {
+        (lo_pos, hi_pos)
+    } else if lo <= hi {
+        (lo, hi)
+    } else {
+        (0.0, 0.0)
     };
-    let mut range = scan(
-        ranges,
-        if positive_only {
-            0.0
-        } else {
-            f32::NEG_INFINITY
-        },
-    );
-    if positive_only && range.0 > range.1 {
-        range = scan(ranges, f32::NEG_INFINITY);
-    }
-    if range.0 > range.1 {
-        range = (0.0, 0.0);
-    }
     QuantRange::new(range.0, range.1, bits)
 }
 
