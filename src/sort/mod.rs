@@ -403,6 +403,9 @@ impl Sorter {
     }
 }
 
+/// Fills a block of float keys: `fill(first_index, block)`.
+type BlockFill<'a> = dyn Fn(usize, &mut [f32]) + Sync + 'a;
+
 /// Running (min, max) of the finite keys `> 0` and of all finite keys, of one block.
 fn scan_block(keys: &[f32], acc: &mut [f32; 4]) {
     // Eight independent lanes (so the compiler vectorises and no comparison waits on the
@@ -410,7 +413,7 @@ fn scan_block(keys: &[f32], acc: &mut [f32; 4]) {
     const L: usize = 8;
     let mut lanes = [[acc[0]; L], [acc[1]; L], [acc[2]; L], [acc[3]; L]];
     let mut it = keys.chunks_exact(L);
-    let mut step = |ks: &[f32], lanes: &mut [[f32; L]; 4]| {
+    let step = |ks: &[f32], lanes: &mut [[f32; L]; 4]| {
         for (j, &k) in ks.iter().enumerate() {
             let all = if k.is_finite() { k } else { f32::NAN };
             let pos = if all > 0.0 { all } else { f32::NAN };
@@ -424,12 +427,11 @@ fn scan_block(keys: &[f32], acc: &mut [f32; 4]) {
         step(ks, &mut lanes);
     }
     step(it.remainder(), &mut lanes);
-    for j in 0..L {
-        acc[0] = acc[0].min(lanes[0][j]);
-        acc[1] = acc[1].max(lanes[1][j]);
-        acc[2] = acc[2].min(lanes[2][j]);
-        acc[3] = acc[3].max(lanes[3][j]);
-    }
+    let [lo_pos, hi_pos, lo, hi] = &lanes;
+    acc[0] = lo_pos.iter().fold(acc[0], |a, &v| a.min(v));
+    acc[1] = hi_pos.iter().fold(acc[1], |a, &v| a.max(v));
+    acc[2] = lo.iter().fold(acc[2], |a, &v| a.min(v));
+    acc[3] = hi.iter().fold(acc[3], |a, &v| a.max(v));
 }
 
 /// Optionally fills `keys` (`fill(first, block)`, in L1-sized blocks) and returns the
@@ -441,7 +443,7 @@ fn visible_range(
     t: usize,
     bits: u32,
     positive_only: bool,
-    fill: Option<&(dyn Fn(usize, &mut [f32]) + Sync)>,
+    fill: Option<&BlockFill<'_>>,
 ) -> QuantRange {
     let n = keys.len();
     let len = n.div_ceil(t).max(1);
