@@ -1,4 +1,5 @@
-//! Back-to-front splat ordering on the CPU: camera keys + a parallel LSD radix argsort.
+//! Back-to-front splat ordering on the CPU: camera keys + a parallel radix argsort (one MSD
+//! pass, then cache-resident LSD passes per bucket).
 //!
 //! No GL here: a [`Sorter`] takes plain positions (`&[[f32; 3]]`) and a camera position and
 //! returns the splat indices **back to front** (farthest first) as `&[u32]`, ready to upload.
@@ -21,8 +22,10 @@
 //! - Non-finite keys never panic: **NaN** (e.g. a NaN position) is drawn **first** (treated as
 //!   farther than everything, so it is painted over), then `+inf`, the finite keys, and
 //!   `−inf` last. See [`far_first_key`].
-//! - [`Precision::Quantized`] sorts by a `bits`-bit bucket of the key instead (faster, fewer
-//!   passes); order errors are bounded by one bucket width, see [`Precision`].
+//! - [`Precision::Quantized`] sorts by a `bits`-bit bucket of the key instead; order errors
+//!   are bounded by one bucket width, see [`Precision`]. On the CPU it is *not* faster than
+//!   full precision (measured in `docs/sorting.md`): it exists for callers that must match a
+//!   quantized (e.g. GPU or web) sorter.
 //!
 //! Design, measurements and the proof behind [`Reuse::MotionBound`] are in `docs/sorting.md`.
 
