@@ -155,6 +155,13 @@ fn key_cases() -> Vec<(&'static str, Vec<f32>)> {
             .map(|_| f32::from_bits(0x4000_0000 | rng.below(1 << 11) as u32))
             .collect(),
     ));
+    // A range of ≤ 10 significant bits: the MSD pass alone sorts (writes indices directly).
+    cases.push((
+        "msd only",
+        (0..70_000)
+            .map(|_| f32::from_bits(0x4000_0000 | rng.below(1 << 10) as u32))
+            .collect(),
+    ));
     cases.push((
         "high bits only",
         (0..70_000)
