@@ -348,7 +348,9 @@ unsafe fn sort_bucket(
     };
     // Below about an eighth of the table entries a comparison sort beats clearing and
     // prefix-summing the radix tables.
-    let entries: usize = (0..digits.passes).map(|p| digits.mask[p] as usize + 1).sum();
+    let entries: usize = (0..digits.passes)
+        .map(|p| digits.mask[p] as usize + 1)
+        .sum();
     if m <= TINY.max(entries / 8) {
         // Items are distinct (the index is in the low bits): any sort is the stable one.
         a.sort_unstable();
