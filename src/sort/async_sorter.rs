@@ -108,7 +108,9 @@ impl Shared {
     }
 }
 
-/// Sorts on a background thread; see the [module docs](self).
+/// Sorts on a background thread: [`request`](Self::request) posts the newest camera,
+/// [`latest`](Self::latest) returns the newest finished order. Neither waits for a sort; the
+/// order buffers are triple-buffered and recycled (no allocation after warm-up).
 #[derive(Debug)]
 pub struct AsyncSorter {
     shared: Arc<Shared>,
