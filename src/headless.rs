@@ -461,10 +461,10 @@ impl HeadlessRenderer {
     }
 
     fn ensure_fbo(&mut self, width: u32, height: u32, srgb: bool) -> Result<(), HeadlessError> {
-        if let Some(f) = &self.fbo {
-            if (f.width, f.height, f.srgb) == (width, height, srgb) {
-                return Ok(());
-            }
+        if let Some(f) = &self.fbo
+            && (f.width, f.height, f.srgb) == (width, height, srgb)
+        {
+            return Ok(());
         }
         let gl = self.ctx.gl();
         if let Some(f) = self.fbo.take() {

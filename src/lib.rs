@@ -22,6 +22,7 @@ pub mod load;
 pub mod reference;
 pub mod scene;
 pub mod sh;
+pub mod sort;
 pub mod validate;
 pub mod write;
 

@@ -135,7 +135,7 @@ struct Builder {
 
 impl Builder {
     fn align(&mut self) {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
     }
@@ -150,7 +150,7 @@ impl Builder {
         self.align();
         let esize = dims * comp.size();
         // Vertex attribute elements start on 4-byte boundaries (glTF 2.0): pad small elements.
-        let stride = if self.padding > 0 || esize % 4 != 0 {
+        let stride = if self.padding > 0 || !esize.is_multiple_of(4) {
             (esize + self.padding).div_ceil(4) * 4
         } else {
             0

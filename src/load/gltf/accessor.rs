@@ -155,11 +155,11 @@ pub fn decode(
             // glTF 2.0 §3.6.2.4: offsets are multiples of the component size, and vertex
             // attribute elements start on 4-byte boundaries.
             let offset = view.offset() as u128 + acc.offset() as u128;
-            if offset % csize as u128 != 0 {
+            if !offset.is_multiple_of(csize as u128) {
                 misaligned = Some(format!(
                     "byte offset {offset} is not a multiple of the component size {csize}"
                 ));
-            } else if offset % 4 != 0 || stride % 4 != 0 {
+            } else if !offset.is_multiple_of(4) || stride % 4 != 0 {
                 misaligned = Some(format!(
                     "vertex attribute elements must start on 4-byte boundaries (offset {offset}, stride {stride})"
                 ));

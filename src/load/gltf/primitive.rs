@@ -346,14 +346,14 @@ pub fn read(
             blocked = true;
         }
     }
-    if let Some(c) = &color0 {
-        if c.count() != n || !(c.dims == 3 || c.dims == 4) {
-            f.push(Finding::fatal(
-                attr_path(path, "COLOR_0"),
-                "COLOR_0 must be VEC3/VEC4 with POSITION's count",
-            ));
-            blocked = true;
-        }
+    if let Some(c) = &color0
+        && (c.count() != n || !(c.dims == 3 || c.dims == 4))
+    {
+        f.push(Finding::fatal(
+            attr_path(path, "COLOR_0"),
+            "COLOR_0 must be VEC3/VEC4 with POSITION's count",
+        ));
+        blocked = true;
     }
     if blocked {
         return None;

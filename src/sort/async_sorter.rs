@@ -1,0 +1,250 @@
+//! A background sorter thread for the viewer: the render loop posts the newest camera and
+//! draws with the newest *finished* order, so a frame never waits on a sort.
+//!
+//! Three order buffers circulate (front: being drawn, ready: newest finished and not yet
+//! taken, back: being sorted); handing one over swaps `Vec`s under a mutex held for a few
+//! pointer moves, and after warm-up nothing is allocated. Requests that arrive while a sort
+//! runs replace each other: only the newest is sorted next.
+
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
+use std::thread::JoinHandle;
+
+use super::{Outcome, SortMode, Sorter};
+
+/// A camera to sort for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SortRequest {
+    /// Key: distance or view depth.
+    pub mode: SortMode,
+    /// Camera centre, world space.
+    pub eye: [f32; 3],
+    /// Unit view direction (used by [`SortMode::ViewDepth`] only).
+    pub forward: [f32; 3],
+}
+
+impl SortRequest {
+    /// A `cameraDistance` request for `eye`.
+    pub fn distance(eye: [f32; 3]) -> Self {
+        SortRequest {
+            mode: SortMode::Distance,
+            eye,
+            forward: [0.0; 3],
+        }
+    }
+
+    /// A request for a [`Camera`](crate::camera::Camera).
+    pub fn for_camera(camera: &crate::camera::Camera, mode: SortMode) -> Self {
+        SortRequest {
+            mode,
+            eye: camera.eye().to_array(),
+            forward: camera.world_to_camera.row(2).truncate().to_array(),
+        }
+    }
+}
+
+/// A finished order.
+#[derive(Debug, Clone)]
+pub struct SortedFrame {
+    order: Vec<u32>,
+    request: Option<SortRequest>,
+    generation: u64,
+    outcome: Outcome,
+}
+
+impl SortedFrame {
+    fn empty() -> Self {
+        SortedFrame {
+            order: Vec::new(),
+            request: None,
+            generation: 0,
+            outcome: Outcome::None,
+        }
+    }
+
+    /// Splat indices back to front.
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// The request this order was sorted for.
+    pub fn request(&self) -> Option<SortRequest> {
+        self.request
+    }
+
+    /// The generation [`AsyncSorter::request`] returned for that request.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Whether the order was sorted or reused (see [`Sorter::last_outcome`]).
+    pub fn outcome(&self) -> Outcome {
+        self.outcome
+    }
+}
+
+#[derive(Debug)]
+struct State {
+    pending: Option<(u64, SortRequest)>,
+    ready: Option<SortedFrame>,
+    spare: Option<SortedFrame>,
+    finished: u64,
+    issued: u64,
+    stop: bool,
+}
+
+#[derive(Debug)]
+struct Shared {
+    state: Mutex<State>,
+    /// Wakes the worker (new request or stop).
+    wake: Condvar,
+    /// Wakes [`AsyncSorter::wait_for`] (a frame finished or the worker stopped).
+    done: Condvar,
+}
+
+impl Shared {
+    fn lock(&self) -> MutexGuard<'_, State> {
+        // The state stays consistent at every unlock, so a poisoned lock is still usable.
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// Sorts on a background thread: [`request`](Self::request) posts the newest camera,
+/// [`latest`](Self::latest) returns the newest finished order. Neither waits for a sort; the
+/// order buffers are triple-buffered and recycled (no allocation after warm-up).
+#[derive(Debug)]
+pub struct AsyncSorter {
+    shared: Arc<Shared>,
+    front: Option<SortedFrame>,
+    worker: Option<JoinHandle<()>>,
+}
+
+/// Marks the worker stopped however it exits (also on panic), so waiters never hang.
+struct StopOnExit(Arc<Shared>);
+impl Drop for StopOnExit {
+    fn drop(&mut self) {
+        self.0.lock().stop = true;
+        self.0.done.notify_all();
+    }
+}
+
+impl AsyncSorter {
+    /// Starts a sorter thread over `positions` with `sorter`'s precision and reuse policy.
+    ///
+    /// # Errors
+    /// When the OS cannot start a thread.
+    pub fn new(positions: Arc<[[f32; 3]]>, mut sorter: Sorter) -> std::io::Result<Self> {
+        let shared = Arc::new(Shared {
+            state: Mutex::new(State {
+                pending: None,
+                ready: None,
+                spare: None,
+                finished: 0,
+                issued: 0,
+                stop: false,
+            }),
+            wake: Condvar::new(),
+            done: Condvar::new(),
+        });
+        let sh = Arc::clone(&shared);
+        let worker = std::thread::Builder::new()
+            .name("splatgl-sort".into())
+            .spawn(move || {
+                let _stop = StopOnExit(Arc::clone(&sh));
+                let mut back = SortedFrame::empty();
+                loop {
+                    let (generation, req) = {
+                        let mut st = sh.lock();
+                        loop {
+                            if st.stop {
+                                return;
+                            }
+                            if let Some(p) = st.pending.take() {
+                                break p;
+                            }
+                            st = sh.wake.wait(st).unwrap_or_else(PoisonError::into_inner);
+                        }
+                    };
+                    let order = match req.mode {
+                        SortMode::Distance => sorter.sort_by_distance(&positions, req.eye),
+                        SortMode::ViewDepth => {
+                            sorter.sort_by_view_depth(&positions, req.eye, req.forward)
+                        }
+                    };
+                    back.order.clear();
+                    back.order.extend_from_slice(order);
+                    back.request = Some(req);
+                    back.generation = generation;
+                    back.outcome = sorter.last_outcome();
+                    let mut st = sh.lock();
+                    let unread = st.ready.replace(back);
+                    back = unread
+                        .or_else(|| st.spare.take())
+                        .unwrap_or_else(SortedFrame::empty);
+                    st.finished = generation;
+                    drop(st);
+                    sh.done.notify_all();
+                }
+            })?;
+        Ok(AsyncSorter {
+            shared,
+            front: None,
+            worker: Some(worker),
+        })
+    }
+
+    /// Posts the newest camera (replacing any request not yet started) and returns its
+    /// generation number (1, 2, …). Never waits for a sort.
+    pub fn request(&self, request: SortRequest) -> u64 {
+        let mut st = self.shared.lock();
+        st.issued += 1;
+        let generation = st.issued;
+        st.pending = Some((generation, request));
+        drop(st);
+        self.shared.wake.notify_one();
+        generation
+    }
+
+    /// The newest finished order (switching to it if one finished since the last call), or
+    /// `None` before the first sort finished. Never waits for a sort.
+    pub fn latest(&mut self) -> Option<&SortedFrame> {
+        let mut st = self.shared.lock();
+        if let Some(new) = st.ready.take()
+            && let Some(old) = self.front.replace(new)
+        {
+            st.spare = Some(old);
+        }
+        drop(st);
+        self.front.as_ref()
+    }
+
+    /// Blocks until the order of request `generation` (or a newer one) finished, then returns
+    /// the newest order, for renders that must be deterministic. `None` if the worker stopped
+    /// first (it panicked) or `generation` was never issued.
+    pub fn wait_for(&mut self, generation: u64) -> Option<&SortedFrame> {
+        let mut st = self.shared.lock();
+        if generation > st.issued {
+            return None;
+        }
+        while st.finished < generation && !st.stop {
+            st = self
+                .shared
+                .done
+                .wait(st)
+                .unwrap_or_else(PoisonError::into_inner);
+        }
+        let reached = st.finished >= generation;
+        drop(st);
+        if reached { self.latest() } else { None }
+    }
+}
+
+impl Drop for AsyncSorter {
+    fn drop(&mut self) {
+        self.shared.lock().stop = true;
+        self.shared.wake.notify_all();
+        if let Some(w) = self.worker.take() {
+            // A panic in the worker was already reported on its thread.
+            let _ = w.join();
+        }
+    }
+}

@@ -1,0 +1,65 @@
+//! The safe radius of [`Reuse::MotionBound`](super::Reuse::MotionBound): how far the eye may
+//! move before a full-precision `cameraDistance` order could change.
+//!
+//! Claim: let the last order be sorted for eye `e` with computed keys `k_c = fl(|p − e|²)`.
+//! If the eye moves by `δ` with `|δ| < R` (below), a fresh sort for `e + δ` returns the same
+//! order. Proof sketch (details in `docs/sorting.md`):
+//! - `|p_i − e − δ|² − |p_j − e − δ|² = (|p_i − e|² − |p_j − e|²) − 2 (p_i − p_j)·δ`, so the
+//!   exact key difference of two splats changes by at most `2 |p_i − p_j| |δ|`.
+//! - The `f32` key `dx·dx + dy·dy + dz·dz` of exact value `s` has error `≤ 5u·s`
+//!   (`u = 2⁻²⁴`, five roundings of non-negative terms). With `|δ| ≤ 0.4 √K` (`K` the largest
+//!   key) every old and new exact key is `≤ 1.96 K (1 + 6u)`, so the four keys of a pair
+//!   carry at most `≈ 29.7 u K < 2⁻¹⁸ K = M` of rounding in total.
+//! - For every *adjacent* pair `(i, j)` of the last order with `p_i ≠ p_j`: if
+//!   `gap = k_c(i) − k_c(j) > M + 2 |p_i − p_j| |δ|`, the new computed keys stay strictly
+//!   ordered. Pairs with `p_i = p_j` always get equal keys and keep index order.
+//! - So the old sequence is sorted under the new (total) order `(key desc, index asc)`,
+//!   which has exactly one sorted sequence: the new order equals the old one.
+//!
+//! `R = min(0.4 √K, min over adjacent pairs with p_i ≠ p_j of (gap − M) / (2 |p_i − p_j|))`,
+//! and 0 if any gap is `≤ M` or any key is not finite.
+
+use super::keys::squared_distance;
+
+/// Distance between two eyes, in `f64`.
+pub(crate) fn moved(a: [f32; 3], b: [f32; 3]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let d = f64::from(b[k]) - f64::from(a[k]);
+            d * d
+        })
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The safe radius of `order` (back to front for `eye`, full precision) — see the module docs.
+pub(crate) fn safe_radius(positions: &[[f32; 3]], order: &[u32], eye: [f32; 3]) -> f64 {
+    let key = |i: u32| f64::from(squared_distance(positions[i as usize], eye));
+    let Some(&first) = order.first() else {
+        return f64::INFINITY;
+    };
+    if order.len() < 2 {
+        return f64::INFINITY;
+    }
+    let k_max = key(first);
+    if !k_max.is_finite() {
+        return 0.0;
+    }
+    let margin = k_max * (-18f64).exp2();
+    let mut radius = 0.4 * k_max.sqrt();
+    for w in order.windows(2) {
+        let (pi, pj) = (positions[w[0] as usize], positions[w[1] as usize]);
+        if pi == pj {
+            continue;
+        }
+        let gap = key(w[0]) - key(w[1]);
+        // NaN gaps (a NaN or inf key further down) fail this test too.
+        if gap.is_nan() || gap <= margin {
+            return 0.0;
+        }
+        let dist = moved(pi, pj);
+        radius = radius.min((gap - margin) / (2.0 * dist));
+    }
+    // Slack for the f64 arithmetic above.
+    radius * (1.0 - 1e-9)
+}

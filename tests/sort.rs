@@ -1,0 +1,571 @@
+//! Property tests of `splatgl::sort`: every order equals a stable std sort of the same keys
+//! (key descending, NaN first, ties by ascending index), quantized orders stay within the
+//! documented error bound, reuse is sound, the async sorter delivers the newest order, and a
+//! warm sorter allocates nothing.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::cmp::Ordering;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering as AtOrd};
+
+use splatgl::sort::{
+    AsyncSorter, Outcome, Precision, Reuse, SortMode, SortRequest, Sorter, quantized_bucket_width,
+    squared_distance, view_depth,
+};
+
+// ---------------------------------------------------------------- allocation counting
+
+/// Counts allocations made on threads marked `TRACK` while `ARMED`.
+struct Counting;
+static ARMED: AtomicBool = AtomicBool::new(false);
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    static TRACK: Cell<bool> = const { Cell::new(false) };
+}
+fn note_alloc() {
+    if ARMED.load(AtOrd::Relaxed) && TRACK.try_with(Cell::get).unwrap_or(false) {
+        ALLOCS.fetch_add(1, AtOrd::Relaxed);
+    }
+}
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        note_alloc();
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
+        note_alloc();
+        unsafe { System.alloc_zeroed(l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        note_alloc();
+        unsafe { System.realloc(p, l, n) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) }
+    }
+}
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+// ---------------------------------------------------------------- helpers
+
+/// SplitMix64: small, seeded, good enough for test data.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    fn f(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f()
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+/// The documented draw order: NaN first, then larger keys first (−0 = +0).
+fn far_first(a: f32, b: f32) -> Ordering {
+    match (a.is_nan(), b.is_nan()) {
+        (true, true) => Ordering::Equal,
+        (true, false) => Ordering::Less,
+        (false, true) => Ordering::Greater,
+        _ => b.partial_cmp(&a).expect("not NaN"),
+    }
+}
+
+/// Stable std sort of the indices by `far_first` keys.
+fn reference(keys: &[f32]) -> Vec<u32> {
+    let mut idx: Vec<u32> = (0..keys.len() as u32).collect();
+    idx.sort_by(|&i, &j| far_first(keys[i as usize], keys[j as usize]));
+    idx
+}
+
+fn random_positions(rng: &mut Rng, n: usize, half: f32) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|_| {
+            [
+                rng.range(-half, half),
+                rng.range(-half, half),
+                rng.range(-half, half),
+            ]
+        })
+        .collect()
+}
+
+/// Adversarial and random key sets, named.
+fn key_cases() -> Vec<(&'static str, Vec<f32>)> {
+    let mut rng = Rng(7);
+    let mut cases = vec![
+        ("empty", vec![]),
+        ("one", vec![3.5]),
+        ("two ascending", vec![1.0, 2.0]),
+        ("two equal", vec![2.0, 2.0]),
+        ("all equal", vec![0.25; 100_000]),
+        ("ascending", (0..100_000).map(|i| i as f32).collect()),
+        (
+            "descending",
+            (0..100_000).rev().map(|i| i as f32 * 0.5).collect(),
+        ),
+        (
+            "specials",
+            vec![
+                f32::NAN,
+                1.0,
+                f32::INFINITY,
+                -0.0,
+                0.0,
+                f32::NEG_INFINITY,
+                -f32::NAN,
+                f32::MIN_POSITIVE,
+                -f32::MIN_POSITIVE,
+                f32::MAX,
+                f32::MIN,
+                f32::from_bits(1),
+                -f32::from_bits(1),
+                0.0,
+                f32::NAN,
+                1.0,
+            ],
+        ),
+    ];
+    // Random, with duplicates, negatives and sprinkled specials.
+    let specials = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -0.0, 0.0];
+    let n = (1 << 20) + 1;
+    let big: Vec<f32> = (0..n)
+        .map(|_| match rng.below(1000) {
+            0 => specials[rng.below(5) as usize],
+            1..=200 => (rng.below(64) as f32) * 0.125,
+            _ => rng.range(-100.0, 1000.0),
+        })
+        .collect();
+    cases.push(("2^20+1 mixed", big));
+    // Keys differing in one radix digit only (exercises skipped passes).
+    cases.push((
+        "low digit only",
+        (0..70_000)
+            .map(|_| f32::from_bits(0x4000_0000 | rng.below(1 << 11) as u32))
+            .collect(),
+    ));
+    // A range of ≤ 10 significant bits: the MSD pass alone sorts (writes indices directly).
+    cases.push((
+        "msd only",
+        (0..70_000)
+            .map(|_| f32::from_bits(0x4000_0000 | rng.below(1 << 10) as u32))
+            .collect(),
+    ));
+    cases.push((
+        "high bits only",
+        (0..70_000)
+            .map(|_| f32::from_bits(0x4000_0000 | ((rng.below(1 << 8) as u32) << 22)))
+            .collect(),
+    ));
+    // A dense cluster (most keys in one MSD bucket, sorted by the parallel big-bucket path)
+    // plus far outliers; once with all low digits live, once with a constant top low digit.
+    let mut cluster: Vec<f32> = (0..300_000)
+        .map(|_| f32::from_bits(0x3F80_0000 | rng.below(1 << 20) as u32))
+        .collect();
+    cluster.extend([1.0e6, -3.0, 5.0e5, f32::INFINITY]);
+    cases.push(("dense cluster", cluster));
+    let mut cluster: Vec<f32> = (0..300_000)
+        .map(|_| f32::from_bits(0x3F80_0000 | rng.below(1 << 11) as u32))
+        .collect();
+    cluster.extend([1.0e6, 0.0, 7.0]);
+    cases.push(("dense cluster, constant digit", cluster));
+    cases.push((
+        "tiny random",
+        (0..1000).map(|_| rng.below(10) as f32).collect(),
+    ));
+    cases
+}
+
+// ---------------------------------------------------------------- exact order
+
+#[test]
+fn full_precision_equals_stable_std_sort() {
+    for max_digit in [11, 8] {
+        let mut sorter = Sorter::new();
+        sorter.set_max_digit_bits(max_digit);
+        for (name, keys) in key_cases() {
+            let got = sorter.sort_keys(&keys).to_vec();
+            assert_eq!(got, reference(&keys), "case {name}, max digit {max_digit}");
+        }
+    }
+}
+
+#[test]
+fn result_does_not_depend_on_thread_count() {
+    let mut rng = Rng(11);
+    let positions = random_positions(&mut rng, 300_001, 50.0);
+    let eye = [3.0, -120.0, 7.5];
+    let mut orders = Vec::new();
+    for threads in [1, 2, 3, 5] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        let order = pool.install(|| Sorter::new().sort_by_distance(&positions, eye).to_vec());
+        orders.push(order);
+    }
+    let keys: Vec<f32> = positions
+        .iter()
+        .map(|&p| squared_distance(p, eye))
+        .collect();
+    let want = reference(&keys);
+    for o in &orders {
+        assert_eq!(o, &want);
+    }
+    // Every key case, on pools of 1, 2 and 3 threads (different chunkings and groupings).
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        let mut sorter = Sorter::new();
+        for (name, keys) in key_cases() {
+            let got = pool.install(|| sorter.sort_keys(&keys).to_vec());
+            assert_eq!(got, reference(&keys), "case {name}, {threads} threads");
+        }
+    }
+}
+
+#[test]
+fn distance_and_depth_sorts_equal_reference() {
+    let mut rng = Rng(3);
+    let mut positions = random_positions(&mut rng, 200_000, 10.0);
+    // Duplicated positions (bit-equal keys) and a few NaN / inf positions.
+    for i in 0..2000 {
+        positions[100_000 + i] = positions[i];
+    }
+    positions[5] = [f32::NAN, 0.0, 0.0];
+    positions[77] = [f32::INFINITY, 0.0, 0.0];
+    positions[78] = [0.0, f32::NEG_INFINITY, 1.0];
+    let mut sorter = Sorter::new();
+    for eye in [[0.0, 0.0, 0.0], [30.0, -2.0, 5.0], [1.0e-3, 4.0, -9.5]] {
+        let keys: Vec<f32> = positions
+            .iter()
+            .map(|&p| squared_distance(p, eye))
+            .collect();
+        assert_eq!(
+            sorter.sort_by_distance(&positions, eye),
+            reference(&keys).as_slice()
+        );
+        assert_eq!(sorter.order()[0], 5, "NaN position drawn first");
+        let fwd = {
+            let v = [0.3f32, -0.5, 0.8];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|c| c / l)
+        };
+        let keys: Vec<f32> = positions.iter().map(|&p| view_depth(p, eye, fwd)).collect();
+        assert_eq!(
+            sorter.sort_by_view_depth(&positions, eye, fwd),
+            reference(&keys).as_slice()
+        );
+    }
+    // Back to front really means farthest first.
+    let order = sorter
+        .sort_by_distance(&positions[200..210], [0.0; 3])
+        .to_vec();
+    let d: Vec<f32> = order
+        .iter()
+        .map(|&i| squared_distance(positions[200 + i as usize], [0.0; 3]))
+        .collect();
+    assert!(d.windows(2).all(|w| w[0] >= w[1]), "{d:?}");
+}
+
+#[test]
+fn camera_sort_matches_view_depth_order() {
+    use glam::Vec3;
+    use splatgl::camera::Camera;
+    let mut rng = Rng(5);
+    let positions = random_positions(&mut rng, 5000, 4.0);
+    let cam = Camera::look_at(
+        Vec3::new(2.0, 1.0, -9.0),
+        Vec3::ZERO,
+        Vec3::new(0.0, -1.0, 0.0),
+        0.8,
+        64,
+        48,
+    );
+    let mut sorter = Sorter::new();
+    let order = sorter
+        .sort_for_camera(&positions, &cam, SortMode::ViewDepth)
+        .to_vec();
+    // Camera-space z along the order never increases by more than rounding.
+    let z: Vec<f32> = order
+        .iter()
+        .map(|&i| cam.to_camera(Vec3::from_array(positions[i as usize])).z)
+        .collect();
+    assert!(
+        z.windows(2).all(|w| w[0] >= w[1] - 1e-4),
+        "not back to front"
+    );
+    let order_d = sorter
+        .sort_for_camera(&positions, &cam, SortMode::Distance)
+        .to_vec();
+    let eye = cam.eye().to_array();
+    let keys: Vec<f32> = positions
+        .iter()
+        .map(|&p| squared_distance(p, eye))
+        .collect();
+    assert_eq!(order_d, reference(&keys));
+}
+
+// ---------------------------------------------------------------- quantized
+
+/// Largest key difference of a misordered pair (an earlier splat nearer than a later one).
+fn worst_inversion(keys: &[f32], order: &[u32]) -> f64 {
+    let mut min_before = f64::INFINITY;
+    let mut worst = 0.0f64;
+    for &i in order {
+        let k = f64::from(keys[i as usize]);
+        worst = worst.max(k - min_before);
+        min_before = min_before.min(k);
+    }
+    worst
+}
+
+fn is_permutation(order: &[u32], n: usize) -> bool {
+    let mut seen = vec![false; n];
+    order.len() == n
+        && order
+            .iter()
+            .all(|&i| (i as usize) < n && !std::mem::replace(&mut seen[i as usize], true))
+}
+
+#[test]
+fn quantized_error_is_below_one_bucket() {
+    let mut rng = Rng(9);
+    let keys: Vec<f32> = (0..300_000)
+        .map(|i| {
+            if i % 3 == 0 {
+                rng.range(1.0, 2.0) // dense cluster
+            } else {
+                rng.range(0.5, 80.0)
+            }
+        })
+        .collect();
+    let (lo, hi) = keys
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &k| {
+            (a.min(k), b.max(k))
+        });
+    for bits in [16, 20, 24] {
+        let mut sorter = Sorter::new().with_precision(Precision::Quantized { bits });
+        let order = sorter.sort_keys(&keys).to_vec();
+        assert!(is_permutation(&order, keys.len()));
+        let w = quantized_bucket_width(lo, hi, bits);
+        let worst = worst_inversion(&keys, &order);
+        assert!(
+            worst < w * (1.0 + 1e-6),
+            "{bits} bits: {worst} vs bucket {w}"
+        );
+        // The bound is not vacuous: some pairs do share buckets at 16 bits.
+        if bits == 16 {
+            assert!(worst > 0.0);
+        }
+    }
+    // Keys further apart than a bucket come out exactly ordered.
+    let spread: Vec<f32> = (0..1000).map(|_| rng.below(1000) as f32).collect();
+    let mut sorter = Sorter::new().with_precision(Precision::Quantized { bits: 16 });
+    assert_eq!(sorter.sort_keys(&spread), reference(&spread).as_slice());
+}
+
+#[test]
+fn quantized_handles_specials_and_camera_modes() {
+    let keys = [f32::NAN, 1.0, f32::INFINITY, f32::NEG_INFINITY, 3.0, 2.0];
+    let mut sorter = Sorter::new().with_precision(Precision::Quantized { bits: 16 });
+    let order = sorter.sort_keys(&keys).to_vec();
+    // NaN and +inf share the farthest bucket (index order), −inf the nearest.
+    assert_eq!(order, [0, 2, 4, 5, 1, 3]);
+    for n in [0usize, 1, 2] {
+        assert_eq!(sorter.sort_keys(&vec![1.0; n]).len(), n);
+    }
+    let mut rng = Rng(13);
+    let positions = random_positions(&mut rng, 100_000, 10.0);
+    let eye = [0.5, 0.0, -20.0];
+    for bits in [16, 24] {
+        let mut s = Sorter::new().with_precision(Precision::Quantized { bits });
+        let order = s.sort_by_distance(&positions, eye).to_vec();
+        let dist: Vec<f32> = positions
+            .iter()
+            .map(|&p| squared_distance(p, eye).sqrt())
+            .collect();
+        let (lo, hi) = dist
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &k| {
+                (a.min(k), b.max(k))
+            });
+        let w = quantized_bucket_width(lo, hi, bits);
+        assert!(worst_inversion(&dist, &order) < w * (1.0 + 1e-6));
+        // View depth: the range is that of the splats in front; those behind the camera
+        // clamp into the nearest bucket, so they come after every splat beyond it.
+        let fwd = [0.0, 0.0, 1.0];
+        let order = s.sort_by_view_depth(&positions, [0.0; 3], fwd).to_vec();
+        let (lo, hi) = positions
+            .iter()
+            .map(|p| p[2])
+            .filter(|&z| z > 0.0)
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), k| {
+                (a.min(k), b.max(k))
+            });
+        let w = quantized_bucket_width(lo, hi, bits);
+        let first_behind = order
+            .iter()
+            .position(|&i| positions[i as usize][2] <= 0.0)
+            .expect("some behind");
+        assert!(
+            order[first_behind..]
+                .iter()
+                .all(|&i| f64::from(positions[i as usize][2]) < f64::from(lo) + w * (1.0 + 1e-6))
+        );
+    }
+}
+
+// ---------------------------------------------------------------- reuse
+
+#[test]
+fn same_view_reuse_and_invalidate() {
+    let mut rng = Rng(17);
+    let positions = random_positions(&mut rng, 1000, 5.0);
+    let mut s = Sorter::new().with_reuse(Reuse::SameView);
+    let a = s.sort_by_distance(&positions, [1.0, 2.0, 3.0]).to_vec();
+    assert_eq!(s.last_outcome(), Outcome::Sorted);
+    let b = s.sort_by_distance(&positions, [1.0, 2.0, 3.0]).to_vec();
+    assert_eq!(s.last_outcome(), Outcome::ReusedSameView);
+    assert_eq!(a, b);
+    s.sort_by_distance(&positions, [1.0, 2.0, 3.0001]);
+    assert_eq!(s.last_outcome(), Outcome::Sorted);
+    s.invalidate();
+    s.sort_by_distance(&positions, [1.0, 2.0, 3.0001]);
+    assert_eq!(s.last_outcome(), Outcome::Sorted);
+    // A different slice (same contents, other address) is not reused.
+    let copy = positions.clone();
+    s.sort_by_distance(&copy, [1.0, 2.0, 3.0001]);
+    assert_eq!(s.last_outcome(), Outcome::Sorted);
+    // Never: always sorts.
+    let mut never = Sorter::new();
+    never.sort_by_distance(&positions, [0.0; 3]);
+    never.sort_by_distance(&positions, [0.0; 3]);
+    assert_eq!(never.last_outcome(), Outcome::Sorted);
+}
+
+#[test]
+fn motion_bound_reuse_is_sound() {
+    let mut rng = Rng(19);
+    let mut checked = 0;
+    for trial in 0..40 {
+        let positions = random_positions(&mut rng, 50 + trial * 10, 3.0);
+        let eye = [rng.range(-20.0, 20.0), rng.range(-20.0, 20.0), 15.0];
+        let mut s = Sorter::new().with_reuse(Reuse::MotionBound);
+        let base = s.sort_by_distance(&positions, eye).to_vec();
+        let r = s.reuse_radius();
+        assert!(r.is_finite() && r >= 0.0);
+        if r == 0.0 {
+            continue;
+        }
+        for _ in 0..20 {
+            // A random direction, moved 0.999 R (the eye bits must differ).
+            let d = [
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            ];
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-6);
+            let step = (0.999 * r) as f32 / l;
+            let moved = [
+                eye[0] + d[0] * step,
+                eye[1] + d[1] * step,
+                eye[2] + d[2] * step,
+            ];
+            let reused = s.sort_by_distance(&positions, moved).to_vec();
+            match s.last_outcome() {
+                Outcome::ReusedWithinBound { moved: m, radius } => assert!(m < radius),
+                Outcome::ReusedSameView | Outcome::Sorted => {}
+                o => panic!("unexpected {o:?}"),
+            }
+            assert_eq!(reused, base);
+            let fresh = Sorter::new().sort_by_distance(&positions, moved).to_vec();
+            assert_eq!(
+                fresh, base,
+                "moving within the safe radius changed the order"
+            );
+            checked += 1;
+        }
+        // Far away: sorts again.
+        s.sort_by_distance(&positions, [eye[0] + 100.0, eye[1], eye[2]]);
+        assert_eq!(s.last_outcome(), Outcome::Sorted);
+    }
+    assert!(checked > 100, "only {checked} motions checked");
+}
+
+// ---------------------------------------------------------------- async
+
+#[test]
+fn async_sorter_delivers_newest_order() {
+    let mut rng = Rng(23);
+    let positions: Arc<[[f32; 3]]> = random_positions(&mut rng, 100_000, 10.0).into();
+    let mut asorter = AsyncSorter::new(Arc::clone(&positions), Sorter::new()).expect("thread");
+    assert!(asorter.latest().is_none());
+    let eyes: Vec<[f32; 3]> = (0..10).map(|i| [i as f32, 20.0 - i as f32, 5.0]).collect();
+    let mut last_gen = 0;
+    for &eye in &eyes {
+        last_gen = asorter.request(SortRequest::distance(eye));
+    }
+    assert_eq!(last_gen, 10);
+    let frame = asorter.wait_for(last_gen).expect("finished");
+    assert_eq!(frame.generation(), last_gen);
+    let want = Sorter::new().sort_by_distance(&positions, eyes[9]).to_vec();
+    assert_eq!(frame.order(), want.as_slice());
+    assert_eq!(frame.request(), Some(SortRequest::distance(eyes[9])));
+    // Round trips keep working with recycled buffers.
+    for &eye in &eyes[..4] {
+        let g = asorter.request(SortRequest::distance(eye));
+        let f = asorter.wait_for(g).expect("finished");
+        assert_eq!(f.order(), Sorter::new().sort_by_distance(&positions, eye));
+    }
+    assert!(asorter.wait_for(1000).is_none(), "never issued");
+}
+
+// ---------------------------------------------------------------- allocations
+
+#[test]
+fn warm_sorter_allocates_nothing() {
+    let mut rng = Rng(29);
+    let positions = random_positions(&mut rng, 200_000, 10.0);
+    let keys: Vec<f32> = positions.iter().map(|p| p[0]).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .start_handler(|_| TRACK.with(|t| t.set(true)))
+        .build()
+        .expect("pool");
+    let count = pool.install(|| {
+        TRACK.with(|t| t.set(true));
+        let mut full = Sorter::new();
+        let mut quant = Sorter::new().with_precision(Precision::Quantized { bits: 16 });
+        // Warm up at the largest size.
+        full.sort_by_distance(&positions, [0.0; 3]);
+        full.sort_keys(&keys);
+        quant.sort_by_distance(&positions, [0.0; 3]);
+        ALLOCS.store(0, AtOrd::SeqCst);
+        ARMED.store(true, AtOrd::SeqCst);
+        for i in 0..5 {
+            let eye = [i as f32, 1.0, -3.0];
+            full.sort_by_distance(&positions, eye);
+            full.sort_by_view_depth(&positions[..1000], eye, [0.0, 0.0, 1.0]);
+            full.sort_keys(&keys);
+            quant.sort_by_distance(&positions, eye);
+        }
+        ARMED.store(false, AtOrd::SeqCst);
+        ALLOCS.load(AtOrd::SeqCst)
+    });
+    assert_eq!(count, 0, "allocations in warm sorts");
+}
