@@ -1,45 +1,23 @@
-//! Back-to-front ordering by camera distance (`sortingMethod: cameraDistance`, RC): the one
-//! place the draw order is made, so a faster sorter (the rayon radix sorter) replaces this
-//! function's body without touching the renderer.
+//! Back-to-front ordering by camera distance (`sortingMethod: cameraDistance`, RC) for the
+//! renderer: a thin wrapper over the crate's radix sorter ([`crate::sort::Sorter`]) that writes
+//! into a caller-owned order buffer.
 
 use glam::Vec3;
-use rayon::slice::ParallelSliceMut;
 
-/// Reusable scratch for [`DistanceSorter::sort`] (no allocation per frame once warm).
-#[derive(Debug, Default, Clone)]
+/// A reusable distance sorter (no allocation per frame once warm).
+#[derive(Debug, Default)]
 pub struct DistanceSorter {
-    keys: Vec<u64>,
-}
-
-/// The sort key of splat `i`: farther first, then lower index first. Squared distances are
-/// non-negative, so their f32 bit patterns order like the values; NaN (a non-finite mean)
-/// sorts as farthest.
-fn key(p: [f32; 3], eye: Vec3, i: u32) -> u64 {
-    let d = Vec3::from_array(p) - eye;
-    let d2 = d.length_squared();
-    let bits = if d2.is_nan() { u32::MAX } else { d2.to_bits() };
-    (u64::from(!bits) << 32) | u64::from(i)
+    sorter: crate::sort::Sorter,
 }
 
 impl DistanceSorter {
     /// Writes into `order` the indices of `positions` sorted back to front: squared Euclidean
-    /// distance to `eye` descending, ties by index ascending (a total order, so the result is
-    /// what a stable sort gives and is deterministic).
+    /// distance to `eye` descending, ties by index ascending (what a stable sort gives; NaN
+    /// first), deterministic and independent of the thread count.
     pub fn sort(&mut self, positions: &[[f32; 3]], eye: Vec3, order: &mut Vec<u32>) {
-        assert!(
-            positions.len() <= u32::MAX as usize,
-            "more than 2^32 splats"
-        );
-        self.keys.clear();
-        self.keys.extend(
-            positions
-                .iter()
-                .enumerate()
-                .map(|(i, p)| key(*p, eye, i as u32)),
-        );
-        self.keys.par_sort_unstable();
+        let sorted = self.sorter.sort_by_distance(positions, eye.to_array());
         order.clear();
-        order.extend(self.keys.iter().map(|k| *k as u32));
+        order.extend_from_slice(sorted);
     }
 }
 
