@@ -97,7 +97,9 @@ struct Layout {
     /// DC source: f_dc (SH) or red/green/blue (colour, with a divisor: 255 for u8).
     dc: [usize; 3],
     dc_is_color: Option<f64>,
-    rest: Vec<usize>,
+    /// `f_rest_j` columns with their destination in the splat's flat SH array:
+    /// channel-major `j = ch·K + coef` → degree-major `(1 + coef)·3 + ch`, resolved once.
+    rest: Vec<(usize, usize)>,
     opacity: usize,
     scale: [usize; 3],
     rot: [usize; 4],
@@ -161,8 +163,14 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
         }
         None => return Err(need("f_dc_0").unwrap_err()),
     };
+    let k_rest = n_rest / 3;
     let rest = (0..n_rest)
-        .map(|i| need(&format!("f_rest_{i}")))
+        .map(|j| {
+            Ok((
+                need(&format!("f_rest_{j}"))?,
+                (1 + j % k_rest) * 3 + j / k_rest,
+            ))
+        })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Layout {
         pos: [need("x")?, need("y")?, need("z")?],
@@ -241,16 +249,23 @@ fn convert_row(
             return Err(bad(l.dc[k], "colour coefficient overflows f32"));
         }
     }
-    let k_rest = l.rest.len() / 3;
-    for (j, &col) in l.rest.iter().enumerate() {
-        let v = get(col);
-        if !v.is_finite() {
-            return Err(bad(col, "SH coefficient is not finite"));
-        }
-        let (ch, coef) = (j / k_rest, j % k_rest);
-        sh[1 + coef][ch] = v as f32;
-        if !sh[1 + coef][ch].is_finite() {
-            return Err(bad(col, "SH coefficient overflows f32"));
+    // Branch-free copy; the (rare) error path finds the culprit afterwards.
+    let flat: &mut [f32] = bytemuck::cast_slice_mut(sh);
+    let mut finite = true;
+    for &(col, dst) in &l.rest {
+        let v = get(col) as f32;
+        flat[dst] = v;
+        finite &= v.is_finite();
+    }
+    if !finite {
+        for &(col, _) in &l.rest {
+            let v = get(col);
+            if !v.is_finite() {
+                return Err(bad(col, "SH coefficient is not finite"));
+            }
+            if !(v as f32).is_finite() {
+                return Err(bad(col, "SH coefficient overflows f32"));
+            }
         }
     }
     let o = get(l.opacity);
