@@ -87,6 +87,7 @@ fn ply_corpus() {
         ),
         (poke_ply(good_ply(), 2, 1, f32::NAN), &["index 2", "'y'", "not finite"]),
         (poke_ply(good_ply(), 1, 15, f32::NAN), &["index 1", "opacity logit is NaN"]),
+        (poke_ply(good_ply(), 1, 8, f32::NAN), &["index 1", "'f_rest_2'", "SH coefficient is not finite"]),
         (
             {
                 let mut b = good_ply();
