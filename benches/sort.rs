@@ -13,29 +13,7 @@ use rayon::prelude::*;
 use rdst::{RadixKey, RadixSort};
 use splatgl::sort::{Precision, Sorter, far_first_key, squared_distance};
 
-/// SplitMix64.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn f(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    /// Standard normal (Box–Muller).
-    fn normal(&mut self) -> f32 {
-        let u = self.f().max(1e-7);
-        let v = self.f();
-        (-2.0 * u.ln()).sqrt() * (std::f32::consts::TAU * v).cos()
-    }
-}
+use splatgl::scene::Rng;
 
 /// A scene and the eye to sort it for.
 struct Scene {
@@ -46,7 +24,7 @@ struct Scene {
 
 /// Uniform in a 20 m cube, seen from outside.
 fn uniform(n: usize) -> Scene {
-    let mut rng = Rng(1);
+    let mut rng = Rng::new(1);
     let positions = (0..n)
         .map(|_| {
             [
@@ -67,7 +45,7 @@ fn uniform(n: usize) -> Scene {
 /// 5 cm – 3 m spreads over a 100 m × 20 m × 100 m area (objects, ground), 10 % on a far
 /// "sky" shell at 150–250 m.
 fn clustered(n: usize) -> Scene {
-    let mut rng = Rng(2);
+    let mut rng = Rng::new(2);
     let k = 300;
     let centres: Vec<([f32; 3], f32, f32)> = (0..k)
         .map(|i| {
@@ -76,7 +54,7 @@ fn clustered(n: usize) -> Scene {
                 rng.range(-2.0, 18.0),
                 rng.range(-50.0, 50.0),
             ];
-            let sigma = 0.05 * 60f32.powf(rng.f());
+            let sigma = 0.05 * 60f32.powf(rng.unit());
             let weight = 1.0 / (i as f32 + 1.0); // Zipf cluster sizes
             (c, sigma, weight)
         })

@@ -33,6 +33,16 @@ impl Rng {
     pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.unit()
     }
+    /// Uniform integer in `[0, n)` (n > 0; modulo bias is irrelevant for test data).
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n
+    }
+    /// Standard normal (Box–Muller).
+    pub fn normal(&mut self) -> f32 {
+        let u = self.unit().max(1e-7);
+        let v = self.unit();
+        (-2.0 * u.ln()).sqrt() * (TAU * v).cos()
+    }
     /// A uniformly distributed unit quaternion `[x, y, z, w]`.
     pub fn quat(&mut self) -> [f32; 4] {
         let (u1, u2, u3) = (self.unit(), self.unit() * TAU, self.unit() * TAU);

@@ -50,27 +50,7 @@ static GLOBAL: Counting = Counting;
 
 // ---------------------------------------------------------------- helpers
 
-/// SplitMix64: small, seeded, good enough for test data.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn f(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f()
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
+use splatgl::scene::Rng;
 
 /// The documented draw order: NaN first, then larger keys first (−0 = +0).
 fn far_first(a: f32, b: f32) -> Ordering {
@@ -103,7 +83,7 @@ fn random_positions(rng: &mut Rng, n: usize, half: f32) -> Vec<[f32; 3]> {
 
 /// Adversarial and random key sets, named.
 fn key_cases() -> Vec<(&'static str, Vec<f32>)> {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let mut cases = vec![
         ("empty", vec![]),
         ("one", vec![3.5]),
@@ -203,7 +183,7 @@ fn full_precision_equals_stable_std_sort() {
 
 #[test]
 fn result_does_not_depend_on_thread_count() {
-    let mut rng = Rng(11);
+    let mut rng = Rng::new(11);
     let positions = random_positions(&mut rng, 300_001, 50.0);
     let eye = [3.0, -120.0, 7.5];
     let mut orders = Vec::new();
@@ -239,7 +219,7 @@ fn result_does_not_depend_on_thread_count() {
 
 #[test]
 fn distance_and_depth_sorts_equal_reference() {
-    let mut rng = Rng(3);
+    let mut rng = Rng::new(3);
     let mut positions = random_positions(&mut rng, 200_000, 10.0);
     // Duplicated positions (bit-equal keys) and a few NaN / inf positions.
     for i in 0..2000 {
@@ -285,7 +265,7 @@ fn distance_and_depth_sorts_equal_reference() {
 fn camera_sort_matches_view_depth_order() {
     use glam::Vec3;
     use splatgl::camera::Camera;
-    let mut rng = Rng(5);
+    let mut rng = Rng::new(5);
     let positions = random_positions(&mut rng, 5000, 4.0);
     let cam = Camera::look_at(
         Vec3::new(2.0, 1.0, -9.0),
@@ -343,7 +323,7 @@ fn is_permutation(order: &[u32], n: usize) -> bool {
 
 #[test]
 fn quantized_error_is_below_one_bucket() {
-    let mut rng = Rng(9);
+    let mut rng = Rng::new(9);
     let keys: Vec<f32> = (0..300_000)
         .map(|i| {
             if i % 3 == 0 {
@@ -389,7 +369,7 @@ fn quantized_handles_specials_and_camera_modes() {
     for n in [0usize, 1, 2] {
         assert_eq!(sorter.sort_keys(&vec![1.0; n]).len(), n);
     }
-    let mut rng = Rng(13);
+    let mut rng = Rng::new(13);
     let positions = random_positions(&mut rng, 100_000, 10.0);
     let eye = [0.5, 0.0, -20.0];
     for bits in [16, 24] {
@@ -434,7 +414,7 @@ fn quantized_handles_specials_and_camera_modes() {
 
 #[test]
 fn same_view_reuse_and_invalidate() {
-    let mut rng = Rng(17);
+    let mut rng = Rng::new(17);
     let positions = random_positions(&mut rng, 1000, 5.0);
     let mut s = Sorter::new().with_reuse(Reuse::SameView);
     let a = s.sort_by_distance(&positions, [1.0, 2.0, 3.0]).to_vec();
@@ -460,7 +440,7 @@ fn same_view_reuse_and_invalidate() {
 
 #[test]
 fn motion_bound_reuse_is_sound() {
-    let mut rng = Rng(19);
+    let mut rng = Rng::new(19);
     let mut checked = 0;
     for trial in 0..40 {
         let positions = random_positions(&mut rng, 50 + trial * 10, 3.0);
@@ -511,7 +491,7 @@ fn motion_bound_reuse_is_sound() {
 
 #[test]
 fn async_sorter_delivers_newest_order() {
-    let mut rng = Rng(23);
+    let mut rng = Rng::new(23);
     let positions: Arc<[[f32; 3]]> = random_positions(&mut rng, 100_000, 10.0).into();
     let mut asorter = AsyncSorter::new(Arc::clone(&positions), Sorter::new()).expect("thread");
     assert!(asorter.latest().is_none());
@@ -539,7 +519,7 @@ fn async_sorter_delivers_newest_order() {
 
 #[test]
 fn warm_sorter_allocates_nothing() {
-    let mut rng = Rng(29);
+    let mut rng = Rng::new(29);
     let positions = random_positions(&mut rng, 200_000, 10.0);
     let keys: Vec<f32> = positions.iter().map(|p| p[0]).collect();
     let pool = rayon::ThreadPoolBuilder::new()

@@ -12,16 +12,13 @@ pub struct Args {
     /// memory_bytes, warnings).
     #[arg(long)]
     pub json: bool,
-    /// How glTF SCALE values are read: auto, linear or log.
-    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
-    pub scale_space: splatgl::load::ScaleSpace,
+    #[command(flatten)]
+    pub load: super::LoadArgs,
 }
 
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
 pub fn run(a: Args) -> ExitCode {
-    let opts = splatgl::load::LoadOptions {
-        scale_space: a.scale_space,
-    };
+    let opts = a.load.options();
     let loaded = match splatgl::load::load_path(&a.file, &opts) {
         Ok(l) => l,
         Err(e) => {

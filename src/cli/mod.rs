@@ -31,6 +31,24 @@ enum Command {
     Compare(compare::Args),
 }
 
+/// Loader options shared by every command that reads a scene.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct LoadArgs {
+    /// How glTF SCALE values are read: auto (signed types or negatives mean the review
+    /// draft's log space), linear (RC) or log.
+    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
+    pub scale_space: splatgl::load::ScaleSpace,
+}
+
+impl LoadArgs {
+    /// The library's options.
+    pub fn options(&self) -> splatgl::load::LoadOptions {
+        splatgl::load::LoadOptions {
+            scale_space: self.scale_space,
+        }
+    }
+}
+
 /// Parses the arguments and runs the subcommand.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();

@@ -97,10 +97,8 @@ pub struct Args {
     /// Keep alpha (1 − T): RGBA PNG; for .pfm also writes NAME.alpha.pfm.
     #[arg(long)]
     pub alpha: bool,
-    /// How glTF SCALE values are read: auto (signed types or negatives mean the review
-    /// draft's log space), linear (RC) or log.
-    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
-    pub scale_space: splatgl::load::ScaleSpace,
+    #[command(flatten)]
+    pub load: super::LoadArgs,
 }
 
 fn floats(s: &str, what: &str, counts: &[usize]) -> Result<Vec<f32>, String> {
@@ -238,7 +236,7 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
     let (cloud, ply) = match &a.scene {
-        Some(p) => load(p, a.scale_space)?,
+        Some(p) => load(p, a.load.options())?,
         None => (splatgl::scene::default_scene(), false),
     };
     let cam = camera(a, &cloud, ply)?;
@@ -358,11 +356,7 @@ fn render_gl(
 }
 
 /// The cloud and whether it came from a PLY (COLMAP axes) rather than glTF (+Y up).
-fn load(
-    p: &Path,
-    scale_space: splatgl::load::ScaleSpace,
-) -> Result<(splatgl::SplatCloud, bool), String> {
-    let opts = splatgl::load::LoadOptions { scale_space };
+fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<(splatgl::SplatCloud, bool), String> {
     let l = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
     for w in l.report.summarized_warnings() {
         eprintln!("warning: {w}");

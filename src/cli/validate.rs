@@ -10,17 +10,13 @@ pub struct Args {
     /// splat_count, findings[{severity, path, message, index}]).
     #[arg(long)]
     pub json: bool,
-    /// How SCALE values are read: auto (signed types or negatives mean the review draft's
-    /// log space), linear (RC) or log.
-    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
-    pub scale_space: splatgl::load::ScaleSpace,
+    #[command(flatten)]
+    pub load: super::LoadArgs,
 }
 
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
 pub fn run(a: Args) -> ExitCode {
-    let opts = splatgl::load::LoadOptions {
-        scale_space: a.scale_space,
-    };
+    let opts = a.load.options();
     let report = splatgl::validate::validate_path(&a.file, &opts);
     if a.json {
         println!("{:#}", report.to_json(&a.file));
