@@ -26,6 +26,7 @@ uniform vec2 u_tan_half_fov;       // tan of half the field of view, x and y
 uniform vec3 u_camera_position;    // eye in world space
 uniform vec4 u_viewport;           // x, y, width, height in window pixels
 uniform float u_cull_depth;        // max(NEAR_CULL, camera near): 3DGS in_frustum
+uniform int u_splat_count;         // splats uploaded: an order index past them is culled
 
 flat out vec3 v_color;
 flat out float v_opacity;
@@ -52,6 +53,11 @@ void cull() {
 }
 
 void main() {
+    // An index past the uploaded splats (a host bug) must not fetch undefined texels.
+    if (a_splat_index >= uint(u_splat_count)) {
+        cull();
+        return;
+    }
     int splat = int(a_splat_index);
     vec4 geom0 = fetch_geometry(splat, 0);
     vec4 a_glob_rotation = fetch_geometry(splat, 1);
@@ -166,6 +172,9 @@ void main() {
     vec2 offset_px = corner.x * half_axes.x * axis1 + corner.y * half_axes.y * axis2;
     clip_space_pos.xy += offset_px * (2.0 / u_viewport.zw) * clip_space_pos.w;
 #endif
+    // No far cull (3DGS has none, nor has the reference): keep the depth inside the clip
+    // volume so splats beyond the projection's far plane are not clipped away.
+    clip_space_pos.z = min(clip_space_pos.z, clip_space_pos.w * (1.0 - 1e-6));
     gl_Position = clip_space_pos;
 
     // --- STEP 5: view-dependent colour from spherical harmonics ---

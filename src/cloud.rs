@@ -384,6 +384,19 @@ impl SplatCloud {
         padded
     }
 
+    /// Whether splat `i` can be drawn at all: finite position, scale, rotation and SH
+    /// coefficients, and an opacity that is not NaN (+inf opacity is capped at α = 0.99 like
+    /// any other). Both renderers skip splats that are not (loaders never produce them; this
+    /// is for clouds built by library callers).
+    pub fn is_drawable(&self, i: usize) -> bool {
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        finite(&self.positions[i])
+            && finite(&self.scales[i])
+            && finite(&self.rotations[i])
+            && !self.opacities[i].is_nan()
+            && self.sh_of(i).iter().all(|c| finite(c))
+    }
+
     /// The 3×3 covariance Σ = R diag(s)² Rᵀ of splat `i`, as the upper triangle
     /// `[xx, xy, xz, yy, yz, zz]`, computed in f64.
     pub fn covariance(&self, i: usize) -> [f64; 6] {

@@ -477,7 +477,13 @@ impl HeadlessRenderer {
         // SAFETY: creates a renderbuffer-backed framebuffer owned by this renderer.
         unsafe {
             let rb = crate::gl::created(gl.create_renderbuffer(), "renderbuffer")?;
-            let fbo = crate::gl::created(gl.create_framebuffer(), "framebuffer")?;
+            let fbo = match crate::gl::created(gl.create_framebuffer(), "framebuffer") {
+                Ok(f) => f,
+                Err(e) => {
+                    gl.delete_renderbuffer(rb);
+                    return Err(e.into());
+                }
+            };
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
             let format = if srgb {
                 glow::SRGB8_ALPHA8

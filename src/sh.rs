@@ -68,7 +68,8 @@ pub fn eval_color(coeffs: &[[f32; 3]], degree: u8, dir: [f32; 3]) -> [f32; 3] {
             c[ch] += y[k] * coef[ch] as f64;
         }
     }
-    c.map(|v| v.max(0.0) as f32)
+    // `v < 0 → 0` rather than `max`, so a NaN channel stays NaN and the splat is skipped.
+    c.map(|v| if v < 0.0 { 0.0 } else { v as f32 })
 }
 
 /// Real Wigner-D matrices for degrees 1..=3 of an orthogonal matrix.

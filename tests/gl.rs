@@ -407,6 +407,18 @@ fn empty_cloud_and_partial_orders() {
             .pixels
             .is_empty()
     );
+    // Indices past the cloud are culled by the shader: the same image as without them.
+    let mut order = Vec::new();
+    splatgl::gl::sort_back_to_front(&cloud.positions[..5], c.eye(), &mut order);
+    let five = r
+        .render_with_order(&c, &RenderOptions::default(), &order)
+        .unwrap();
+    let mut bad = order.clone();
+    bad.extend([10, u32::MAX, 1_000_000, 15, 99]);
+    let with_bad = r
+        .render_with_order(&c, &RenderOptions::default(), &bad)
+        .unwrap();
+    assert_eq!(five, with_bad);
     // An empty order draws nothing.
     let img = r
         .render_with_order(&c, &RenderOptions::default(), &[])
@@ -653,4 +665,39 @@ fn real_files_render_without_gl_errors() {
         rendered += 1;
     }
     assert!(rendered >= 3, "the real files that load must render");
+}
+
+/// No far cull in either backend (3DGS has none): splats beyond the camera's far plane are
+/// drawn by GL exactly like by the reference, not clipped.
+#[test]
+fn splats_beyond_the_far_plane_are_drawn() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = scene::random_cloud(60, 0, 1.0, 4);
+    for p in &mut cloud.positions {
+        p[2] -= 40.0;
+    }
+    for s in &mut cloud.scales {
+        *s = s.map(|v| v * 20.0);
+    }
+    let mut c = cam(
+        Vec3::new(0.0, 0.0, 3.0),
+        Vec3::new(0.0, 0.0, -40.0),
+        50.0,
+        64,
+        48,
+    );
+    c.far = 10.0;
+    check(
+        "beyond far",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+    let img = r.render(&c, &RenderOptions::default()).unwrap();
+    assert!(
+        img.pixels.iter().any(|p| p[3] > 0.1),
+        "splats must be visible"
+    );
 }

@@ -20,11 +20,13 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Print what a splat file holds: format, count, SH degree, colour space, bounds, warnings.
+    /// Exit status: 0, or 2 when the file cannot be loaded.
     Info(info::Args),
     /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
     Validate(validate::Args),
     /// Render an image (without a scene: the bundled default scene).
+    /// Exit status: 0, or 2 on any error (message on stderr).
     Render(render::Args),
     /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
     /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.

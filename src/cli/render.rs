@@ -76,7 +76,8 @@ pub struct Args {
     /// Highest SH degree to evaluate (the file's degree caps it).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=3))]
     pub sh_degree: u8,
-    /// Background colour, linear 0..1.
+    /// Background colour as it appears in the output image (display values, 0..1; for
+    /// lin_rec709_display clouds it is decoded before blending so it comes out unchanged).
     #[arg(long, default_value = "0,0,0", value_name = "r,g,b")]
     pub background: String,
     /// Blending order.
@@ -240,6 +241,14 @@ fn go(a: &Args) -> Result<(), String> {
         None => (splatgl::scene::default_scene(), false),
     };
     let cam = camera(a, &cloud, ply)?;
+    // cameras.json sizes and derived sizes are bounded like the flags (an image is 16 bytes
+    // per pixel in f32).
+    if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
+        return Err(format!(
+            "image size {}x{} is outside 1..=16384 per side; give --width/--height",
+            cam.width, cam.height
+        ));
+    }
     let bg = floats(&a.background, "--background", &[3])?;
     let opts = RenderOptions {
         sh_degree: a.sh_degree,

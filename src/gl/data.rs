@@ -75,7 +75,12 @@ fn geometry_of(cloud: &SplatCloud, i: usize, out: &mut [f32]) {
         p[0],
         p[1],
         p[2],
-        cloud.opacities[i],
+        // Splats the reference skips (non-finite data) get opacity 0: the shader culls them.
+        if cloud.is_drawable(i) {
+            cloud.opacities[i]
+        } else {
+            0.0
+        },
         q[0],
         q[1],
         q[2],
@@ -123,8 +128,13 @@ fn upload_texture(
         ] {
             gl.tex_parameter_i32(glow::TEXTURE_2D, pname, v as i32);
         }
+        // Whatever unpack state the host left must not offset or redirect the read of
+        // `staging`: client memory, tight rows, no skipped rows or pixels.
+        gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
         gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
         gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 0);
+        gl.pixel_store_i32(glow::UNPACK_SKIP_ROWS, 0);
+        gl.pixel_store_i32(glow::UNPACK_SKIP_PIXELS, 0);
         const ROWS_PER_CHUNK: usize = 64;
         let floats_per_row = width * 4;
         let mut staging = vec![0.0f32; ROWS_PER_CHUNK * floats_per_row];
@@ -177,6 +187,7 @@ impl SplatTextures {
     ) -> Result<Self, GlError> {
         let width = 1usize << width_log2;
         cloud.check_lengths().map_err(GlError::Upload)?;
+        super::clear_pending_errors(gl);
         let n = cloud.len();
         let sh_t = sh_texels(cloud.sh_degree);
         let k = cloud.coeffs_per_splat();
@@ -205,13 +216,17 @@ impl SplatTextures {
                 return Err(e);
             }
         };
-        super::check_error(gl, "uploading splat textures")?;
-        Ok(SplatTextures {
+        let textures = SplatTextures {
             geometry,
             sh,
             sh_texels: sh_t,
             len: n,
-        })
+        };
+        if let Err(e) = super::check_error(gl, "uploading splat textures") {
+            textures.destroy(gl);
+            return Err(e);
+        }
+        Ok(textures)
     }
 
     /// Deletes both textures.

@@ -102,6 +102,18 @@ pub enum GlError {
     },
 }
 
+/// Clears errors the host left pending (at most a few: each `glGetError` clears one flag), so
+/// that a later [`check_error`] reports only what this crate caused.
+pub(crate) fn clear_pending_errors(gl: &glow::Context) {
+    use glow::HasContext;
+    for _ in 0..8 {
+        // SAFETY: as in `check_error`.
+        if unsafe { gl.get_error() } == glow::NO_ERROR {
+            break;
+        }
+    }
+}
+
 /// Checks `glGetError` (used after uploads and target creation, never on the draw hot path).
 pub(crate) fn check_error(gl: &glow::Context, during: &'static str) -> Result<(), GlError> {
     use glow::HasContext;

@@ -42,6 +42,7 @@ struct Uniforms {
     camera_position: Option<glow::UniformLocation>,
     viewport: Option<glow::UniformLocation>,
     cull_depth: Option<glow::UniformLocation>,
+    splat_count: Option<glow::UniformLocation>,
 }
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
@@ -108,6 +109,7 @@ impl SplatRenderer {
                 camera_position: loc("u_camera_position"),
                 viewport: loc("u_viewport"),
                 cull_depth: loc("u_cull_depth"),
+                splat_count: loc("u_splat_count"),
             };
             let vao = match gl.create_vertex_array() {
                 Ok(v) => v,
@@ -159,12 +161,7 @@ impl SplatRenderer {
     /// sizes the order buffer for `cloud.len()` indices.
     pub fn upload(&mut self, gl: &glow::Context, cloud: &SplatCloud) -> Result<(), GlError> {
         let textures = SplatTextures::upload(gl, cloud, self.tex_width_log2)?;
-        if let Some(old) = self.textures.replace(textures) {
-            old.destroy(gl);
-        }
-        self.cloud_degree = cloud.sh_degree;
-        self.color_space = cloud.meta.color_space.effective();
-        self.instances = 0;
+        // The order buffer first: on failure the previous cloud stays complete and usable.
         // SAFETY: (re)allocates the renderer's own order buffer.
         unsafe {
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.order_buffer));
@@ -175,8 +172,19 @@ impl SplatRenderer {
             );
             gl.bind_buffer(glow::ARRAY_BUFFER, None);
         }
+        if let Err(e) = super::check_error(gl, "allocating the order buffer") {
+            textures.destroy(gl);
+            self.instances = 0; // the buffer's old contents are gone
+            return Err(e);
+        }
+        if let Some(old) = self.textures.replace(textures) {
+            old.destroy(gl);
+        }
+        self.cloud_degree = cloud.sh_degree;
+        self.color_space = cloud.meta.color_space.effective();
+        self.instances = 0;
         self.order_capacity = cloud.len();
-        super::check_error(gl, "allocating the order buffer")
+        Ok(())
     }
 
     /// The linked splat program (for inspection, e.g. its active attributes).
@@ -227,7 +235,6 @@ impl SplatRenderer {
                 capacity: self.order_capacity,
             });
         }
-        debug_assert!(order.iter().all(|&i| (i as usize) < self.order_capacity));
         // SAFETY: writes `order.len() * 4` bytes into the order buffer, which holds
         // `order_capacity * 4 >= order.len() * 4` bytes.
         unsafe {
@@ -251,8 +258,9 @@ impl SplatRenderer {
     }
 
     /// Draws the splats of the last uploaded order into the bound framebuffer and viewport,
-    /// blending premultiplied colour with `ONE, ONE_MINUS_SRC_ALPHA`. The camera's
-    /// `width`/`height` should match the viewport.
+    /// blending premultiplied colour with `ONE, ONE_MINUS_SRC_ALPHA`. When the camera's
+    /// `width`/`height` differ from the viewport's (e.g. a camera in logical pixels on a HiDPI
+    /// surface), its intrinsics are scaled to the viewport ([`Camera::resized`]).
     pub fn draw_current(&self, gl: &glow::Context, camera: &Camera) -> Result<(), GlError> {
         let Some(tex) = &self.textures else {
             return Err(GlError::NotUploaded);
@@ -263,17 +271,25 @@ impl SplatRenderer {
             .sh_degree
             .unwrap_or(self.cloud_degree)
             .min(self.cloud_degree);
+        let mut viewport = [0i32; 4];
+        // SAFETY: a plain integer query into a 4-element array.
+        unsafe { gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport) };
+        let (vw, vh) = (viewport[2].max(0) as u32, viewport[3].max(0) as u32);
+        let scaled;
+        let camera = if (camera.width, camera.height) != (vw, vh) && vw > 0 && vh > 0 {
+            scaled = camera.resized(vw, vh);
+            &scaled
+        } else {
+            camera
+        };
         let view: Mat4 = camera.gl_view();
         let proj: Mat4 = camera.gl_projection();
         let eye = camera.eye();
         let tan = camera.tan_half_fov();
         // SAFETY: binds objects this renderer owns, sets uniforms of its own program with values
         // of the declared types, and draws `instances` instances, which `set_order` bounded by
-        // the order buffer's size (an index past the cloud only makes texelFetch return
-        // undefined values, never touch memory outside the textures).
+        // the order buffer's size; the shader culls any index past the uploaded splats.
         unsafe {
-            let mut viewport = [0i32; 4];
-            gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport);
             gl.use_program(Some(self.program));
             gl.uniform_matrix_4_f32_slice(u.view.as_ref(), false, &view.to_cols_array());
             gl.uniform_matrix_4_f32_slice(u.projection.as_ref(), false, &proj.to_cols_array());
@@ -293,8 +309,13 @@ impl SplatRenderer {
             );
             gl.uniform_1_i32(u.sh_degree.as_ref(), i32::from(degree));
             gl.uniform_1_i32(u.sh_texels.as_ref(), tex.sh_texels as i32);
+            gl.uniform_1_i32(u.splat_count.as_ref(), tex.len as i32);
             gl.uniform_1_i32(u.geometry.as_ref(), 0);
             gl.uniform_1_i32(u.sh.as_ref(), 1);
+            // A host sampler object on these units would override the textures' NEAREST
+            // filtering (RGBA32F is not filterable on ES 3.0): unbind samplers.
+            gl.bind_sampler(0, None);
+            gl.bind_sampler(1, None);
             gl.active_texture(glow::TEXTURE0);
             gl.bind_texture(glow::TEXTURE_2D, Some(tex.geometry));
             gl.active_texture(glow::TEXTURE1);

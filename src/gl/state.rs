@@ -4,7 +4,7 @@
 //! # [`SplatRenderer::draw`](super::SplatRenderer::draw)
 //!
 //! Reads: the bound draw framebuffer and `GL_VIEWPORT` (splats are drawn into the host's
-//! viewport; the camera's `width`/`height` should equal the viewport's size).
+//! viewport; a camera of another size is scaled to it with `Camera::resized`).
 //!
 //! | state | set to during the draw | left afterwards |
 //! |---|---|---|
@@ -13,6 +13,7 @@
 //! | `GL_ARRAY_BUFFER_BINDING` | the order buffer | **0** |
 //! | `GL_ACTIVE_TEXTURE` | `TEXTURE0` / `TEXTURE1` | **`TEXTURE0`** |
 //! | `TEXTURE_2D` binding, units 0 and 1 | geometry / SH textures | **0** on both units |
+//! | sampler object binding, units 0 and 1 | none | **none** |
 //! | `GL_BLEND` | enabled | **enabled** (left) |
 //! | blend func | `ONE, ONE_MINUS_SRC_ALPHA` (both RGB and alpha) | **left** |
 //! | blend equation | `FUNC_ADD` | **left** |
@@ -29,9 +30,10 @@
 //!
 //! # [`SplatRenderer::upload`](super::SplatRenderer::upload)
 //!
-//! Changes `GL_ACTIVE_TEXTURE` (left `TEXTURE0`), `TEXTURE_2D` binding (left 0),
-//! `GL_UNPACK_ALIGNMENT` (left 4, the default), `GL_UNPACK_ROW_LENGTH` (left 0),
-//! `GL_ARRAY_BUFFER` binding (left 0), `GL_VERTEX_ARRAY_BINDING` (left 0).
+//! Changes the `TEXTURE_2D` binding of the active texture unit (left 0),
+//! `GL_PIXEL_UNPACK_BUFFER` binding (left 0), `GL_UNPACK_ALIGNMENT` (left 4, the default),
+//! `GL_UNPACK_ROW_LENGTH`, `GL_UNPACK_SKIP_ROWS`, `GL_UNPACK_SKIP_PIXELS` (left 0, the
+//! defaults), and the `GL_ARRAY_BUFFER` binding (left 0).
 //!
 //! # [`OffscreenTarget`](super::OffscreenTarget)
 //!

@@ -50,9 +50,32 @@ impl OffscreenTarget {
         // SAFETY: creates and configures objects owned by the target; the framebuffer binding
         // is restored before returning.
         unsafe {
-            let texture = crate::gl::created(gl.create_texture(), "texture")?;
-            let fbo = crate::gl::created(gl.create_framebuffer(), "framebuffer")?;
-            let vao = crate::gl::created(gl.create_vertex_array(), "vertex array")?;
+            super::clear_pending_errors(gl);
+            // On a failed creation, delete what exists so far.
+            let texture = match crate::gl::created(gl.create_texture(), "texture") {
+                Ok(t) => t,
+                Err(e) => {
+                    gl.delete_program(program);
+                    return Err(e);
+                }
+            };
+            let fbo = match crate::gl::created(gl.create_framebuffer(), "framebuffer") {
+                Ok(f) => f,
+                Err(e) => {
+                    gl.delete_texture(texture);
+                    gl.delete_program(program);
+                    return Err(e);
+                }
+            };
+            let vao = match crate::gl::created(gl.create_vertex_array(), "vertex array") {
+                Ok(v) => v,
+                Err(e) => {
+                    gl.delete_framebuffer(fbo);
+                    gl.delete_texture(texture);
+                    gl.delete_program(program);
+                    return Err(e);
+                }
+            };
             gl.bind_texture(glow::TEXTURE_2D, Some(texture));
             gl.tex_storage_2d(
                 glow::TEXTURE_2D,
@@ -100,7 +123,10 @@ impl OffscreenTarget {
                 target.destroy(gl);
                 return Err(GlError::Framebuffer(status));
             }
-            super::check_error(gl, "creating the RGBA16F target")?;
+            if let Err(e) = super::check_error(gl, "creating the RGBA16F target") {
+                target.destroy(gl);
+                return Err(e);
+            }
             Ok(target)
         }
     }
@@ -142,6 +168,7 @@ impl OffscreenTarget {
             gl.uniform_2_f32(self.u_origin.as_ref(), v[0] as f32, v[1] as f32);
             gl.uniform_1_i32(self.u_encode.as_ref(), i32::from(encode_srgb));
             gl.active_texture(glow::TEXTURE0);
+            gl.bind_sampler(0, None);
             gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
             gl.bind_vertex_array(Some(self.vao));
             gl.draw_arrays(glow::TRIANGLES, 0, 3);

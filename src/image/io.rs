@@ -93,7 +93,13 @@ impl Image {
         let mut dec = png::Decoder::new(Cursor::new(bytes));
         dec.set_transformations(png::Transformations::EXPAND);
         let mut reader = dec.read_info()?;
+        // Checked before allocating: a header can claim any size. At most 2^28 pixels, and no
+        // more decoded bytes than DEFLATE can expand the file to (≈1032×).
+        let (w, h) = (reader.info().width as u64, reader.info().height as u64);
         let size = reader.output_buffer_size().ok_or(ImageError::PngTooLarge)?;
+        if w * h > 1 << 28 || size as u64 > 1032 * bytes.len() as u64 + 65536 {
+            return Err(ImageError::PngTooLarge);
+        }
         let mut buf = vec![0; size];
         let info = reader.next_frame(&mut buf)?;
         let channels = info.color_type.samples();
@@ -168,7 +174,12 @@ impl Image {
             }
             tokens.push(std::str::from_utf8(&bytes[start..pos]).map_err(|_| bad("header"))?);
         }
-        pos += 1; // the single whitespace byte ending the header
+        // The single whitespace byte ending the header (a CRLF counts as one line end).
+        pos += if bytes.get(pos..pos + 2) == Some(b"\r\n") {
+            2
+        } else {
+            1
+        };
         let channels = match tokens[0] {
             "PF" => 3,
             "Pf" => 1,
@@ -181,7 +192,10 @@ impl Image {
         let scale: f32 = tokens[3]
             .parse()
             .map_err(|_| bad("scale is not a number"))?;
-        let little = scale < 0.0;
+        if !(scale.is_finite() && scale != 0.0) {
+            return Err(bad("scale must be a finite non-zero number"));
+        }
+        let little = scale.is_sign_negative();
         let n = w as usize * h as usize * channels;
         let data = bytes
             .get(pos..)

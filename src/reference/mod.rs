@@ -19,6 +19,9 @@ mod sort;
 pub use project::{NEAR_CULL_3DGS, Projected, ViewContext};
 pub use sort::{SortMode, back_to_front, sort_key};
 
+/// Most (splat, tile) bin entries held at once (4 bytes each): 64 MiB.
+pub const MAX_BIN_ENTRIES: u64 = 16 << 20;
+
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
 use crate::image::Image;
@@ -80,6 +83,13 @@ pub fn render_with_stats(
 ) -> (Image, RenderStats) {
     let [r, g, b] = opts.background;
     let mut image = Image::filled(camera.width, camera.height, [r, g, b, 0.0]);
+    if camera.width == 0 || camera.height == 0 {
+        let stats = RenderStats {
+            splats: cloud.len(),
+            ..Default::default()
+        };
+        return (image, stats);
+    }
     let degree = opts.sh_degree.min(cloud.sh_degree);
     let ctx = ViewContext::new(camera, opts.cull_depth(camera) as f64, degree);
     let projected: Vec<Option<Projected>> = (0..cloud.len())
@@ -90,19 +100,28 @@ pub fn render_with_stats(
         .into_iter()
         .filter_map(|i| projected[i as usize])
         .collect();
-    if camera.width == 0 || camera.height == 0 {
-        let stats = RenderStats {
-            splats: cloud.len(),
-            ..Default::default()
-        };
-        return (image, stats);
+    // Bin and rasterize in bands of tile rows holding at most MAX_BIN_ENTRIES (splat, tile)
+    // pairs, so memory stays bounded however large the splats or the image (a single tile row
+    // over the limit is still done alone).
+    let per_row = raster::row_entries(&splats, camera.height);
+    let mut tile_entries = 0u64;
+    let mut start = 0usize;
+    while start < per_row.len() {
+        let (mut end, mut sum) = (start, 0u64);
+        while end < per_row.len() && (end == start || sum + per_row[end] <= MAX_BIN_ENTRIES) {
+            sum += per_row[end];
+            end += 1;
+        }
+        let rows = start as u32..end as u32;
+        let tiles = raster::bin(&splats, camera.width, rows.clone());
+        raster::rasterize(&mut image, &splats, &tiles, rows);
+        tile_entries += sum;
+        start = end;
     }
-    let tiles = raster::bin(&splats, camera.width, camera.height);
-    raster::rasterize(&mut image, &splats, &tiles);
     let stats = RenderStats {
         splats: cloud.len(),
         visible: splats.len(),
-        tile_entries: tiles.iter().map(Vec::len).sum(),
+        tile_entries: tile_entries as usize,
     };
     (image, stats)
 }

@@ -81,8 +81,8 @@ impl ViewContext {
     /// Σ' = J W Σ Wᵀ Jᵀ + 0.3·I for a camera-space mean `t` and world covariance `sigma`,
     /// as `[xx, xy, yy]`.
     pub fn cov2d(&self, t: DVec3, sigma: DMat3) -> [f64; 3] {
-        let txtz = (t.x / t.z).clamp(-self.lim[0], self.lim[0]);
-        let tytz = (t.y / t.z).clamp(-self.lim[1], self.lim[1]);
+        let txtz = (t.x / t.z).max(-self.lim[0]).min(self.lim[0]);
+        let tytz = (t.y / t.z).max(-self.lim[1]).min(self.lim[1]);
         let j0 = DVec3::new(self.fx / t.z, 0.0, -self.fx * txtz / t.z);
         let j1 = DVec3::new(0.0, self.fy / t.z, -self.fy * tytz / t.z);
         // Rows of J·W are Wᵀ jᵢ.
@@ -97,6 +97,9 @@ impl ViewContext {
 
     /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
     pub fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
+        if !cloud.is_drawable(i) {
+            return None;
+        }
         let opacity = cloud.opacities[i];
         let best_alpha = opacity.min(ALPHA_MAX);
         if best_alpha.is_nan() || best_alpha < ALPHA_MIN {
@@ -113,7 +116,9 @@ impl ViewContext {
         ));
         let [a, b, c] = self.cov2d(t, sigma);
         let det = a * c - b * b;
-        if !(det > 0.0 && det.is_finite()) {
+        // Positive definite (a > 0 and det > 0). Rounding in r·Σ·r for extremely elongated
+        // splats seen end-on can make it negative definite; such a splat is skipped.
+        if !(a > 0.0 && det > 0.0 && det.is_finite()) {
             return None;
         }
         let u = self.fx * t.x / t.z + self.cx;
@@ -144,6 +149,9 @@ impl ViewContext {
 /// Pixels `i` with centre `i + 0.5` in `[centre − extent, centre + extent]`, clipped to
 /// `0..size`; `None` when empty.
 fn pixel_range(centre: f64, extent: f64, size: u32) -> Option<(u32, u32)> {
+    if !(centre.is_finite() && extent.is_finite()) {
+        return None;
+    }
     let lo = (centre - extent - 0.5).ceil().max(0.0);
     let hi = (centre + extent - 0.5).floor().min(size as f64 - 1.0);
     (lo <= hi).then(|| (lo as u32, hi as u32 + 1))

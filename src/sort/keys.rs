@@ -49,7 +49,14 @@ pub(crate) fn quantized_key(f: f32, lo: f64, scale: f64, top: u32) -> u32 {
     let x = ((f64::from(f) - lo) * scale).max(0.0).min(f64::from(top));
     // SAFETY: `x` is finite and in [0, top], top < 2^24 ≤ i32::MAX (i32: one SSE2 instruction).
     let q = unsafe { x.to_int_unchecked::<i32>() } as u32;
-    if f.is_nan() { 0 } else { top - q }
+    // Infinities go to the end buckets explicitly (with a zero-width range, inf·0 is NaN).
+    if f.is_nan() || f == f32::INFINITY {
+        0
+    } else if f == f32::NEG_INFINITY {
+        top
+    } else {
+        top - q
+    }
 }
 
 /// The key range of a quantized sort.

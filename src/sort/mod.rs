@@ -397,6 +397,11 @@ impl Sorter {
     /// Keys (`fill(first, block)` writes those of `first..first + block.len()`) → `out[..n]`
     /// in ascending key order (ties by index).
     fn sort_u32(&mut self, n: usize, t: usize, fill: impl Fn(usize, &mut [u32]) + Sync) {
+        // Counts and indices are u32: more would wrap and make the parallel scatter race.
+        assert!(
+            n <= u32::MAX as usize,
+            "the sorter handles at most 2^32 − 1 splats"
+        );
         let rb = &mut self.scratch.radix;
         rb.prepare(n, t);
         let (keys, minmax) = rb.keys_and_minmax(n, t);

@@ -42,7 +42,8 @@ pub(crate) fn safe_radius(positions: &[[f32; 3]], order: &[u32], eye: [f32; 3]) 
         return f64::INFINITY;
     }
     let k_max = key(first);
-    if !k_max.is_finite() {
+    // The bound needs every moved key (≤ 1.96·K) to stay finite in f32.
+    if !k_max.is_finite() || 1.96 * k_max >= f64::from(f32::MAX) {
         return 0.0;
     }
     let margin = k_max * (-18f64).exp2();
