@@ -46,9 +46,14 @@ pub fn far_first_key(f: f32) -> u32 {
 pub(crate) fn quantized_key(f: f32, lo: f64, scale: f64, top: u32) -> u32 {
     // f64: the bucket of every f32 key is exact to ~2^-28 of a bucket even at 24 bits.
     // max/min drop a NaN operand, so `x` is in [0, top] (NaN keys → 0, fixed below).
-    let x = ((f64::from(f) - lo) * scale).max(0.0).min(f64::from(top));
-    // SAFETY: `x` is finite and in [0, top], top < 2^24 ≤ i32::MAX (i32: one SSE2 instruction).
-    let q = unsafe { x.to_int_unchecked::<i32>() } as u32;
+    // Finite keys use buckets 1..=top−1; 0 is reserved for +inf/NaN and top for −inf, so the
+    // infinities stay at the ends even when every finite key shares one bucket.
+    let x = ((f64::from(f) - lo) * scale)
+        .max(0.0)
+        .min(f64::from(top - 2));
+    // SAFETY: `x` is finite and in [0, top − 2], top < 2^24 ≤ i32::MAX (i32: one SSE2
+    // instruction).
+    let q = unsafe { x.to_int_unchecked::<i32>() } as u32 + 1;
     // Infinities go to the end buckets explicitly (with a zero-width range, inf·0 is NaN).
     if f.is_nan() || f == f32::INFINITY {
         0
@@ -68,12 +73,13 @@ pub(crate) struct QuantRange {
 }
 
 impl QuantRange {
-    /// Buckets of width `(hi − lo) / 2^bits` over `[lo, hi]`.
+    /// Buckets of width `(hi − lo) / (2^bits − 2)` over `[lo, hi]` (two of the `2^bits`
+    /// keys are reserved for the infinities).
     pub(crate) fn new(lo: f32, hi: f32, bits: u32) -> Self {
         let top = ((1u64 << bits) - 1) as u32;
         let (lo, hi) = (f64::from(lo), f64::from(hi));
         let scale = if hi > lo && (hi - lo).is_finite() {
-            (1u64 << bits) as f64 / (hi - lo)
+            ((1u64 << bits) - 2) as f64 / (hi - lo)
         } else {
             0.0
         };

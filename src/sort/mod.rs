@@ -64,7 +64,7 @@ pub enum Precision {
     /// distance (not squared) for [`SortMode::Distance`], the depth for
     /// [`SortMode::ViewDepth`], the given float for [`Sorter::sort_keys`].
     ///
-    /// **Error bound**: buckets are `w = (hi − lo) / 2^bits` wide and bucket order is key
+    /// **Error bound**: buckets are `w = (hi − lo) / (2^bits − 2)` wide and bucket order is key
     /// order, so two splats are drawn in the wrong order only if they share a bucket, i.e.
     /// only if their keys differ by less than `w` (checked by the tests with a `10⁻⁶·w` slack
     /// for rounding). Within a bucket the order is ascending splat index. Keys outside the
@@ -86,7 +86,9 @@ pub enum Reuse {
     Never,
     /// Reuse the last order when the positions slice, mode, precision and the camera (eye,
     /// and view direction for depth) are **bit-identical** to the last sort: the sort is
-    /// deterministic, so the order is provably the same.
+    /// deterministic, so the order is provably the same. The positions slice is recognised
+    /// by address and length, not content: a caller that changes positions in place, or frees
+    /// and reallocates them, must call [`Sorter::invalidate`].
     SameView,
     /// As `SameView`, plus, for full-precision distance sorts, reuse when the eye moved by
     /// less than a radius proven (in `docs/sorting.md`) not to change any adjacent pair of the
