@@ -408,6 +408,16 @@ fn spec_violations_the_loader_survives_are_validation_errors() {
         e.contains("MUST NOT be negative") && e.contains("index 1"),
         "{e}"
     );
+    // A nested extension must also be in extensionsUsed (RC).
+    let nested = gltf_with(|d, _| {
+        d["meshes"][0]["primitives"][0]["extensions"]["KHR_gaussian_splatting"]["extensions"] =
+            json!({"EXT_gaussian_splatting_kernel_customShape": {}});
+    });
+    assert!(
+        msgs(&nested)
+            .iter()
+            .any(|m| m.contains("MUST also be listed in extensionsUsed"))
+    );
     // And the file the writer produces is valid.
     assert_eq!(validate(&gltf_with(|_, _| {})).status(), Status::Valid);
 }

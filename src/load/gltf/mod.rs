@@ -125,7 +125,12 @@ pub fn walk(
                 continue;
             };
             let before = w.findings.len();
-            let meta = primitive::read_meta(ext, &ppath, &mut w.findings);
+            let used: Vec<&str> = json
+                .get("extensionsUsed")
+                .and_then(Value::as_array)
+                .map(|a| a.iter().filter_map(Value::as_str).collect())
+                .unwrap_or_default();
+            let meta = primitive::read_meta(ext, &ppath, &used, &mut w.findings);
             if w.findings[before..].iter().any(|f| f.blocks_loading) {
                 blocked = true;
                 continue;

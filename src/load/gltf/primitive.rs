@@ -41,7 +41,14 @@ fn attr_path(base: &str, name: &str) -> String {
 }
 
 /// Reads the extension object into [`SplatMeta`], reporting missing/unknown values.
-pub fn read_meta(ext: &Map<String, Value>, path: &str, f: &mut Vec<Finding>) -> SplatMeta {
+/// `used` is the document's `extensionsUsed` (extensions nested in the object must be listed
+/// there, RC §Extending the Base Extension).
+pub fn read_meta(
+    ext: &Map<String, Value>,
+    path: &str,
+    used: &[&str],
+    f: &mut Vec<Finding>,
+) -> SplatMeta {
     let p = format!("{path}.extensions.{EXT}");
     let mut get = |key: &str, required: bool| -> Option<String> {
         match ext.get(key) {
@@ -100,6 +107,12 @@ pub fn read_meta(ext: &Map<String, Value>, path: &str, f: &mut Vec<Finding>) -> 
     if let Some(exts) = ext.get("extensions").and_then(Value::as_object) {
         for name in exts.keys() {
             let ep = format!("{p}.extensions.{name}");
+            if !used.contains(&name.as_str()) {
+                f.push(Finding::error(
+                    &ep,
+                    format!("{name:?} MUST also be listed in extensionsUsed"),
+                ));
+            }
             if name.to_ascii_lowercase().contains("compression") {
                 f.push(Finding::fatal(
                     ep,
