@@ -97,7 +97,7 @@ void main() {
 #endif
     mat3 scale_matrix = mat3(scale.x, 0.0, 0.0, 0.0, scale.y, 0.0, 0.0, 0.0, scale.z);
     mat3 M = rotation_matrix * scale_matrix;
-    mat3 sigma3d = M * transpose(M);
+    // sigma3d = M * transpose(M); kept factored: Step 3 needs only M.
 
     // --- STEP 3: projection + Jacobian -> 2D covariance  Sigma' = J W Sigma W^T J^T ---
 #ifdef ERRATUM_B
@@ -106,7 +106,6 @@ void main() {
     // Erratum b: the view rotation itself (3DGS computeCov2D), not its transpose.
     mat3 W = mat3(u_view_matrix);
 #endif
-    mat3 T = W * sigma3d * transpose(W);
     // Erratum k: 3DGS clamps x/z and y/z to 1.3 tan(half fov) inside J only.
 #ifdef ERRATUM_K
     vec2 t = view_space_pos.xy;
@@ -120,15 +119,23 @@ void main() {
         fx / z_depth, 0.0, 0.0,
         0.0, fy / z_depth, 0.0,
         fx * t.x / (z_depth * z_depth), fy * t.y / (z_depth * z_depth), 0.0);
-    mat3 cov2d = J * T * transpose(J);
+    // Sigma' = J W sigma3d W^T J^T = P P^T with P = J W M (2x3: rows p0, p1). Its
+    // determinant is the sum of the squared 2x2 minors of P (Cauchy-Binet), |p0 x p1|^2: no
+    // cancellation, where a*c - b*b in f32 loses every digit for long thin splats.
+    mat3 P = J * W * M;
+    vec3 p0 = vec3(P[0][0], P[1][0], P[2][0]);
+    vec3 p1 = vec3(P[0][1], P[1][1], P[2][1]);
+    mat2 cov2d = mat2(dot(p0, p0), dot(p0, p1), dot(p0, p1), dot(p1, p1));
+    vec3 minors = cross(p0, p1);
+    float det = dot(minors, minors);
 #ifndef ERRATUM_I
-    // Erratum i: 3DGS's low-pass dilation of 0.3 px^2.
+    // Erratum i: 3DGS's low-pass dilation of 0.3 px^2: det(S + dI) = det S + d tr S + d^2.
+    det += DILATION * (cov2d[0][0] + cov2d[1][1]) + DILATION * DILATION;
     cov2d[0][0] += DILATION;
     cov2d[1][1] += DILATION;
 #endif
 
     // --- STEP 4: extent (radius of the circle around the 3-sigma ellipse, as in 3DGS) ---
-    float det = cov2d[0][0] * cov2d[1][1] - cov2d[0][1] * cov2d[0][1];
     if (!(det > 0.0) || isinf(det)) {
         cull();
         return;

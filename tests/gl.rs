@@ -701,3 +701,32 @@ fn splats_beyond_the_far_plane_are_drawn() {
         "splats must be visible"
     );
 }
+
+/// Long needles whose 3σ major axis spans thousands of pixels while the minor axis is below a
+/// pixel: Σ''s determinant must not lose its digits to f32 cancellation (spec: the kernel is
+/// the same for every splat shape).
+#[test]
+fn long_thin_needles() {
+    let Some(mut r) = headless() else { return };
+    let mut cloud = SplatCloud::new(0);
+    for k in 0..6 {
+        let q = Quat::from_rotation_z(0.3 + 0.45 * k as f32) * Quat::from_rotation_x(0.2);
+        let y = -0.06 + 0.024 * k as f32;
+        cloud.push(
+            [0.0, y, 0.0],
+            [8.0 + 4.0 * k as f32, 0.0015, 0.0015],
+            q.to_array(),
+            0.9,
+            &sh_for([0.9, 0.5 + 0.08 * k as f32, 0.2], 0),
+        );
+    }
+    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 8.0, 64, 48);
+    check(
+        "needles",
+        &mut r,
+        &cloud,
+        &c,
+        &RenderOptions::default(),
+        MAX_ERR_DENSE,
+    );
+}

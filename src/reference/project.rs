@@ -3,7 +3,7 @@
 
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
-use crate::covariance::{covariance_from_scale_rotation, unpack_sym};
+use crate::covariance::c_matrix;
 use glam::{DMat3, DMat4, DVec3};
 
 /// 3DGS culls splats whose camera-space depth is ≤ 0.2 (`in_frustum`).
@@ -95,6 +95,24 @@ impl ViewContext {
         ]
     }
 
+    /// The same Σ' from the factor C of Σ = C Cᵀ (C = R·diag(s)): with P = J W C (rows p₀, p₁),
+    /// Σ' = P Pᵀ + 0.3·I, returned as `([xx, xy, yy], det)` where the determinant comes from
+    /// Cauchy–Binet, `|p₀ × p₁|² + 0.3·(|p₀|² + |p₁|²) + 0.09`. Positive definite by
+    /// construction: no cancellation even for needles seen end-on.
+    pub fn cov2d_factored(&self, t: DVec3, c: DMat3) -> ([f64; 3], f64) {
+        let txtz = (t.x / t.z).max(-self.lim[0]).min(self.lim[0]);
+        let tytz = (t.y / t.z).max(-self.lim[1]).min(self.lim[1]);
+        let j0 = DVec3::new(self.fx / t.z, 0.0, -self.fx * txtz / t.z);
+        let j1 = DVec3::new(0.0, self.fy / t.z, -self.fy * tytz / t.z);
+        // Rows of J·W·C are Cᵀ Wᵀ jᵢ.
+        let ct_wt = c.transpose() * self.w.transpose();
+        let (p0, p1) = (ct_wt * j0, ct_wt * j1);
+        let (aa, cc) = (p0.dot(p0), p1.dot(p1));
+        let d = DILATION_PX2;
+        let det = p0.cross(p1).length_squared() + d * (aa + cc) + d * d;
+        ([aa + d, p0.dot(p1), cc + d], det)
+    }
+
     /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
     pub fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
         if !cloud.is_drawable(i) {
@@ -110,15 +128,10 @@ impl ViewContext {
         if !t.is_finite() || t.z <= self.cull_z {
             return None;
         }
-        let sigma = unpack_sym(covariance_from_scale_rotation(
-            cloud.scales[i],
-            cloud.rotations[i],
-        ));
-        let [a, b, c] = self.cov2d(t, sigma);
-        let det = a * c - b * b;
-        // Positive definite (a > 0 and det > 0). Rounding in r·Σ·r for extremely elongated
-        // splats seen end-on can make it negative definite; such a splat is skipped.
-        if !(a > 0.0 && det > 0.0 && det.is_finite()) {
+        let factor = c_matrix(cloud.scales[i], cloud.rotations[i]);
+        let ([a, b, c], det) = self.cov2d_factored(t, factor);
+        // Positive definite by construction; only overflow to infinity is left to reject.
+        if !(a > 0.0 && det > 0.0 && det.is_finite() && c.is_finite()) {
             return None;
         }
         let u = self.fx * t.x / t.z + self.cx;
