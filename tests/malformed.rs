@@ -50,7 +50,7 @@ fn poke_ply(mut bytes: Vec<u8>, row: usize, col: usize, v: f32) -> Vec<u8> {
 
 #[test]
 fn ply_corpus() {
-    let cases: Vec<(Vec<u8>, &[&str])> = vec![
+    let mut cases: Vec<(Vec<u8>, &[&str])> = vec![
         (b"".to_vec(), &["header line 1"]),
         (b"plx\nformat ascii 1.0\nend_header\n".to_vec(), &["expected 'ply'"]),
         (b"ply\nformat ascii 1.0\n".to_vec(), &["no 'end_header'"]),
@@ -110,6 +110,22 @@ fn ply_corpus() {
             &["list property 'y'"],
         ),
     ];
+    // Compressed PLY: too few chunks for the splats, and a missing chunk property.
+    let mut packed = String::from("element chunk 0\nproperty float min_x\nelement vertex 1\n");
+    for p in [
+        "packed_position",
+        "packed_rotation",
+        "packed_scale",
+        "packed_color",
+    ] {
+        packed += &format!("property uint {p}\n");
+    }
+    let mut too_few = ply_header(&packed);
+    too_few.extend_from_slice(&[0u8; 16]);
+    cases.push((too_few, &["0 chunks cannot hold 1 splats"]));
+    let mut missing = ply_header(&packed.replace("chunk 0", "chunk 1"));
+    missing.extend_from_slice(&[0u8; 20]);
+    cases.push((missing, &["chunk.min_y"]));
     assert!(cases.len() >= 17);
     for (i, (bytes, needles)) in cases.iter().enumerate() {
         let e = err_of(bytes, "bad.ply");

@@ -143,3 +143,83 @@ fn u8_colours_instead_of_f_dc() {
         "w-first (2,0,0,0) normalised"
     );
 }
+
+/// A hand-packed PlayCanvas compressed PLY: one chunk, two splats, every field decoded to the
+/// value the packing defines.
+#[test]
+fn compressed_ply_fields() {
+    let chunk_props = [
+        "min_x",
+        "min_y",
+        "min_z",
+        "max_x",
+        "max_y",
+        "max_z",
+        "min_scale_x",
+        "min_scale_y",
+        "min_scale_z",
+        "max_scale_x",
+        "max_scale_y",
+        "max_scale_z",
+        "min_r",
+        "min_g",
+        "min_b",
+        "max_r",
+        "max_g",
+        "max_b",
+    ];
+    let mut h = String::from("ply\nformat binary_little_endian 1.0\nelement chunk 1\n");
+    for p in chunk_props {
+        h += &format!("property float {p}\n");
+    }
+    h += "element vertex 2\n";
+    for p in [
+        "packed_position",
+        "packed_rotation",
+        "packed_scale",
+        "packed_color",
+    ] {
+        h += &format!("property uint {p}\n");
+    }
+    h += "end_header\n";
+    let mut b = h.into_bytes();
+    let chunk = [
+        -1.0f32, -2.0, -3.0, 1.0, 2.0, 3.0, // box
+        -4.0, -4.0, -4.0, 0.0, 0.0, 0.0, // log scale range
+        0.0, 0.0, 0.0, 1.0, 1.0, 1.0, // colour range
+    ];
+    for v in chunk {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    // Splat 0: position at the max corner, identity (w = rot_0 largest, others ≈ 0), scale at the
+    // range top (exp 0 = 1), colour (255, 0, 255) with opacity 255.
+    let half10 = 511u32; // (511/1023 − 0.5)·√2 ≈ −0.0007
+    let identity = (half10 << 20) | (half10 << 10) | half10; // index 0 = rot_0 = w
+    let s0 = [u32::MAX, identity, u32::MAX, 0xFF00_FFFF];
+    // Splat 1: min corner, x largest (a 180° turn about x), scale range bottom (exp −4), grey.
+    let x_turn = (1 << 30) | (half10 << 20) | (half10 << 10) | half10;
+    let s1 = [0u32, x_turn, 0, 0x8080_8080];
+    for v in s0.iter().chain(&s1) {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    let c = load(&b);
+    assert_eq!(c.len(), 2);
+    assert_eq!(c.positions[0], [1.0, 2.0, 3.0]);
+    assert_eq!(c.positions[1], [-1.0, -2.0, -3.0]);
+    assert!(c.scales[0].iter().all(|s| (s - 1.0).abs() < 1e-6));
+    assert!(
+        c.scales[1]
+            .iter()
+            .all(|s| (s - (-4.0f32).exp()).abs() < 1e-6)
+    );
+    let q0 = c.rotations[0];
+    assert!((q0[3].abs() - 1.0).abs() < 1e-5, "identity: {q0:?}"); // xyzw, w ≈ ±1
+    let q1 = c.rotations[1];
+    assert!((q1[0].abs() - 1.0).abs() < 1e-5, "x turn: {q1:?}");
+    assert_eq!(c.opacities[0], 1.0);
+    assert!((c.opacities[1] - 128.0 / 255.0).abs() < 1e-6);
+    let colour = splatgl::sh::eval_color(c.sh_of(0), 0, [0.0, 0.0, 1.0]);
+    assert!(
+        (colour[0] - 1.0).abs() < 1e-5 && colour[1].abs() < 1e-5 && (colour[2] - 1.0).abs() < 1e-5
+    );
+}

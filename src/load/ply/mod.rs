@@ -6,6 +6,8 @@
 //! channel-major → degree-major RGB triples, `red/green/blue` (u8 → /255, floats as they are)
 //! → DC coefficient `(c − 0.5) / Y₀₀`. Extra properties are ignored.
 //!
+//! PlayCanvas compressed PLY (`packed_*` properties) is decoded by [`compressed`].
+//!
 //! Binary rows are decoded in parallel (rayon, blocks of rows) with property offsets resolved
 //! once from the header: no per-property lookups in the inner loop.
 
@@ -88,6 +90,7 @@ pub enum PlyError {
     },
 }
 
+mod compressed;
 mod header;
 use header::{Element, Encoding, Header, Property, Scalar, parse_header};
 
@@ -110,11 +113,6 @@ struct Layout {
 }
 
 fn layout(vertex: &Element) -> Result<Layout, PlyError> {
-    if vertex.props.iter().any(|p| p.name == "packed_position") {
-        return Err(PlyError::Unsupported(
-            "PlayCanvas compressed PLY (packed_* properties) is not supported yet".into(),
-        ));
-    }
     if let Some(p) = vertex.props.iter().find(|p| p.list.is_some()) {
         return Err(PlyError::Unsupported(format!(
             "list property '{}' in element 'vertex'",
@@ -292,10 +290,18 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
         .position(|e| e.name == "vertex")
         .ok_or(PlyError::NoVertexElement)?;
     let vertex = &header.elements[vi];
-    let l = layout(vertex)?;
     let body = &bytes[header.body..];
     let mut report = LoadReport::new(Format::Ply);
     report.scale_space = Some(super::ScaleSeen::Log);
+    if compressed::is_compressed(vertex) {
+        let (cloud, _) = compressed::decode(&header, body)?;
+        report.warn(
+            "",
+            "PlayCanvas compressed PLY: quantised positions, scales, rotations and colours",
+        );
+        return Ok(Loaded { cloud, report });
+    }
+    let l = layout(vertex)?;
 
     let (cloud, non_unit) = match header.encoding {
         Encoding::Ascii => load_ascii(&header, vi, &l, body)?,

@@ -1,0 +1,293 @@
+//! PlayCanvas / SuperSplat "compressed PLY": splats in chunks of 256 sharing min/max ranges.
+//!
+//! Layout (binary little endian):
+//! - `element chunk`: float `min_x..max_z`, `min_scale_x..max_scale_z` (log scale) and,
+//!   optionally, `min_r..max_b` (colour range; [0, 1] when absent);
+//! - `element vertex`: uint `packed_position` (11/10/11-bit unorm x/y/z within the chunk's
+//!   box), `packed_rotation` (2-bit index of the largest component, then three 10-bit
+//!   components scaled by √2), `packed_scale` (11/10/11 within the chunk's log-scale range),
+//!   `packed_color` (8-bit r, g, b within the colour range, and linear opacity);
+//! - optional `element sh`: uchar `f_rest_0..` (9/24/45, channel-major as INRIA), each byte
+//!   `v` meaning `(n − 0.5)·8` with `n = 0` for 0, 1 for 255 and `(v + 0.5)/256` otherwise.
+//!
+//! The rotation's four components are in the INRIA order (w, x, y, z).
+
+use super::PlyError;
+use super::header::{Element, Encoding, Header, Scalar};
+use crate::cloud::{SplatCloud, sh_coeff_count};
+
+/// Splats per chunk.
+const CHUNK: usize = 256;
+
+/// Whether a vertex element is the compressed layout.
+pub(super) fn is_compressed(vertex: &Element) -> bool {
+    vertex.props.iter().any(|p| p.name == "packed_position")
+}
+
+/// Byte range of each element in the body (fixed-size rows only).
+fn element_ranges(h: &Header, body: &[u8]) -> Result<Vec<(usize, usize)>, PlyError> {
+    let mut out = Vec::new();
+    let mut pos = 0usize;
+    for el in &h.elements {
+        if let Some(p) = el.props.iter().find(|p| p.list.is_some()) {
+            return Err(PlyError::Unsupported(format!(
+                "compressed PLY: list property '{}' in element '{}'",
+                p.name, el.name
+            )));
+        }
+        let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
+        let needed = el.count.saturating_mul(row as u64);
+        if needed > (body.len() - pos) as u64 {
+            return Err(PlyError::Truncated {
+                element: el.name.clone(),
+                count: el.count,
+                needed,
+                available: (body.len() - pos) as u64,
+            });
+        }
+        out.push((pos, row));
+        pos += needed as usize;
+    }
+    Ok(out)
+}
+
+/// Column reader: value of property `name` (of type `ty`) in row `i` of element `e`.
+struct Columns<'a> {
+    data: &'a [u8],
+    row: usize,
+    offsets: Vec<(String, usize, Scalar)>,
+}
+
+impl<'a> Columns<'a> {
+    fn new(el: &Element, body: &'a [u8], (start, row): (usize, usize)) -> Self {
+        let mut off = 0;
+        let offsets = el
+            .props
+            .iter()
+            .map(|p| {
+                let o = off;
+                off += p.ty.size();
+                (p.name.clone(), o, p.ty)
+            })
+            .collect();
+        Columns {
+            data: &body[start..start + row * el.count as usize],
+            row,
+            offsets,
+        }
+    }
+    /// Offset of a property of the expected type, or a precise error.
+    fn find(&self, el: &str, name: &str, ty: Scalar) -> Result<usize, PlyError> {
+        match self.offsets.iter().find(|(n, _, _)| n == name) {
+            Some((_, o, t)) if *t == ty => Ok(*o),
+            Some((_, _, t)) => Err(PlyError::Unsupported(format!(
+                "compressed PLY: element '{el}' property '{name}' is {t:?}, expected {ty:?}"
+            ))),
+            None => Err(PlyError::MissingProperty {
+                property: format!("{el}.{name}"),
+            }),
+        }
+    }
+    fn f32_at(&self, i: usize, off: usize) -> f32 {
+        let b = &self.data[i * self.row + off..];
+        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    }
+    fn u32_at(&self, i: usize, off: usize) -> u32 {
+        let b = &self.data[i * self.row + off..];
+        u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+    }
+}
+
+fn unorm(v: u32, bits: u32) -> f32 {
+    let max = (1u32 << bits) - 1;
+    (v & max) as f32 / max as f32
+}
+
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    a * (1.0 - t) + b * t
+}
+
+/// 11/10/11 unorm triple (x in the high bits).
+fn unpack_111011(v: u32) -> [f32; 3] {
+    [unorm(v >> 21, 11), unorm(v >> 11, 10), unorm(v, 11)]
+}
+
+/// Smallest-three quaternion → the four stored components in the file's order.
+fn unpack_rotation(v: u32) -> [f32; 4] {
+    let k = std::f32::consts::SQRT_2; // components lie in [−1/√2, 1/√2]
+    let a = (unorm(v >> 20, 10) - 0.5) * k;
+    let b = (unorm(v >> 10, 10) - 0.5) * k;
+    let c = (unorm(v, 10) - 0.5) * k;
+    let m = (1.0 - (a * a + b * b + c * c)).max(0.0).sqrt();
+    match v >> 30 {
+        0 => [m, a, b, c],
+        1 => [a, m, b, c],
+        2 => [a, b, m, c],
+        _ => [a, b, c, m],
+    }
+}
+
+fn sh_byte(v: u8) -> f32 {
+    let n = match v {
+        0 => 0.0,
+        255 => 1.0,
+        v => (v as f32 + 0.5) / 256.0,
+    };
+    (n - 0.5) * 8.0
+}
+
+/// Decodes a compressed PLY whose header is `h` and body `body`.
+/// Returns the cloud and the number of non-unit quaternions (always 0: they are rebuilt unit).
+pub(super) fn decode(h: &Header, body: &[u8]) -> Result<(SplatCloud, usize), PlyError> {
+    if h.encoding != Encoding::Le {
+        return Err(PlyError::Unsupported(
+            "compressed PLY must be binary_little_endian".into(),
+        ));
+    }
+    let ranges = element_ranges(h, body)?;
+    let find = |name: &str| h.elements.iter().position(|e| e.name == name);
+    let (ci, vi) = match (find("chunk"), find("vertex")) {
+        (Some(c), Some(v)) => (c, v),
+        _ => {
+            return Err(PlyError::MissingProperty {
+                property: "element 'chunk' (compressed PLY)".into(),
+            });
+        }
+    };
+    let (chunk_el, vertex_el) = (&h.elements[ci], &h.elements[vi]);
+    let n = vertex_el.count as usize;
+    if (chunk_el.count as usize).saturating_mul(CHUNK) < n {
+        return Err(PlyError::Unsupported(format!(
+            "compressed PLY: {} chunks cannot hold {n} splats (256 per chunk)",
+            chunk_el.count
+        )));
+    }
+    let chunks = Columns::new(chunk_el, body, ranges[ci]);
+    let verts = Columns::new(vertex_el, body, ranges[vi]);
+    let f = |name: &str| chunks.find("chunk", name, Scalar::F32);
+    let bounds = [
+        f("min_x")?,
+        f("min_y")?,
+        f("min_z")?,
+        f("max_x")?,
+        f("max_y")?,
+        f("max_z")?,
+    ];
+    let scales = [
+        f("min_scale_x")?,
+        f("min_scale_y")?,
+        f("min_scale_z")?,
+        f("max_scale_x")?,
+        f("max_scale_y")?,
+        f("max_scale_z")?,
+    ];
+    let colours = ["min_r", "min_g", "min_b", "max_r", "max_g", "max_b"]
+        .map(|c| chunks.find("chunk", c, Scalar::F32).ok());
+    let u = |name: &str| verts.find("vertex", name, Scalar::U32);
+    let (pp, pr, ps, pc) = (
+        u("packed_position")?,
+        u("packed_rotation")?,
+        u("packed_scale")?,
+        u("packed_color")?,
+    );
+
+    // Optional SH element: uchar f_rest_0..K (channel-major).
+    let sh = match find("sh") {
+        None => None,
+        Some(si) => {
+            let el = &h.elements[si];
+            if el.count as usize != n {
+                return Err(PlyError::Unsupported(format!(
+                    "compressed PLY: element 'sh' has {} rows, 'vertex' {n}",
+                    el.count
+                )));
+            }
+            let cols = Columns::new(el, body, ranges[si]);
+            let k = el.props.len();
+            let degree = match k {
+                9 => 1,
+                24 => 2,
+                45 => 3,
+                count => return Err(PlyError::BadShCount { count }),
+            };
+            let offs = (0..k)
+                .map(|j| cols.find("sh", &format!("f_rest_{j}"), Scalar::U8))
+                .collect::<Result<Vec<_>, _>>()?;
+            Some((cols, offs, degree))
+        }
+    };
+    let degree = sh.as_ref().map_or(0, |s| s.2);
+    let kk = sh_coeff_count(degree);
+    let mut cloud = SplatCloud::with_capacity(degree, n);
+    let mut coeffs = vec![[0.0f32; 3]; kk];
+    let chunk_val = |c: usize, off: usize| chunks.f32_at(c, off);
+    for i in 0..n {
+        let c = i / CHUNK;
+        let p = unpack_111011(verts.u32_at(i, pp));
+        let pos: [f32; 3] = std::array::from_fn(|a| {
+            lerp(chunk_val(c, bounds[a]), chunk_val(c, bounds[a + 3]), p[a])
+        });
+        let s = unpack_111011(verts.u32_at(i, ps));
+        let scale: [f32; 3] = std::array::from_fn(|a| {
+            lerp(chunk_val(c, scales[a]), chunk_val(c, scales[a + 3]), s[a]).exp()
+        });
+        let [w, x, y, z] = unpack_rotation(verts.u32_at(i, pr));
+        let Some((rot, _)) = super::super::normalize_quat([x, y, z, w]) else {
+            return Err(PlyError::Value {
+                index: i,
+                property: "packed_rotation".into(),
+                message: "decodes to a zero quaternion".into(),
+            });
+        };
+        let col = verts.u32_at(i, pc);
+        let rgba = [
+            unorm(col >> 24, 8),
+            unorm(col >> 16, 8),
+            unorm(col >> 8, 8),
+            unorm(col, 8),
+        ];
+        for ch in 0..3 {
+            let v = match (colours[ch], colours[ch + 3]) {
+                (Some(lo), Some(hi)) => lerp(chunk_val(c, lo), chunk_val(c, hi), rgba[ch]),
+                _ => rgba[ch],
+            };
+            coeffs[0][ch] = ((v as f64 - 0.5) / crate::sh::SH_C0) as f32;
+        }
+        if let Some((cols, offs, _)) = &sh {
+            let per = offs.len() / 3;
+            for (j, &o) in offs.iter().enumerate() {
+                coeffs[1 + j % per][j / per] = sh_byte(cols.data[i * cols.row + o]);
+            }
+        }
+        let finite = pos
+            .iter()
+            .chain(&scale)
+            .chain(coeffs[0].iter())
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(PlyError::Value {
+                index: i,
+                property: "chunk ranges".into(),
+                message: "decode to a non-finite position, scale or colour".into(),
+            });
+        }
+        cloud.push(pos, scale, rot, rgba[3], &coeffs);
+    }
+    Ok((cloud, 0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_unpacking_is_unit_and_places_the_largest() {
+        // a = b = c = 0 (512 ≈ 0.5 → 0), largest = w (index 3).
+        let v = (3 << 30) | (512 << 20) | (512 << 10) | 512;
+        let q = unpack_rotation(v);
+        assert!((q[3] - 1.0).abs() < 1e-2 && q[0].abs() < 1e-2);
+        assert_eq!(unpack_111011(u32::MAX), [1.0, 1.0, 1.0]);
+        assert_eq!(sh_byte(0), -4.0);
+        assert_eq!(sh_byte(255), 4.0);
+    }
+}
