@@ -189,3 +189,22 @@ fn bevy_camera_node() {
     let (px, _) = cam.project(glam::Vec3::new(4.0, 5.0, 0.0)).unwrap();
     assert!((px - glam::Vec2::new(32.0, 24.0)).length() < 1e-3, "{px}");
 }
+
+#[test]
+fn other_splat_formats_are_named_not_unknown() {
+    for (name, kind) in [
+        ("playcanvas_biker_v4.spz", "SPZ"),
+        ("splat_transform_minimal-v2.spz", "SPZ"),
+        ("splat_transform_minimal.splat", ".splat"),
+        ("splat_transform_minimal.ksplat", ".ksplat"),
+    ] {
+        let Some(p) = real(name) else { continue };
+        let e = load_path(&p, &LoadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(kind) && e.contains("not supported yet"),
+            "{name}: {e}"
+        );
+    }
+}

@@ -189,6 +189,16 @@ pub enum LoadError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A splat format splatgl recognises but does not read yet.
+    #[error(
+        "{path}: {kind} files are not supported yet (splatgl reads glTF/GLB with KHR_gaussian_splatting and PLY)"
+    )]
+    NotYet {
+        /// The file.
+        path: PathBuf,
+        /// The format.
+        kind: &'static str,
+    },
     /// Neither magic bytes nor extension say what the file is.
     #[error("{path}: unknown file format (expected .gltf, .glb or .ply)")]
     UnknownFormat {
@@ -211,6 +221,23 @@ pub enum LoadError {
         /// What.
         source: gltf::GltfError,
     },
+}
+
+/// Splat formats splatgl recognises but does not read yet.
+fn known_unsupported(bytes: &[u8], path: Option<&Path>) -> Option<&'static str> {
+    let ext = path
+        .and_then(|p| p.extension())
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    if bytes.starts_with(b"NGSP") || ext.as_deref() == Some("spz") {
+        return Some("Niantic SPZ");
+    }
+    match ext.as_deref() {
+        Some("splat") => Some("antimatter15 .splat"),
+        Some("ksplat") => Some("mkkellogg .ksplat"),
+        Some("sog") => Some("PlayCanvas SOG"),
+        _ => None,
+    }
 }
 
 /// Loads a file of any supported format.
@@ -265,7 +292,10 @@ pub fn load_bytes(
                 source,
             })
         }
-        None => Err(LoadError::UnknownFormat { path: shown }),
+        None => match known_unsupported(bytes, path) {
+            Some(kind) => Err(LoadError::NotYet { path: shown, kind }),
+            None => Err(LoadError::UnknownFormat { path: shown }),
+        },
     }
 }
 
