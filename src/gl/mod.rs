@@ -21,7 +21,8 @@
 //! * [`data`] — texture layout of the splat data (bytes per splat).
 //! * [`renderer`] — [`SplatRenderer`].
 //! * [`target`] — [`OffscreenTarget`], the RGBA16F accumulation target with a resolve pass.
-//! * [`sort`] — [`sort_back_to_front`], the one ordering function (a radix sorter plugs in here).
+//! * [`sort`] — [`sort_back_to_front`] / [`sort::DistanceSorter`], over the crate's radix
+//!   sorter ([`crate::sort::Sorter`]). `examples/embed.rs` shows a host-owned context.
 //! * [`state`] — every piece of GL state the backend touches.
 
 pub mod consts;
