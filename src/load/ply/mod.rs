@@ -6,7 +6,7 @@
 //! channel-major → degree-major RGB triples, `red/green/blue` (u8 → /255, floats as they are)
 //! → DC coefficient `(c − 0.5) / Y₀₀`. Extra properties are ignored.
 //!
-//! PlayCanvas compressed PLY (`packed_*` properties) is decoded by [`compressed`].
+//! PlayCanvas compressed PLY (`packed_*` properties) is decoded by `compressed.rs` beside this file.
 //!
 //! Binary rows are decoded in parallel (rayon, blocks of rows) with property offsets resolved
 //! once from the header: no per-property lookups in the inner loop.
