@@ -35,18 +35,9 @@ fn element_ranges(h: &Header, body: &[u8]) -> Result<Vec<(usize, usize)>, PlyErr
                 p.name, el.name
             )));
         }
-        let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
-        let needed = el.count.saturating_mul(row as u64);
-        if needed > (body.len() - pos) as u64 {
-            return Err(PlyError::Truncated {
-                element: el.name.clone(),
-                count: el.count,
-                needed,
-                available: (body.len() - pos) as u64,
-            });
-        }
+        let (len, row) = super::fixed_rows_len(el, body.len() - pos)?;
         out.push((pos, row));
-        pos += needed as usize;
+        pos += len;
     }
     Ok(out)
 }

@@ -336,6 +336,22 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
     Ok(Loaded { cloud, report })
 }
 
+/// (bytes, row size) of an element of fixed-size rows, checked against the `available` bytes
+/// before anything is read or allocated.
+fn fixed_rows_len(el: &Element, available: usize) -> Result<(usize, usize), PlyError> {
+    let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
+    let needed = el.count.saturating_mul(row as u64);
+    if needed > available as u64 {
+        return Err(PlyError::Truncated {
+            element: el.name.clone(),
+            count: el.count,
+            needed,
+            available: available as u64,
+        });
+    }
+    Ok((needed as usize, row))
+}
+
 /// Byte offset just past the elements before `vertex` (binary).
 fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyError> {
     let mut pos = 0usize;
@@ -355,17 +371,7 @@ fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyEr
             continue;
         }
         if el.props.iter().all(|p| p.list.is_none()) {
-            let row: usize = el.props.iter().map(|p| p.ty.size()).sum();
-            let needed = el.count.saturating_mul(row as u64);
-            if needed > (body.len() - pos) as u64 {
-                return Err(PlyError::Truncated {
-                    element: el.name.clone(),
-                    count: el.count,
-                    needed,
-                    available: (body.len() - pos) as u64,
-                });
-            }
-            pos += needed as usize;
+            pos += fixed_rows_len(el, body.len() - pos)?.0;
             continue;
         }
         // Rows with lists: walk them (each row takes at least one byte, so the count is
