@@ -87,18 +87,17 @@ pub fn walk(
 
     // Pass 1: every splat primitive of every mesh, decoded and checked once.
     let mut decoded: HashMap<(usize, usize), primitive::LocalSplats> = HashMap::new();
+    let no_values: &[Value] = &[];
     let meshes = json
         .get("meshes")
         .and_then(Value::as_array)
-        .cloned()
-        .unwrap_or_default();
+        .map_or(no_values, Vec::as_slice);
     let mut blocked = false;
     for (mi, mesh) in meshes.iter().enumerate() {
         let prims = mesh
             .get("primitives")
             .and_then(Value::as_array)
-            .cloned()
-            .unwrap_or_default();
+            .map_or(no_values, Vec::as_slice);
         for (pi, prim) in prims.iter().enumerate() {
             let ppath = format!("meshes[{mi}].primitives[{pi}]");
             let exts = prim.get("extensions").and_then(Value::as_object);
