@@ -23,7 +23,6 @@ pub mod reference;
 pub mod scene;
 pub mod sh;
 pub mod sort;
-pub mod validate;
 pub mod write;
 
 pub use cloud::SplatCloud;

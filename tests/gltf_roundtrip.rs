@@ -5,8 +5,8 @@
 mod common;
 use common::random_cloud;
 use splatgl::SplatCloud;
+use splatgl::load::validate::{Status, validate_bytes};
 use splatgl::load::{Format, LoadOptions, load_bytes, load_path};
-use splatgl::validate::{Status, validate_bytes};
 use splatgl::write::{Comp, GltfWriteOptions, to_glb, to_gltf};
 use std::path::Path;
 

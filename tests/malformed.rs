@@ -6,8 +6,8 @@ mod common;
 use base64::Engine;
 use common::random_cloud;
 use serde_json::{Value, json};
+use splatgl::load::validate::{Status, validate_bytes};
 use splatgl::load::{LoadOptions, ScaleSpace, load_bytes};
-use splatgl::validate::{Status, validate_bytes};
 use splatgl::write::{GltfWriteOptions, build, to_glb};
 use std::path::Path;
 

@@ -10,7 +10,7 @@ use splatgl::load::{LoadOptions, load_bytes};
 use splatgl::write::{GltfWriteOptions, build, to_glb};
 use std::path::Path;
 
-fn load_glb(bytes: &[u8]) -> splatgl::load::Loaded {
+fn load_glb(bytes: &[u8]) -> splatgl::load::Scene {
     load_bytes(bytes, Some(Path::new("t.glb")), &LoadOptions::default()).expect("loads")
 }
 
@@ -154,10 +154,10 @@ fn mirrored_node_is_flagged() {
     let l = load_glb(&to_glb(&local, &o));
     assert!(
         l.report
-            .warnings
+            .findings
             .iter()
             .any(|w| w.message.contains("undefined")),
         "{:?}",
-        l.report.warnings
+        l.report.findings
     );
 }

@@ -3,10 +3,10 @@
 
 mod common;
 use common::real;
+use splatgl::load::validate::{Status, validate_path};
 use splatgl::load::{LoadError, LoadOptions, ScaleSeen, load_path};
-use splatgl::validate::{Status, validate_path};
 
-fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Loaded> {
+fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Scene> {
     let path = real(name)?;
     let l = load_path(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(l.cloud.len(), count, "{name}: splat count");
@@ -27,11 +27,8 @@ fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Loaded
     Some(l)
 }
 
-fn has_warning(l: &splatgl::load::Loaded, needle: &str) -> bool {
-    l.report
-        .warnings
-        .iter()
-        .any(|w| w.to_string().contains(needle))
+fn has_warning(l: &splatgl::load::Scene, needle: &str) -> bool {
+    l.report.warning_lines().iter().any(|w| w.contains(needle))
 }
 
 #[test]
@@ -176,8 +173,7 @@ fn bevy_camera_node() {
     let Some(p) = real("bevy_khr_conformance_matrix.gltf") else {
         return;
     };
-    let bytes = std::fs::read(&p).unwrap();
-    let cams = splatgl::load::gltf::cameras(&bytes, splatgl::load::Format::Gltf, Some(&p)).unwrap();
+    let cams = load_path(&p, &LoadOptions::default()).unwrap().cameras;
     assert_eq!(cams.len(), 1);
     assert_eq!(
         cams[0].node_to_world.w_axis.truncate(),

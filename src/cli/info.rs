@@ -29,7 +29,6 @@ pub fn run(a: Args) -> ExitCode {
     let c = &loaded.cloud;
     let r = &loaded.report;
     let b = c.bounds();
-    let warnings: Vec<String> = r.warnings.iter().map(|w| w.to_string()).collect();
     let info = serde_json::json!({
         "file": a.file.display().to_string(),
         "format": r.format.name(),
@@ -44,7 +43,7 @@ pub fn run(a: Args) -> ExitCode {
         "scale_space": r.scale_space.map(|s| s.name()),
         "non_unit_quaternions": r.non_unit_quaternions,
         "memory_bytes": c.memory_bytes(),
-        "warnings": warnings,
+        "warnings": r.warning_lines(),
     });
     if a.json {
         println!("{info:#}");

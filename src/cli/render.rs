@@ -1,8 +1,10 @@
 //! `splatgl render`: one image of a scene (or of the bundled default scene).
 
 use glam::Vec3;
-use splatgl::camera::{Camera, load_cameras_json};
+use splatgl::SplatCloud;
+use splatgl::camera::{Camera, GltfPerspective, load_cameras_json};
 use splatgl::image::{Image, PngDepth};
+use splatgl::load::{Format, Scene};
 use splatgl::reference::{RenderOptions, SortMode};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -132,7 +134,14 @@ fn size_or(a: &Args, w: u32, h: u32) -> (u32, u32) {
     }
 }
 
-fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, String> {
+/// The view: from --camera, --gltf-camera (one of the scene file's `cameras`), --look-at, or
+/// framing `cloud` (read from a file of `format`, `None` for the default scene).
+fn camera(
+    a: &Args,
+    cloud: &SplatCloud,
+    format: Option<Format>,
+    cameras: &[GltfPerspective],
+) -> Result<Camera, String> {
     let fov = a.fov.to_radians();
     if !(fov > 0.0 && fov < std::f32::consts::PI) {
         return Err(format!("--fov {} must be in (0, 180)", a.fov));
@@ -155,19 +164,14 @@ fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, St
         let Some(path) = &a.scene else {
             return Err("--gltf-camera needs a glTF scene file".into());
         };
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let format = splatgl::load::detect_format(&bytes, Some(path));
-        let format = match format {
-            Some(f @ (splatgl::load::Format::Gltf | splatgl::load::Format::Glb)) => f,
-            _ => return Err("--gltf-camera needs a .gltf or .glb scene".into()),
-        };
-        let cams = splatgl::load::gltf::cameras(&bytes, format, Some(path))
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        let g = cams.get(n).ok_or_else(|| {
+        if !matches!(format, Some(Format::Gltf | Format::Glb)) {
+            return Err("--gltf-camera needs a .gltf or .glb scene".into());
+        }
+        let g = cameras.get(n).ok_or_else(|| {
             format!(
                 "--gltf-camera {n}: {} has {} perspective camera node(s)",
                 path.display(),
-                cams.len()
+                cameras.len()
             )
         })?;
         // Keep the camera's aspect ratio when no size is given.
@@ -196,7 +200,7 @@ fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, St
     if a.scene.is_none() {
         return Ok(splatgl::scene::default_camera(w, h));
     }
-    let framed = if ply {
+    let framed = if format == Some(Format::Ply) {
         // INRIA/COLMAP axes: −Y up. Look from +Z, slightly from above (−Y).
         let fwd = Vec3::new(0.0, 0.35, -1.0);
         Camera::frame_points_along(&cloud.positions, fwd, -Vec3::Y, fov, w, h)
@@ -236,11 +240,14 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
 
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
-    let (cloud, ply) = match &a.scene {
-        Some(p) => load(p, a.load.options())?,
-        None => (splatgl::scene::default_scene(), false),
+    let (cloud, format, cameras) = match &a.scene {
+        Some(p) => {
+            let s = load(p, a.load.options())?;
+            (s.cloud, Some(s.report.format), s.cameras)
+        }
+        None => (splatgl::scene::default_scene(), None, Vec::new()),
     };
-    let cam = camera(a, &cloud, ply)?;
+    let cam = camera(a, &cloud, format, &cameras)?;
     // cameras.json sizes and derived sizes are bounded like the flags (an image is 16 bytes
     // per pixel in f32).
     if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
@@ -364,13 +371,13 @@ fn render_gl(
     Err("this splatgl was built without the `gl` feature".into())
 }
 
-/// The cloud and whether it came from a PLY (COLMAP axes) rather than glTF (+Y up).
-fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<(splatgl::SplatCloud, bool), String> {
-    let l = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
-    for w in l.report.summarized_warnings() {
+/// The scene file, parsed once (cloud and cameras); its findings go to stderr as warnings.
+fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<Scene, String> {
+    let scene = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
+    for w in scene.report.summarized_warnings() {
         eprintln!("warning: {w}");
     }
-    Ok((l.cloud, l.report.format == splatgl::load::Format::Ply))
+    Ok(scene)
 }
 
 /// Runs it. Exit status 0 on success, 2 on any error.

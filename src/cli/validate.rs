@@ -17,7 +17,7 @@ pub struct Args {
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
 pub fn run(a: Args) -> ExitCode {
     let opts = a.load.options();
-    let report = splatgl::validate::validate_path(&a.file, &opts);
+    let report = splatgl::load::validate::validate_path(&a.file, &opts);
     if a.json {
         println!("{:#}", report.to_json(&a.file));
     } else {
@@ -25,9 +25,9 @@ pub fn run(a: Args) -> ExitCode {
             println!("{f}");
         }
         let verdict = match report.status() {
-            splatgl::validate::Status::Valid => "valid",
-            splatgl::validate::Status::Invalid => "INVALID",
-            splatgl::validate::Status::Unreadable => "UNREADABLE",
+            splatgl::load::validate::Status::Valid => "valid",
+            splatgl::load::validate::Status::Invalid => "INVALID",
+            splatgl::load::validate::Status::Unreadable => "UNREADABLE",
         };
         println!(
             "{}: {verdict} ({} errors, {} warnings)",

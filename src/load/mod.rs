@@ -1,17 +1,27 @@
 //! Loaders: glTF 2.0 (`.gltf`, `.glb`) with `KHR_gaussian_splatting`, and INRIA 3DGS PLY.
 //!
-//! [`load_path`] picks the format by magic bytes (then by extension) and returns the
-//! [`SplatCloud`] together with a [`LoadReport`] (format, scale space seen, warnings).
+//! [`load_path`] picks the format by magic bytes (then by extension, see [`detect_format`])
+//! and parses the file once into a [`Scene`]: the [`SplatCloud`], the glTF cameras, and a
+//! [`LoadReport`] (format, scale space seen, [`Finding`]s). [`validate`] checks a file with the
+//! same readers and reports the same findings.
+//!
 //! Every failure is a [`LoadError`] naming the file, the element, the index and what was
 //! expected. No input panics, and sizes claimed by headers are checked against the bytes that
 //! are really there before anything is allocated.
 
-pub mod finding;
+mod finding;
+mod format;
 pub mod gltf;
 pub mod ply;
+mod report;
+pub mod validate;
 
+pub use finding::{Finding, Severity};
+pub use format::{Format, detect_format};
+pub use report::{LoadReport, ScaleSeen};
+
+use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// How `KHR_gaussian_splatting:SCALE` values are to be read.
@@ -46,135 +56,16 @@ pub struct LoadOptions {
     pub scale_space: ScaleSpace,
 }
 
-/// The file formats splatgl reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    /// glTF JSON (`.gltf`).
-    Gltf,
-    /// Binary glTF (`.glb`).
-    Glb,
-    /// INRIA 3DGS PLY (binary little/big endian or ASCII).
-    Ply,
-}
-
-impl Format {
-    /// Short lowercase name used in `info` output.
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Gltf => "gltf",
-            Format::Glb => "glb",
-            Format::Ply => "ply",
-        }
-    }
-}
-
-/// What the loader noticed while reading; nothing here stops the load.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Warning {
-    /// Where (a JSON path, PLY element/property), may be empty.
-    pub location: String,
-    /// What.
-    pub message: String,
-}
-
-impl fmt::Display for Warning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.location.is_empty() {
-            write!(f, "{}", self.message)
-        } else {
-            write!(f, "{}: {}", self.location, self.message)
-        }
-    }
-}
-
-/// Scale space as read from the file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScaleSeen {
-    /// Linear scales.
-    Linear,
-    /// Log-space scales (exp applied).
-    Log,
-    /// Primitives of both kinds.
-    Mixed,
-}
-
-impl ScaleSeen {
-    /// `"linear"`, `"log"` or `"mixed"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ScaleSeen::Linear => "linear",
-            ScaleSeen::Log => "log",
-            ScaleSeen::Mixed => "mixed",
-        }
-    }
-    pub(crate) fn merge(a: Option<Self>, b: Self) -> Self {
-        match a {
-            None => b,
-            Some(a) if a == b => a,
-            Some(_) => ScaleSeen::Mixed,
-        }
-    }
-}
-
-/// What the loader learnt besides the splats.
+/// A loaded file: the splats, the cameras it defines, and what the loader noticed.
 #[derive(Debug, Clone)]
-pub struct LoadReport {
-    /// Detected format.
-    pub format: Format,
-    /// Scale space seen (`None` when there were no splats to look at).
-    pub scale_space: Option<ScaleSeen>,
-    /// Quaternions that were not unit length (within 1e-3) and were normalised.
-    pub non_unit_quaternions: usize,
-    /// Non-fatal findings.
-    pub warnings: Vec<Warning>,
-}
-
-impl LoadReport {
-    pub(crate) fn new(format: Format) -> Self {
-        LoadReport {
-            format,
-            scale_space: None,
-            non_unit_quaternions: 0,
-            warnings: Vec::new(),
-        }
-    }
-    /// The warnings for people: identical messages merged into one line naming the first
-    /// location and how many more there are, in first-seen order.
-    pub fn summarized_warnings(&self) -> Vec<String> {
-        let mut groups: Vec<(&Warning, usize)> = Vec::new();
-        let mut index: std::collections::HashMap<&str, usize> = Default::default();
-        for w in &self.warnings {
-            match index.get(w.message.as_str()) {
-                Some(&g) => groups[g].1 += 1,
-                None => {
-                    index.insert(&w.message, groups.len());
-                    groups.push((w, 1));
-                }
-            }
-        }
-        groups
-            .into_iter()
-            .map(|(w, n)| match n {
-                1 => w.to_string(),
-                n => format!("{w} (and {} more like it)", n - 1),
-            })
-            .collect()
-    }
-
-    pub(crate) fn warn(&mut self, location: impl Into<String>, message: impl Into<String>) {
-        self.warnings.push(Warning {
-            location: location.into(),
-            message: message.into(),
-        });
-    }
-}
-
-/// A loaded scene.
-#[derive(Debug, Clone)]
-pub struct Loaded {
+pub struct Scene {
     /// The splats, global space.
     pub cloud: SplatCloud,
-    /// Format, scale space, warnings.
+    /// The perspective camera nodes of the glTF scene, in traversal order (depth first), with
+    /// their global transforms (orthographic cameras are skipped: splat rendering with them is
+    /// undefined per the RC). Empty for formats without cameras (PLY).
+    pub cameras: Vec<GltfPerspective>,
+    /// Format, scale space, findings.
     pub report: LoadReport,
 }
 
@@ -223,25 +114,8 @@ pub enum LoadError {
     },
 }
 
-/// Splat formats splatgl recognises but does not read yet.
-fn known_unsupported(bytes: &[u8], path: Option<&Path>) -> Option<&'static str> {
-    let ext = path
-        .and_then(|p| p.extension())
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    if bytes.starts_with(b"NGSP") || ext.as_deref() == Some("spz") {
-        return Some("Niantic SPZ");
-    }
-    match ext.as_deref() {
-        Some("splat") => Some("antimatter15 .splat"),
-        Some("ksplat") => Some("mkkellogg .ksplat"),
-        Some("sog") => Some("PlayCanvas SOG"),
-        _ => None,
-    }
-}
-
 /// Loads a file of any supported format.
-pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Loaded, LoadError> {
+pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, LoadError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
         path: path.to_owned(),
@@ -250,52 +124,78 @@ pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Loaded, L
     load_bytes(&bytes, Some(path), opts)
 }
 
-/// Detects the format from magic bytes, then the extension.
-pub fn detect_format(bytes: &[u8], path: Option<&Path>) -> Option<Format> {
-    if bytes.starts_with(b"glTF") {
-        return Some(Format::Glb);
-    }
-    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
-        return Some(Format::Ply);
-    }
-    let ext = path
-        .and_then(|p| p.extension())
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("gltf") => Some(Format::Gltf),
-        Some("glb") => Some(Format::Glb),
-        Some("ply") => Some(Format::Ply),
-        _ => {
-            let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
-            (first == Some(&b'{')).then_some(Format::Gltf)
-        }
-    }
-}
-
-/// Loads from memory. `path` names the file in errors and resolves external glTF buffers
-/// (without it, only GLB and data-URI buffers can be read).
+/// Loads from memory. `path` names the file in errors, helps detect the format, and resolves
+/// external glTF buffers (without it, only GLB and data-URI buffers can be read).
 pub fn load_bytes(
     bytes: &[u8],
     path: Option<&Path>,
     opts: &LoadOptions,
-) -> Result<Loaded, LoadError> {
+) -> Result<Scene, LoadError> {
     let shown = path.map_or_else(|| PathBuf::from("<memory>"), Path::to_owned);
-    match detect_format(bytes, path) {
-        Some(Format::Ply) => ply::load(bytes).map_err(|source| LoadError::Ply {
-            path: shown,
-            source,
-        }),
-        Some(f @ (Format::Gltf | Format::Glb)) => {
-            gltf::load(bytes, f, path, opts).map_err(|source| LoadError::Gltf {
-                path: shown,
-                source,
-            })
+    let Some(format) = detect_format(bytes, path) else {
+        return Err(match format::not_yet(bytes, path) {
+            Some(kind) => LoadError::NotYet { path: shown, kind },
+            None => LoadError::UnknownFormat { path: shown },
+        });
+    };
+    let mut report = LoadReport::new(format);
+    let (cloud, cameras) = read(format, bytes, path, opts, &mut report).map_err(|e| e.at(shown))?;
+    Ok(Scene {
+        cloud,
+        cameras,
+        report,
+    })
+}
+
+/// Why a reader stopped, before the file name is attached (see [`LoadError`]).
+#[derive(Debug)]
+pub(crate) enum ReadError {
+    Ply(ply::PlyError),
+    Gltf(gltf::GltfError),
+}
+
+impl ReadError {
+    fn at(self, path: PathBuf) -> LoadError {
+        match self {
+            ReadError::Ply(source) => LoadError::Ply { path, source },
+            ReadError::Gltf(source) => LoadError::Gltf { path, source },
         }
-        None => match known_unsupported(bytes, path) {
-            Some(kind) => Err(LoadError::NotYet { path: shown, kind }),
-            None => Err(LoadError::UnknownFormat { path: shown }),
-        },
+    }
+    /// Whether the file's framing could not be read at all (`validate`'s "unreadable").
+    fn unreadable(&self) -> bool {
+        matches!(
+            self,
+            ReadError::Ply(ply::PlyError::Header { .. })
+                | ReadError::Gltf(gltf::GltfError::Container(_))
+        )
+    }
+}
+
+impl std::fmt::Display for ReadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReadError::Ply(e) => e.fmt(f),
+            ReadError::Gltf(e) => e.fmt(f),
+        }
+    }
+}
+
+/// The readers, one arm per format. Each fills `report` (findings, scale space, non-unit
+/// quaternions) and returns the cloud and the cameras the file defines.
+pub(crate) fn read(
+    format: Format,
+    bytes: &[u8],
+    path: Option<&Path>,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<(SplatCloud, Vec<GltfPerspective>), ReadError> {
+    match format {
+        Format::Ply => ply::read(bytes, report)
+            .map(|cloud| (cloud, Vec::new()))
+            .map_err(ReadError::Ply),
+        Format::Gltf | Format::Glb => {
+            gltf::read(bytes, format, path, opts, report).map_err(ReadError::Gltf)
+        }
     }
 }
 
