@@ -44,7 +44,7 @@ pub struct Finding {
 
 impl Finding {
     /// An error that stops loading.
-    pub fn fatal(path: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn fatal(path: impl Into<String>, message: impl Into<String>) -> Self {
         Finding {
             severity: Severity::Error,
             blocks_loading: true,
@@ -54,21 +54,21 @@ impl Finding {
         }
     }
     /// A spec violation the loader can work around.
-    pub fn error(path: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn error(path: impl Into<String>, message: impl Into<String>) -> Self {
         Finding {
             blocks_loading: false,
             ..Finding::fatal(path, message)
         }
     }
     /// A warning.
-    pub fn warning(path: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn warning(path: impl Into<String>, message: impl Into<String>) -> Self {
         Finding {
             severity: Severity::Warning,
             ..Finding::error(path, message)
         }
     }
     /// Sets the offending index.
-    pub fn at(mut self, index: u64) -> Self {
+    pub(crate) fn at(mut self, index: u64) -> Self {
         self.index = Some(index);
         self
     }
@@ -96,7 +96,7 @@ impl Finding {
 
 /// Repeats collapsed: one entry per distinct (severity, message), holding the first finding
 /// that said it and how many said it, in first-seen order.
-pub fn collapse(findings: &[Finding]) -> Vec<(&Finding, usize)> {
+pub(crate) fn collapse(findings: &[Finding]) -> Vec<(&Finding, usize)> {
     let mut groups: Vec<(&Finding, usize)> = Vec::new();
     let mut index: HashMap<(Severity, &str), usize> = HashMap::new();
     for f in findings {

@@ -19,7 +19,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in the order detection tries them.
-    pub const ALL: [Format; 3] = [Format::Gltf, Format::Glb, Format::Ply];
+    const ALL: [Format; 3] = [Format::Gltf, Format::Glb, Format::Ply];
 
     /// Short lowercase name used in `info` output.
     pub fn name(self) -> &'static str {

@@ -18,6 +18,7 @@ mod accessor;
 mod container;
 mod meta;
 mod primitive;
+mod rules;
 mod transform;
 
 use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen};

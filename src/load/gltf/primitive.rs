@@ -1,8 +1,9 @@
-//! One `KHR_gaussian_splatting` primitive → a local-space [`SplatCloud`], with every RC rule
-//! about its attributes checked and reported as a [`Finding`].
+//! One `KHR_gaussian_splatting` primitive → a local-space [`SplatCloud`]: its attributes
+//! fetched, checked against the RC's rules (`rules.rs` beside this file), and assembled.
 
-use super::accessor::{Decoded, component_name, decode};
+use super::accessor::{Decoded, decode};
 use super::container::PREFIX;
+use super::rules;
 use crate::cloud::{ColorSpace, SplatCloud, SplatMeta};
 use crate::load::Finding;
 use crate::load::{ScaleSeen, ScaleSpace};
@@ -36,41 +37,8 @@ pub struct Ctx<'a> {
     pub budget: &'a std::cell::Cell<u64>,
 }
 
-fn attr_path(base: &str, name: &str) -> String {
+pub(super) fn attr_path(base: &str, name: &str) -> String {
     format!("{base}.attributes[\"{name}\"]")
-}
-
-/// POSITION with `KHR_mesh_quantization`: float, or 8/16-bit integers, normalized or not.
-const POSITION_QUANTIZED: &[(DataType, bool)] = &[
-    (DataType::F32, false),
-    (DataType::I8, false),
-    (DataType::I8, true),
-    (DataType::U8, false),
-    (DataType::U8, true),
-    (DataType::I16, false),
-    (DataType::I16, true),
-    (DataType::U16, false),
-    (DataType::U16, true),
-];
-
-/// What the RC allows per attribute: (dims, allowed (type, normalized) pairs).
-fn allowed(name: &str) -> (usize, &'static [(DataType, bool)]) {
-    use DataType::*;
-    match name {
-        "ROTATION" => (4, &[(F32, false), (I8, true), (I16, true)]),
-        "SCALE" => (
-            3,
-            &[
-                (F32, false),
-                (U8, false),
-                (U8, true),
-                (U16, false),
-                (U16, true),
-            ],
-        ),
-        "OPACITY" => (1, &[(F32, false), (U8, true), (U16, true)]),
-        _ => (3, &[(F32, false)]), // SH
-    }
 }
 
 /// Reads and checks one primitive. Returns `None` after a blocking finding.
@@ -82,15 +50,15 @@ pub fn read(
 ) -> Option<LocalSplats> {
     check_primitive(&ctx.path, prim, f);
     let attrs = fetch(ctx, prim, f)?;
-    check_types_and_counts(ctx, &attrs, f)?;
-    let degree = sh_degree(&ctx.path, &attrs.higher, f);
-    let log = scale_space(ctx, &attrs.scale, f)?;
-    check_opacity(&ctx.path, &attrs.opacity, f)?;
+    rules::check_types_and_counts(ctx, &attrs, f)?;
+    let degree = rules::sh_degree(&ctx.path, &attrs.higher, f);
+    let log = rules::scale_space(ctx, &attrs.scale, f)?;
+    rules::check_opacity(&ctx.path, &attrs.opacity, f)?;
     assemble(ctx, &attrs, meta, degree, log, f)
 }
 
 /// The attribute semantic as written in the file.
-fn semantic(name: &str) -> String {
+pub(super) fn semantic(name: &str) -> String {
     if name == "POSITION" || name == "COLOR_0" {
         name.to_owned()
     } else {
@@ -99,16 +67,16 @@ fn semantic(name: &str) -> String {
 }
 
 /// The primitive's attributes, decoded; the required ones are there.
-struct Attributes {
-    position: Decoded,
-    rotation: Decoded,
-    scale: Decoded,
-    opacity: Decoded,
-    sh0: Option<Decoded>,
+pub(super) struct Attributes {
+    pub position: Decoded,
+    pub rotation: Decoded,
+    pub scale: Decoded,
+    pub opacity: Decoded,
+    pub sh0: Option<Decoded>,
     /// Read only without `SH_DEGREE_0_COEF_0` (the RC's fallback).
-    color0: Option<Decoded>,
+    pub color0: Option<Decoded>,
     /// Degrees 1..=3, coefficient by coefficient (`None`: absent).
-    higher: Vec<Vec<Option<Decoded>>>,
+    pub higher: Vec<Vec<Option<Decoded>>>,
 }
 
 /// Mode and material: the primitive's own properties.
@@ -220,194 +188,6 @@ fn fetch(ctx: &Ctx, prim: &Value, f: &mut Vec<Finding>) -> Option<Attributes> {
         color0,
         higher,
     })
-}
-
-/// An attribute to check: its path, its data, the components and the (type, normalized) pairs
-/// the RC allows.
-type Check<'d> = (String, &'d Decoded, usize, &'static [(DataType, bool)]);
-
-/// Component counts, element counts, component types, alignment and finiteness of every
-/// attribute. `None` after a blocking finding.
-fn check_types_and_counts(ctx: &Ctx, a: &Attributes, f: &mut Vec<Finding>) -> Option<()> {
-    let path = &ctx.path;
-    let n = a.position.count();
-    let position_types: &[(DataType, bool)] = if ctx.quantization {
-        POSITION_QUANTIZED
-    } else {
-        &[(DataType::F32, false)]
-    };
-    let mut typed: Vec<Check> = vec![(attr_path(path, "POSITION"), &a.position, 3, position_types)];
-    for (name, d) in [
-        ("ROTATION", &a.rotation),
-        ("SCALE", &a.scale),
-        ("OPACITY", &a.opacity),
-    ] {
-        let (dims, ok) = allowed(name);
-        typed.push((attr_path(path, &semantic(name)), d, dims, ok));
-    }
-    if let Some(s) = &a.sh0 {
-        typed.push((
-            attr_path(path, &semantic("SH_DEGREE_0_COEF_0")),
-            s,
-            3,
-            allowed("SH").1,
-        ));
-    }
-    for (l, coefs) in a.higher.iter().enumerate() {
-        for (c, d) in coefs.iter().enumerate() {
-            if let Some(d) = d {
-                let p = attr_path(path, &format!("{PREFIX}SH_DEGREE_{}_COEF_{c}", l + 1));
-                typed.push((p, d, 3, allowed("SH").1));
-            }
-        }
-    }
-    let mut blocked = false;
-    for (p, d, dims, ok) in &typed {
-        if d.dims != *dims {
-            f.push(Finding::fatal(
-                p.clone(),
-                format!("expected {dims} components, found {}", d.dims),
-            ));
-            blocked = true;
-        } else if d.count() != n {
-            f.push(Finding::fatal(
-                p.clone(),
-                format!("count {} differs from POSITION's count {n}", d.count()),
-            ));
-            blocked = true;
-        } else if !ok.is_empty() && !ok.contains(&(d.component, d.normalized)) {
-            // Signed SCALE is the review draft's log space: reported by the scale-space check,
-            // unless the caller insists on linear.
-            let is_legacy_scale = p.ends_with("SCALE\"]")
-                && matches!(d.component, DataType::I8 | DataType::I16)
-                && ctx.scale_space != ScaleSpace::Linear;
-            if !is_legacy_scale {
-                f.push(Finding::error(
-                    p.clone(),
-                    format!(
-                        "component type {} is not allowed by the RC",
-                        component_name(d.component, d.normalized)
-                    ),
-                ));
-            }
-        }
-        if let Some(m) = &d.misaligned {
-            f.push(Finding::error(p.clone(), format!("glTF 2.0 layout: {m}")));
-        }
-        if let Some(i) = d.data.iter().position(|v| !v.is_finite()) {
-            f.push(Finding::fatal(p.clone(), "value is not finite").at((i / d.dims) as u64));
-            blocked = true;
-        }
-    }
-    if let Some(c) = &a.color0
-        && (c.count() != n || !(c.dims == 3 || c.dims == 4))
-    {
-        f.push(Finding::fatal(
-            attr_path(path, "COLOR_0"),
-            "COLOR_0 must be VEC3/VEC4 with POSITION's count",
-        ));
-        blocked = true;
-    }
-    (!blocked).then_some(())
-}
-
-/// The highest complete SH degree with every lower degree complete; incomplete degrees are
-/// reported and not used.
-fn sh_degree(path: &str, higher: &[Vec<Option<Decoded>>], f: &mut Vec<Finding>) -> u8 {
-    let mut degree = 0u8;
-    for (l, coefs) in higher.iter().enumerate() {
-        let present = coefs.iter().filter(|c| c.is_some()).count();
-        if present == 0 {
-            break;
-        }
-        if present < coefs.len() || degree as usize != l {
-            f.push(Finding::error(
-                format!("{path}.attributes"),
-                format!(
-                    "SH degree {} is partially defined ({present} of {} coefficients); using degree {degree}",
-                    l + 1,
-                    coefs.len()
-                ),
-            ));
-            break;
-        }
-        degree = l as u8 + 1;
-    }
-    for (l, coefs) in higher.iter().enumerate().skip(degree as usize) {
-        if coefs.iter().any(Option::is_some) && l > degree as usize {
-            f.push(Finding::error(
-                format!("{path}.attributes"),
-                format!(
-                    "SH degree {} is present but a lower degree is incomplete",
-                    l + 1
-                ),
-            ));
-        }
-    }
-    degree
-}
-
-/// Whether SCALE is read in log space (the review draft) rather than linear (the RC), by the
-/// option or, under `auto`, by signed types or negative values. `None` after a blocking finding.
-fn scale_space(ctx: &Ctx, scale: &Decoded, f: &mut Vec<Finding>) -> Option<bool> {
-    let scale_path = attr_path(&ctx.path, &semantic("SCALE"));
-    let signed = matches!(scale.component, DataType::I8 | DataType::I16);
-    let first_negative = scale
-        .data
-        .iter()
-        .position(|v| *v < 0.0)
-        .map(|i| (i / 3) as u64);
-    let log = match ctx.scale_space {
-        ScaleSpace::Log => true,
-        ScaleSpace::Linear => {
-            if let Some(i) = first_negative {
-                f.push(Finding::fatal(&scale_path, "scale MUST NOT be negative").at(i));
-                return None;
-            }
-            false
-        }
-        ScaleSpace::Auto => signed || first_negative.is_some(),
-    };
-    if log && ctx.scale_space == ScaleSpace::Auto {
-        let why = if signed {
-            format!(
-                "signed component type ({})",
-                component_name(scale.component, scale.normalized)
-            )
-        } else {
-            "negative values".to_owned()
-        };
-        let mut fd = Finding::error(
-            &scale_path,
-            format!(
-                "legacy draft: log-space scale ({why}); read as exp(v). RC scales are linear and MUST NOT be negative"
-            ),
-        );
-        if let (false, Some(i)) = (signed, first_negative) {
-            fd = fd.at(i);
-        }
-        f.push(fd);
-    }
-    Some(log)
-}
-
-/// Opacity in [0, 1] (with a rounding tolerance). `None` after a blocking finding.
-fn check_opacity(path: &str, opacity: &Decoded, f: &mut Vec<Finding>) -> Option<()> {
-    let Some(i) = opacity
-        .data
-        .iter()
-        .position(|v| !(-1e-6..=1.0 + 1e-6).contains(v))
-    else {
-        return Some(());
-    };
-    f.push(
-        Finding::fatal(
-            attr_path(path, &semantic("OPACITY")),
-            format!("opacity {} is outside [0, 1]", opacity.data[i]),
-        )
-        .at(i as u64),
-    );
-    None
 }
 
 /// Builds the local cloud: quaternions normalised (unit within a tolerance that allows for the
