@@ -2,22 +2,13 @@
 use splatgl::cloud::{ColorSpace, Kernel, Projection, SortingMethod};
 use std::process::ExitCode;
 
-/// Arguments of `info`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// The file (.gltf, .glb or .ply).
-    pub file: std::path::PathBuf,
-    /// Print JSON (keys: format, splat_count, sh_degree, color_space, kernel, projection,
-    /// sorting_method, bounds_min, bounds_max, scale_space, non_unit_quaternions,
-    /// memory_bytes, warnings).
-    #[arg(long)]
-    pub json: bool,
-    #[command(flatten)]
-    pub load: super::LoadArgs,
-}
+/// Help of `info --json`.
+pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
+    kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
+    non_unit_quaternions, memory_bytes, warnings)";
 
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
-pub fn run(a: Args) -> ExitCode {
+pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
     let loaded = match splatgl::load::load_path(&a.file, &opts) {
         Ok(l) => l,

@@ -21,16 +21,31 @@ pub struct Cli {
 enum Command {
     /// Print what a splat file holds: format, count, SH degree, colour space, bounds, warnings.
     /// Exit status: 0, or 2 when the file cannot be loaded.
-    Info(info::Args),
+    #[command(mut_arg("json", |a| a.help(info::JSON_HELP)))]
+    Info(FileArgs),
     /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
-    Validate(validate::Args),
+    #[command(mut_arg("json", |a| a.help(validate::JSON_HELP)))]
+    #[command(mut_arg("file", |a| a.help("The file to check (.gltf, .glb or .ply)")))]
+    Validate(FileArgs),
     /// Render an image (without a scene: the bundled default scene).
     /// Exit status: 0, or 2 on any error (message on stderr).
     Render(render::Args),
     /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
     /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
     Compare(compare::Args),
+}
+
+/// The arguments of `info` and `validate`: one file, read with the loader options.
+#[derive(clap::Args, Debug)]
+pub struct FileArgs {
+    /// The file (.gltf, .glb or .ply).
+    pub file: std::path::PathBuf,
+    /// Print JSON (each command lists its keys).
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub load: LoadArgs,
 }
 
 /// Loader options shared by every command that reads a scene.

@@ -1,21 +1,12 @@
 //! `splatgl validate FILE [--json]`.
 use std::process::ExitCode;
 
-/// Arguments of `validate`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// The file to check (.gltf, .glb or .ply).
-    pub file: std::path::PathBuf,
-    /// Print the findings as JSON (keys: file, format, status, valid, errors, warnings,
-    /// splat_count, findings[{severity, path, message, index}]).
-    #[arg(long)]
-    pub json: bool,
-    #[command(flatten)]
-    pub load: super::LoadArgs,
-}
+/// Help of `validate --json`.
+pub const JSON_HELP: &str = "Print the findings as JSON (keys: file, format, status, valid, \
+    errors, warnings, splat_count, findings[{severity, path, message, index}])";
 
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
-pub fn run(a: Args) -> ExitCode {
+pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
     let report = splatgl::load::validate::validate_path(&a.file, &opts);
     if a.json {

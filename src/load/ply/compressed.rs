@@ -142,23 +142,22 @@ struct Fields {
 impl Fields {
     fn find(chunks: &Columns, verts: &Columns) -> Result<Self, PlyError> {
         let f = |name: &str| chunks.find("chunk", name, Scalar::F32);
-        let six = |names: [&str; 6]| -> Result<[usize; 6], PlyError> {
-            let mut out = [0; 6];
-            for (o, n) in out.iter_mut().zip(names) {
-                *o = f(n)?;
-            }
-            Ok(out)
+        let six = |infix: &str, axes: [&str; 3]| -> [String; 6] {
+            std::array::from_fn(|i| {
+                let side = if i < 3 { "min" } else { "max" };
+                format!("{side}_{infix}{}", axes[i % 3])
+            })
         };
-        let bounds = six(["min_x", "min_y", "min_z", "max_x", "max_y", "max_z"])?;
-        let scales = six([
-            "min_scale_x",
-            "min_scale_y",
-            "min_scale_z",
-            "max_scale_x",
-            "max_scale_y",
-            "max_scale_z",
-        ])?;
-        let colours = ["min_r", "min_g", "min_b", "max_r", "max_g", "max_b"].map(|c| f(c).ok());
+        let (xyz, rgb) = (["x", "y", "z"], ["r", "g", "b"]);
+        let mut bounds = [0; 6];
+        let mut scales = [0; 6];
+        for (o, n) in bounds.iter_mut().zip(six("", xyz)) {
+            *o = f(&n)?;
+        }
+        for (o, n) in scales.iter_mut().zip(six("scale_", xyz)) {
+            *o = f(&n)?;
+        }
+        let colours = six("", rgb).map(|c| f(&c).ok());
         let u = |name: &str| verts.find("vertex", name, Scalar::U32);
         let packed = [
             u("packed_position")?,
