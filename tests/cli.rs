@@ -139,3 +139,52 @@ fn backends_agree_on_linear_colour_space() {
         "{px:?}"
     );
 }
+
+/// `render --gltf-camera N` takes the view from the N-th camera node of the file it loaded:
+/// the image equals the reference render from that camera, and a missing index is an error
+/// that says how many cameras there are.
+#[test]
+fn render_takes_the_view_from_a_gltf_camera_node() {
+    use base64::Engine;
+    let cloud = common::random_cloud(7, 200, 1);
+    let (mut doc, bin) = splatgl::write::build(&cloud, &Default::default());
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"camera": 0, "translation": [0.3, 0.2, 6.0]}));
+    doc["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    doc["cameras"] = serde_json::json!([{"type": "perspective",
+        "perspective": {"yfov": 0.7, "znear": 0.1, "aspectRatio": 1.5}}]);
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    doc["buffers"][0]["uri"] = format!("data:application/octet-stream;base64,{b64}").into();
+    let scene = tmp("cam.gltf", &serde_json::to_vec(&doc).unwrap());
+    let out = tmp("cam.pfm", b"");
+    let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let args = ["render", s, "--gltf-camera", "0", "--backend", "reference"];
+    let (code, _, err) = splatgl(&[&args[..], &["--height", "40", "-o", o]].concat());
+    assert_eq!(code, 0, "{err}");
+    let img = splatgl::image::Image::read(&out).unwrap();
+    assert_eq!(
+        (img.width, img.height),
+        (60, 40),
+        "width from the aspect ratio"
+    );
+
+    let loaded = splatgl::load::load_path(&scene, &Default::default()).unwrap();
+    assert_eq!(loaded.cameras.len(), 1);
+    let cam = splatgl::camera::Camera::from_gltf(&loaded.cameras[0], 60, 40).unwrap();
+    let want = splatgl::reference::render(&loaded.cloud, &cam, &Default::default());
+    let rgb = |p: &[f32; 4]| [p[0], p[1], p[2]];
+    assert!(
+        want.pixels.iter().any(|p| p[3] > 0.0),
+        "the camera sees the splats"
+    );
+    assert!(
+        img.pixels.iter().map(rgb).eq(want.pixels.iter().map(rgb)),
+        "same image as the reference from that camera"
+    );
+
+    let (code, _, err) = splatgl(&[&args[..2], &["--gltf-camera", "1", "-o", o]].concat());
+    assert_eq!(code, 2);
+    assert!(err.contains("1 perspective camera node"), "{err}");
+}

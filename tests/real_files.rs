@@ -204,3 +204,27 @@ fn other_splat_formats_are_named_not_unknown() {
         );
     }
 }
+
+/// `validate` and `load` read a file with the same readers: for every real file that loads,
+/// validate lists exactly the findings of the load report, in the same order.
+#[test]
+fn validate_lists_the_findings_of_the_load_report() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!("skipping: {} not found", dir.display());
+        return;
+    };
+    let mut compared = 0;
+    for e in entries {
+        let p = e.unwrap().path();
+        let Ok(l) = load_path(&p, &LoadOptions::default()) else {
+            continue;
+        };
+        let v = validate_path(&p, &LoadOptions::default());
+        assert_eq!(v.findings, l.report.findings, "{}", p.display());
+        assert_eq!(v.splat_count, Some(l.cloud.len()), "{}", p.display());
+        compared += 1;
+    }
+    // SOURCES.md lists nine glTF/PLY files splatgl reads.
+    assert!(compared >= 9, "only {compared} real files load");
+}

@@ -148,10 +148,12 @@ pub fn load_bytes(
 }
 
 /// Why a reader stopped, before the file name is attached (see [`LoadError`]).
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub(crate) enum ReadError {
-    Ply(ply::PlyError),
-    Gltf(gltf::GltfError),
+    #[error(transparent)]
+    Ply(#[from] ply::PlyError),
+    #[error(transparent)]
+    Gltf(#[from] gltf::GltfError),
 }
 
 impl ReadError {
@@ -171,17 +173,11 @@ impl ReadError {
     }
 }
 
-impl std::fmt::Display for ReadError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ReadError::Ply(e) => e.fmt(f),
-            ReadError::Gltf(e) => e.fmt(f),
-        }
-    }
-}
-
 /// The readers, one arm per format. Each fills `report` (findings, scale space, non-unit
 /// quaternions) and returns the cloud and the cameras the file defines.
+///
+/// A new format is a [`Format`] variant (with its magic bytes and extensions), a reader here,
+/// and a [`ReadError`] / [`LoadError`] variant for the reader's error type.
 pub(crate) fn read(
     format: Format,
     bytes: &[u8],
@@ -189,14 +185,10 @@ pub(crate) fn read(
     opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Result<(SplatCloud, Vec<GltfPerspective>), ReadError> {
-    match format {
-        Format::Ply => ply::read(bytes, report)
-            .map(|cloud| (cloud, Vec::new()))
-            .map_err(ReadError::Ply),
-        Format::Gltf | Format::Glb => {
-            gltf::read(bytes, format, path, opts, report).map_err(ReadError::Gltf)
-        }
-    }
+    Ok(match format {
+        Format::Ply => (ply::read(bytes, report)?, Vec::new()),
+        Format::Gltf | Format::Glb => gltf::read(bytes, format, path, opts, report)?,
+    })
 }
 
 /// Normalises a quaternion `[x, y, z, w]`; returns it and whether it was off unit length by

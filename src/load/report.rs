@@ -73,3 +73,40 @@ impl LoadReport {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warning_lines_keep_the_info_json_form() {
+        let mut r = LoadReport::new(Format::Glb);
+        r.findings.push(Finding::error("meshes[0]", "bad").at(3));
+        r.findings.push(Finding::warning("", "whole file"));
+        r.findings.push(Finding::warning("vertex.rot_0..3", "odd"));
+        assert_eq!(
+            r.warning_lines(),
+            [
+                "meshes[0] [index 3]: invalid per KHR_gaussian_splatting RC / glTF 2.0: bad",
+                "whole file",
+                "vertex.rot_0..3: odd",
+            ]
+        );
+    }
+
+    #[test]
+    fn summarized_warnings_merge_repeats_of_one_severity_in_first_seen_order() {
+        let mut r = LoadReport::new(Format::Gltf);
+        r.findings.push(Finding::warning("nodes[0]", "undefined"));
+        r.findings.push(Finding::error("nodes[1]", "undefined"));
+        r.findings.push(Finding::warning("nodes[2]", "undefined"));
+        r.findings.push(Finding::warning("nodes[3]", "undefined"));
+        assert_eq!(
+            r.summarized_warnings(),
+            [
+                "nodes[0]: undefined (and 2 more like it)",
+                "nodes[1]: invalid per KHR_gaussian_splatting RC / glTF 2.0: undefined",
+            ]
+        );
+    }
+}
