@@ -78,12 +78,20 @@ impl LoadReport {
 mod tests {
     use super::*;
 
+    fn report(findings: Vec<Finding>) -> LoadReport {
+        LoadReport {
+            findings,
+            ..LoadReport::new(Format::Glb)
+        }
+    }
+
     #[test]
     fn warning_lines_keep_the_info_json_form() {
-        let mut r = LoadReport::new(Format::Glb);
-        r.findings.push(Finding::error("meshes[0]", "bad").at(3));
-        r.findings.push(Finding::warning("", "whole file"));
-        r.findings.push(Finding::warning("vertex.rot_0..3", "odd"));
+        let r = report(vec![
+            Finding::error("meshes[0]", "bad").at(3),
+            Finding::warning("", "whole file"),
+            Finding::warning("vertex.rot_0..3", "odd"),
+        ]);
         assert_eq!(
             r.warning_lines(),
             [
@@ -96,11 +104,15 @@ mod tests {
 
     #[test]
     fn summarized_warnings_merge_repeats_of_one_severity_in_first_seen_order() {
-        let mut r = LoadReport::new(Format::Gltf);
-        r.findings.push(Finding::warning("nodes[0]", "undefined"));
-        r.findings.push(Finding::error("nodes[1]", "undefined"));
-        r.findings.push(Finding::warning("nodes[2]", "undefined"));
-        r.findings.push(Finding::warning("nodes[3]", "undefined"));
+        // nodes[1] says the same as the others, but as an error.
+        let r = report(
+            (0..4)
+                .map(|i| match i {
+                    1 => Finding::error(format!("nodes[{i}]"), "undefined"),
+                    _ => Finding::warning(format!("nodes[{i}]"), "undefined"),
+                })
+                .collect(),
+        );
         assert_eq!(
             r.summarized_warnings(),
             [
