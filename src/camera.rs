@@ -20,7 +20,9 @@
 use glam::{DMat3, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
 
 mod json;
-pub use json::{CamerasJsonEntry, load_cameras_json, parse_cameras_json};
+pub use json::{
+    CamerasJsonEntry, load_cameras_json, load_cameras_json_limited, parse_cameras_json,
+};
 
 /// Why a camera could not be built.
 #[derive(Debug, thiserror::Error)]

@@ -13,6 +13,7 @@ pub mod cloud;
 pub mod color;
 pub mod compare;
 pub mod covariance;
+pub mod files;
 #[cfg(feature = "gl")]
 pub mod gl;
 #[cfg(feature = "gl")]

@@ -118,10 +118,19 @@ fn external_buffer_must_be_a_regular_file() {
     let bytes = doc_with(|d, _| d["buffers"][0]["uri"] = json!("/dev/zero"));
     let p = dir.join("z.gltf");
     std::fs::write(&p, &bytes).unwrap();
+    // Outside the folder: refused by the containment rule; allowed, it is still a device.
     let e = splatgl::load::load_path(&p, &LoadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("not a regular file"), "{e}");
+    assert!(e.contains("absolute path"), "{e}");
+    let outside = LoadOptions {
+        allow_outside_paths: true,
+        ..LoadOptions::default()
+    };
+    let e = splatgl::load::load_path(&p, &outside)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("character device"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -136,11 +145,49 @@ fn log_scale_overflow_and_transform_overflow() {
         b[o..o + 4].copy_from_slice(&(-1.0f32).to_le_bytes()); // makes it log space
         b[o + 4..o + 8].copy_from_slice(&100.0f32.to_le_bytes());
     });
-    assert!(load_err(&bytes).contains("overflows"));
+    // The overflowing splat is dropped and named; in strict mode the load fails.
+    let l = load_bytes(&bytes, Some(Path::new("h.gltf")), &LoadOptions::default()).unwrap();
+    assert_eq!(l.cloud.len(), 7);
+    let w = l.report.warning_lines().join("\n");
+    assert!(w.contains("SCALE\"] [index 0]: invalid per KHR_gaussian_splatting RC / glTF 2.0: exp(log-space scale) overflows f32; 1 splat dropped"), "{w}");
+    assert!(load_strict_err(&bytes).contains("overflow"));
     let huge = doc_with(|d, _| {
         d["nodes"][0]["matrix"] = json!([1e38, 0, 0, 0, 0, 1e38, 0, 0, 0, 0, 1e38, 0, 0, 0, 0, 1])
     });
-    assert!(load_err(&huge).contains("non-finite"));
+    let l = load_bytes(&huge, Some(Path::new("h.gltf")), &LoadOptions::default()).unwrap();
+    assert!(l.cloud.is_empty() && l.cloud.validate().is_ok());
+    let w = l.report.warning_lines().join("\n");
+    // Each splat goes with the first field that broke (positions of 1e38 × 5 overflow f32).
+    let dropped: usize = l
+        .report
+        .findings
+        .iter()
+        .filter(|f| f.path == "nodes[0]" && f.message.contains("under this node's transform"))
+        .map(|f| {
+            f.message
+                .split(" splat")
+                .next()
+                .unwrap()
+                .rsplit(' ')
+                .next()
+                .unwrap()
+                .parse::<usize>()
+                .unwrap()
+        })
+        .sum();
+    assert_eq!(dropped, 8, "{w}");
+    assert!(load_strict_err(&huge).contains("strict mode"));
+}
+
+fn load_strict_err(bytes: &[u8]) -> String {
+    let strict = LoadOptions {
+        strict: true,
+        ..LoadOptions::default()
+    };
+    match load_bytes(bytes, Some(Path::new("h.gltf")), &strict) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e.to_string(),
+    }
 }
 
 #[test]

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 /// Help of `info --json`.
 pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
     kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
-    non_unit_quaternions, memory_bytes, warnings)";
+    non_unit_quaternions, memory_bytes, warnings; with -v also limits)";
 
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
 pub fn run(a: super::FileArgs) -> ExitCode {
@@ -20,7 +20,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     let c = &loaded.cloud;
     let r = &loaded.report;
     let b = c.bounds();
-    let info = serde_json::json!({
+    let mut info = serde_json::json!({
         "file": a.file.display().to_string(),
         "format": r.format.name(),
         "splat_count": c.len(),
@@ -36,6 +36,14 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "memory_bytes": c.memory_bytes(),
         "warnings": r.warning_lines(),
     });
+    let limits = opts.limits.entries();
+    if a.verbose {
+        let map: serde_json::Map<_, _> = limits
+            .iter()
+            .map(|&(k, v)| (k.to_owned(), serde_json::json!(v)))
+            .collect();
+        info["limits"] = serde_json::Value::Object(map);
+    }
     if a.json {
         println!("{info:#}");
         return ExitCode::SUCCESS;
@@ -61,6 +69,12 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "memory:         {:.1} MiB",
         c.memory_bytes() as f64 / 1048576.0
     );
+    if a.verbose {
+        println!("limits:");
+        for (k, v) in limits {
+            println!("  {k:<24}{v}");
+        }
+    }
     for w in r.summarized_warnings() {
         println!("warning: {w}");
     }

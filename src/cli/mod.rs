@@ -1,6 +1,7 @@
 //! Command-line interface: one file per subcommand.
 
 use clap::{Parser, Subcommand};
+use splatgl::load::Limits;
 use std::process::ExitCode;
 
 mod compare;
@@ -27,6 +28,7 @@ enum Command {
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
     #[command(mut_arg("json", |a| a.help(validate::JSON_HELP)))]
     #[command(mut_arg("file", |a| a.help("The file to check (.gltf, .glb or .ply)")))]
+    #[command(mut_arg("verbose", |a| a.hide(true)))]
     Validate(FileArgs),
     /// Render an image (without a scene: the bundled default scene).
     /// Exit status: 0, or 2 on any error (message on stderr).
@@ -44,6 +46,9 @@ pub struct FileArgs {
     /// Print JSON (each command lists its keys).
     #[arg(long)]
     pub json: bool,
+    /// Also print the loader's limits (`limits` in JSON).
+    #[arg(short, long)]
+    pub verbose: bool,
     #[command(flatten)]
     pub load: LoadArgs,
 }
@@ -55,6 +60,34 @@ pub struct LoadArgs {
     /// draft's log space), linear (RC) or log.
     #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
     pub scale_space: splatgl::load::ScaleSpace,
+    /// Fail on a splat with a non-finite or overflowing value instead of dropping it.
+    #[arg(long)]
+    pub strict: bool,
+    /// Let external glTF buffers lie outside the asset's folder (absolute paths, `..`,
+    /// symlinks pointing out). Only for files you trust.
+    #[arg(long)]
+    pub allow_outside_paths: bool,
+    /// Most splats a scene may hold.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT_MAX_SPLATS)]
+    pub max_splats: u64,
+    /// Most bytes read from files for one scene (scene file and external buffers; also
+    /// cameras.json). Plain bytes or with a K, M or G suffix (powers of 1024).
+    #[arg(long, value_name = "BYTES", default_value = "4G", value_parser = parse_bytes)]
+    pub max_bytes: u64,
+}
+
+/// `123`, `64K`, `512M`, `4G` (binary multiples).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let (num, shift) = match s.char_indices().last() {
+        Some((i, 'k' | 'K')) => (&s[..i], 10),
+        Some((i, 'm' | 'M')) => (&s[..i], 20),
+        Some((i, 'g' | 'G')) => (&s[..i], 30),
+        _ => (s, 0),
+    };
+    num.parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1 << shift))
+        .ok_or_else(|| format!("expected a byte count like 1048576, 64K, 512M or 4G, found {s:?}"))
 }
 
 impl LoadArgs {
@@ -62,6 +95,14 @@ impl LoadArgs {
     pub fn options(&self) -> splatgl::load::LoadOptions {
         splatgl::load::LoadOptions {
             scale_space: self.scale_space,
+            strict: self.strict,
+            allow_outside_paths: self.allow_outside_paths,
+            resolver: None,
+            limits: Limits {
+                max_splats: self.max_splats,
+                max_bytes: self.max_bytes,
+                ..Limits::default()
+            },
         }
     }
 }

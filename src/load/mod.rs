@@ -7,22 +7,32 @@
 //!
 //! Every failure is a [`LoadError`] naming the file, the element, the index and what was
 //! expected. No input panics, and sizes claimed by headers are checked against the bytes that
-//! are really there before anything is allocated.
+//! are really there, and against [`Limits`], before anything is allocated.
+//!
+//! Files are read only when they are regular files within [`Limits::max_bytes`]
+//! ([`crate::files`]); external glTF buffers only inside the asset's folder (unless
+//! [`LoadOptions::allow_outside_paths`]) or through [`LoadOptions::resolver`]. No splat with a
+//! non-finite or overflowing value leaves a loader (`hygiene.rs`): such splats are dropped with
+//! a finding, or fail the load in [`LoadOptions::strict`] mode.
 
 mod finding;
 mod format;
 pub mod gltf;
+pub(crate) mod hygiene;
+mod limits;
 pub mod ply;
 mod report;
 pub mod validate;
 
 pub use finding::{Finding, Severity};
 pub use format::{Format, detect_format};
+pub use limits::{LimitExceeded, Limits, check_json_depth};
 pub use report::{LoadReport, ScaleSeen};
 
 use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// How `KHR_gaussian_splatting:SCALE` values are to be read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -49,11 +59,41 @@ impl std::str::FromStr for ScaleSpace {
     }
 }
 
+/// Serves the bytes of an external glTF buffer named by its URI (as written in the file, not
+/// percent-decoded), like the `gltf` crate's data-source closure. An `Err` message becomes the
+/// finding of that buffer.
+pub type Resolver = Arc<dyn Fn(&str) -> Result<Vec<u8>, String> + Send + Sync>;
+
 /// Options for all loaders.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Clone, Default)]
 pub struct LoadOptions {
     /// How glTF SCALE values are read (PLY scales are always log, as INRIA writes them).
     pub scale_space: ScaleSpace,
+    /// A splat with a non-finite or overflowing value fails the load (a [`LoadError`] naming
+    /// the field, the element and the index) instead of being dropped with a warning.
+    pub strict: bool,
+    /// Let external buffer URIs leave the asset's folder (absolute paths, `..`, symlinks
+    /// pointing outside). Off by default: a file from the internet must not make splatgl read
+    /// the rest of the disk.
+    pub allow_outside_paths: bool,
+    /// Serves external (non-`data:`) glTF buffers instead of the file system; with it, no file
+    /// is opened for buffers and `load_bytes` needs no path. The embedder's resolver is its own
+    /// policy: the containment rule does not apply to it, the byte limits do.
+    pub resolver: Option<Resolver>,
+    /// Resource limits.
+    pub limits: Limits,
+}
+
+impl std::fmt::Debug for LoadOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LoadOptions")
+            .field("scale_space", &self.scale_space)
+            .field("strict", &self.strict)
+            .field("allow_outside_paths", &self.allow_outside_paths)
+            .field("resolver", &self.resolver.as_ref().map(|_| "Fn(&str)"))
+            .field("limits", &self.limits)
+            .finish()
+    }
 }
 
 /// A loaded file: the splats, the cameras it defines, and what the loader noticed.
@@ -112,20 +152,45 @@ pub enum LoadError {
         /// What.
         source: gltf::GltfError,
     },
+    /// A [`Limits`] bound was exceeded.
+    #[error("{path}: {source}")]
+    Limit {
+        /// The file.
+        path: PathBuf,
+        /// Which limit, by how much.
+        source: LimitExceeded,
+    },
+    /// In strict mode: a splat with a non-finite or overflowing value.
+    #[error("{path}: {finding}")]
+    Unusable {
+        /// The file.
+        path: PathBuf,
+        /// Where, which field, which index.
+        finding: Finding,
+    },
 }
 
 /// Loads a file of any supported format.
 pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, LoadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let bytes = read_scene_file(path, opts)?;
     load_bytes(&bytes, Some(path), opts)
 }
 
+/// Reads a scene file: a regular file within `limits.max_bytes`.
+pub(crate) fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<Vec<u8>, LoadError> {
+    crate::files::read_bounded(path, opts.limits.max_bytes, "the scene file").map_err(|source| {
+        LoadError::Io {
+            path: path.to_owned(),
+            source,
+        }
+    })
+}
+
 /// Loads from memory. `path` names the file in errors, helps detect the format, and resolves
-/// external glTF buffers (without it, only GLB and data-URI buffers can be read).
+/// external glTF buffers (without it, only GLB and data-URI buffers can be read, or those
+/// [`LoadOptions::resolver`] serves). External buffers read from files count against
+/// `limits.max_bytes`; `bytes` themselves do not.
 pub fn load_bytes(
     bytes: &[u8],
     path: Option<&Path>,
@@ -154,13 +219,21 @@ pub(crate) enum ReadError {
     Ply(#[from] ply::PlyError),
     #[error(transparent)]
     Gltf(#[from] gltf::GltfError),
+    #[error(transparent)]
+    Limit(#[from] LimitExceeded),
+    #[error("{0}")]
+    Unusable(Finding),
 }
 
 impl ReadError {
     fn at(self, path: PathBuf) -> LoadError {
         match self {
+            ReadError::Ply(ply::PlyError::Limit(source)) | ReadError::Limit(source) => {
+                LoadError::Limit { path, source }
+            }
             ReadError::Ply(source) => LoadError::Ply { path, source },
             ReadError::Gltf(source) => LoadError::Gltf { path, source },
+            ReadError::Unusable(finding) => LoadError::Unusable { path, finding },
         }
     }
     /// Whether the file's framing could not be read at all (`validate`'s "unreadable").
@@ -177,7 +250,9 @@ impl ReadError {
 /// quaternions) and returns the cloud and the cameras the file defines.
 ///
 /// A new format is a [`Format`] variant (with its magic bytes and extensions), a reader here,
-/// and a [`ReadError`] / [`LoadError`] variant for the reader's error type.
+/// and a [`ReadError`] / [`LoadError`] variant for the reader's error type. Readers check
+/// `opts.limits` before allocating (`check_splats`, `check_decompressed`); the splat limit and
+/// the numeric hygiene pass below apply to every format whatever its reader does.
 pub(crate) fn read(
     format: Format,
     bytes: &[u8],
@@ -185,10 +260,22 @@ pub(crate) fn read(
     opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Result<(SplatCloud, Vec<GltfPerspective>), ReadError> {
-    Ok(match format {
-        Format::Ply => (ply::read(bytes, report)?, Vec::new()),
+    let (mut cloud, cameras) = match format {
+        Format::Ply => (ply::read(bytes, opts, report)?, Vec::new()),
         Format::Gltf | Format::Glb => gltf::read(bytes, format, path, opts, report)?,
-    })
+    };
+    opts.limits
+        .check_splats(cloud.len() as u64, "the loaded cloud")?;
+    let site = hygiene::Site {
+        path: "",
+        what: "",
+        severity: Severity::Warning,
+        strict: opts.strict,
+        origin: None,
+    };
+    hygiene::clean(&mut cloud, &site, &mut report.findings).map_err(ReadError::Unusable)?;
+    debug_assert!(cloud.validate().is_ok(), "{:?}", cloud.validate());
+    Ok((cloud, cameras))
 }
 
 /// Normalises a quaternion `[x, y, z, w]`; returns it and whether it was off unit length by

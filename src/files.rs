@@ -1,0 +1,129 @@
+//! Bounded reads of regular files: the one way splatgl reads a file from disk (scenes, external
+//! glTF buffers, `cameras.json`, images).
+//!
+//! A path is checked to be a regular file **before** it is opened for reading (so a FIFO cannot
+//! block the open, and `/dev/zero`, a directory or a socket fail at once), opened non-blocking,
+//! checked again on the open handle (the path may have been swapped in between), and its size
+//! is compared with the caller's limit before a byte is read. The read itself stops one byte past
+//! the limit, so a file that grows while being read cannot exceed it either.
+
+use std::fs::File;
+use std::io::{self, Read};
+use std::path::Path;
+
+/// What a non-regular file is, for the error message.
+fn kind_of(t: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a regular file"
+    }
+}
+
+fn not_regular(what: &str, t: std::fs::FileType) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!("{what} is {} (only regular files are read)", kind_of(t)),
+    )
+}
+
+/// Opens `path` for reading after checking it is a regular file, and returns the handle and
+/// the file's size. `what` names the file in errors ("scene", "external buffer", …).
+pub fn open_regular(path: &Path, what: &str) -> io::Result<(File, u64)> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(not_regular(what, meta.file_type()));
+    }
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // If the path became a FIFO after the check above, the open must not wait for a writer.
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let f = options.open(path)?;
+    let meta = f.metadata()?;
+    if !meta.is_file() {
+        return Err(not_regular(what, meta.file_type()));
+    }
+    Ok((f, meta.len()))
+}
+
+/// The error for a file larger than a limit. `flag` names what raises it.
+pub(crate) fn too_large(what: &str, size: u64, limit: u64, flag: &str) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!("{what} is {size} bytes, more than the limit of {limit} bytes ({flag})"),
+    )
+}
+
+/// Reads at most `limit` bytes of `file` into memory; more is an error.
+pub(crate) fn read_at_most(file: File, limit: u64, what: &str) -> io::Result<Vec<u8>> {
+    let mut data = Vec::new();
+    file.take(limit.saturating_add(1)).read_to_end(&mut data)?;
+    if data.len() as u64 > limit {
+        return Err(too_large(
+            what,
+            data.len() as u64,
+            limit,
+            "limits.max_bytes",
+        ));
+    }
+    Ok(data)
+}
+
+/// Reads a whole regular file of at most `limit` bytes. Directories, FIFOs, sockets and
+/// devices are errors before anything is read; so is a file whose size exceeds `limit`
+/// (checked before reading, and again while reading). `what` names the file in errors.
+pub fn read_bounded(path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> {
+    let (f, size) = open_regular(path, what)?;
+    if size > limit {
+        return Err(too_large(
+            what,
+            size,
+            limit,
+            "limits.max_bytes, --max-bytes",
+        ));
+    }
+    read_at_most(f, limit, what)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn devices_and_directories_are_refused_before_reading() {
+        let e = read_bounded(Path::new("/dev/zero"), 1 << 20, "scene").unwrap_err();
+        assert!(e.to_string().contains("character device"), "{e}");
+        let e = read_bounded(Path::new("/"), 1 << 20, "scene").unwrap_err();
+        assert!(e.to_string().contains("directory"), "{e}");
+    }
+
+    #[test]
+    fn size_is_checked_against_the_limit() {
+        let p = std::env::temp_dir().join(format!("splatgl-files-{}", std::process::id()));
+        std::fs::write(&p, [7u8; 100]).unwrap();
+        assert_eq!(read_bounded(&p, 100, "x").unwrap().len(), 100);
+        let e = read_bounded(&p, 99, "x").unwrap_err().to_string();
+        assert!(e.contains("100 bytes") && e.contains("99"), "{e}");
+        std::fs::remove_file(&p).ok();
+    }
+}
