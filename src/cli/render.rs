@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use splatgl::SplatCloud;
-use splatgl::camera::{Camera, GltfPerspective, load_cameras_json};
+use splatgl::camera::{Camera, GltfPerspective, load_cameras_json_limited};
 use splatgl::image::{Image, PngDepth};
 use splatgl::load::{Format, Scene};
 use splatgl::reference::{RenderOptions, SortMode};
@@ -147,7 +147,8 @@ fn camera(
         return Err(format!("--fov {} must be in (0, 180)", a.fov));
     }
     if let Some(path) = &a.camera {
-        let list = load_cameras_json(path).map_err(|e| e.to_string())?;
+        let limits = a.load.options().limits;
+        let list = load_cameras_json_limited(path, &limits).map_err(|e| e.to_string())?;
         let e = list.get(a.view).ok_or_else(|| {
             format!(
                 "--view {}: {} has {} views",
@@ -238,8 +239,30 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
     r.map_err(|e| e.to_string())
 }
 
+/// Refuses outputs that would replace an input (the scene or the cameras.json), before any
+/// work is done.
+fn check_outputs(a: &Args) -> Result<(), String> {
+    let inputs: Vec<&Path> = a
+        .scene
+        .iter()
+        .chain(&a.camera)
+        .map(PathBuf::as_path)
+        .collect();
+    let alpha = a.output.with_extension("alpha.pfm");
+    let mut outputs = vec![a.output.as_path()];
+    if a.alpha {
+        outputs.push(&alpha);
+    }
+    for out in outputs {
+        splatgl::write::refuse_overwriting_inputs(out, &inputs)
+            .map_err(|e| format!("{}: {e}", out.display()))?;
+    }
+    Ok(())
+}
+
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
+    check_outputs(a)?;
     let (cloud, format, cameras) = match &a.scene {
         Some(p) => {
             let s = load(p, a.load.options())?;
