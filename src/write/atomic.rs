@@ -69,6 +69,16 @@ pub fn write_atomic(
     refuse_overwriting_inputs(path, inputs)?;
     let tmp = temp_path(path)?;
     let file = OpenOptions::new().write(true).create_new(true).open(&tmp)?;
+    // Removes the temporary file on every way out but success, a panic in `fill` included.
+    struct Cleanup<'p>(&'p Path, bool);
+    impl Drop for Cleanup<'_> {
+        fn drop(&mut self) {
+            if !self.1 {
+                std::fs::remove_file(self.0).ok();
+            }
+        }
+    }
+    let mut cleanup = Cleanup(&tmp, false);
     let result = (|| {
         let mut w = BufWriter::new(file);
         fill(&mut w)?;
@@ -77,10 +87,8 @@ pub fn write_atomic(
         drop(file);
         std::fs::rename(&tmp, path)
     })();
-    if let Err(e) = result {
-        std::fs::remove_file(&tmp).ok();
-        return Err(e);
-    }
+    result?;
+    cleanup.1 = true;
     // Make the rename itself durable (best effort: not every platform can open a folder).
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     if let Ok(d) = File::open(dir.unwrap_or(Path::new("."))) {
