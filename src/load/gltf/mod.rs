@@ -371,6 +371,18 @@ fn cameras(
             continue;
         }
         if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+            let values = [p.yfov(), p.znear(), p.aspect_ratio().unwrap_or(1.0)];
+            let far_ok = p.zfar().is_none_or(f32::is_finite);
+            if !(values.iter().all(|v| v.is_finite()) && far_ok && m.as_mat4().is_finite()) {
+                findings.push(Finding::warning(
+                    format!("nodes[{}]", node.index()),
+                    format!(
+                        "cameras[{}] has a non-finite value or global transform; camera skipped",
+                        cam.index()
+                    ),
+                ));
+                continue;
+            }
             out.push(GltfPerspective {
                 yfov: p.yfov(),
                 aspect_ratio: p.aspect_ratio(),
