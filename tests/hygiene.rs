@@ -329,3 +329,34 @@ fn ply_rows_with_unusable_values_are_dropped_with_a_warning() {
     let e = strict_err(&bytes, "d.ply");
     assert!(e.contains("index 1") && e.contains("'y'"), "{e}");
 }
+
+#[test]
+fn cli_warns_about_dropped_splats_and_strict_fails() {
+    let mut bytes = to_inria_ply(&random_cloud(8, 3, 0));
+    let body = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    bytes[body + 4..body + 8].copy_from_slice(&f32::NAN.to_le_bytes()); // row 0, y
+    let p = std::env::temp_dir().join(format!("splatgl-hygiene-{}.ply", std::process::id()));
+    std::fs::write(&p, &bytes).unwrap();
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_splatgl"))
+            .args(args)
+            .arg(&p)
+            .output()
+            .unwrap();
+        let text =
+            String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+        (o.status.code(), text)
+    };
+    let (code, out) = run(&["info"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("splats:         2"), "{out}");
+    assert!(out.contains("warning: vertex.y [index 0]: position is not finite; 1 splat with unusable values dropped"), "{out}");
+    let (code, out) = run(&["info", "--strict"]);
+    assert_eq!(code, Some(2), "{out}");
+    assert!(out.contains("index 0") && out.contains("'y'"), "{out}");
+    std::fs::remove_file(&p).ok();
+}
