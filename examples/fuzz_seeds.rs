@@ -178,6 +178,8 @@ fn real_seeds(dir: &Path, real: &Path) {
             Some("ply") => "ply",
             Some("gltf") => "gltf_json",
             Some("glb") => "glb",
+            // Targets of the readers still to come take their seeds by their extension.
+            Some(ext @ ("spz" | "splat" | "ksplat" | "sog")) => ext,
             _ => continue,
         };
         if small && let Ok(bytes) = std::fs::read(&p) {

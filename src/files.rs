@@ -1,5 +1,5 @@
 //! Bounded reads of regular files: the one way splatgl reads a file from disk (scenes, external
-//! glTF buffers, `cameras.json`, images).
+//! glTF buffers, `cameras.json`, images); and the containment rule for files a document names.
 //!
 //! A path is checked to be a regular file **before** it is opened for reading (so a FIFO cannot
 //! block the open, and `/dev/zero`, a directory or a socket fail at once), opened non-blocking,
@@ -9,7 +9,7 @@
 
 use std::fs::File;
 use std::io::{self, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// What a non-regular file is, for the error message.
 fn kind_of(t: std::fs::FileType) -> &'static str {
@@ -105,9 +105,67 @@ pub fn read_bounded(path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> 
     read_at_most(f, limit, what)
 }
 
+/// The containment rule for files a document names (glTF buffer URIs, later image URIs, files
+/// beside a SOG `meta.json`): `uri` is percent-decoded and joined to `base` (the document's
+/// folder); both are canonicalised (`..` resolved, symlinks followed) and the file must lie
+/// inside `base`. Absolute paths, `..` escapes and symlinks pointing outside are refused with a
+/// message naming the URI and the rule, unless `allow_outside`. Returns the canonical path.
+pub(crate) fn contained(base: &Path, uri: &str, allow_outside: bool) -> Result<PathBuf, String> {
+    let decoded = percent_decode(uri);
+    let rel = Path::new(&decoded);
+    let how = "external files must lie inside the glTF file's folder (allow with --allow-outside-paths / LoadOptions::allow_outside_paths)";
+    if rel.is_absolute() && !allow_outside {
+        return Err(format!("URI {uri:?} is an absolute path; {how}"));
+    }
+    let joined = base.join(rel);
+    let file = joined
+        .canonicalize()
+        .map_err(|e| format!("external buffer {}: {e}", joined.display()))?;
+    if allow_outside {
+        return Ok(file);
+    }
+    let root = base
+        .canonicalize()
+        .map_err(|e| format!("asset folder {}: {e}", base.display()))?;
+    if !file.starts_with(&root) {
+        return Err(format!(
+            "URI {uri:?} resolves to {}, outside the asset's folder {}; {how}",
+            file.display(),
+            root.display()
+        ));
+    }
+    Ok(file)
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let hex = |c: u8| (c as char).to_digit(16).map(|d| d as u8);
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
+        {
+            out.push(h * 16 + l);
+            i += 3;
+            continue;
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn percent_decoding_keeps_invalid_escapes() {
+        assert_eq!(percent_decode("a%20b%2e.bin"), "a b..bin");
+        assert_eq!(percent_decode("%zz%4"), "%zz%4");
+    }
 
     #[test]
     fn devices_and_directories_are_refused_before_reading() {

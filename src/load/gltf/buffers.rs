@@ -1,11 +1,10 @@
 //! Buffer resolution: the GLB BIN chunk, base64 data URIs, the embedder's
 //! [`LoadOptions::resolver`], or files — inside the asset's folder only.
 //!
-//! **Containment rule.** A file URI is percent-decoded and joined to the folder of the glTF
-//! file; both are canonicalised (`..` resolved, symlinks followed) and the file must lie inside
-//! the folder. Absolute paths, `..` escapes and symlinks pointing outside are refused with a
-//! finding at `buffers[i].uri`, unless [`LoadOptions::allow_outside_paths`] is set. Files are
-//! read only when regular ([`crate::files`]), up to `byteLength`, within `limits.max_bytes`.
+//! File URIs follow the containment rule ([`crate::files::contained`]: inside the glTF file's
+//! folder after `..` and symlinks are resolved) unless [`LoadOptions::allow_outside_paths`];
+//! a refusal is a finding at `buffers[i].uri`. Files are read only when regular
+//! ([`crate::files`]), up to `byteLength`, within `limits.max_bytes`.
 
 use crate::load::finding::Finding;
 use crate::load::{LoadOptions, Resolver};
@@ -103,7 +102,7 @@ fn read_uri(
         .ok_or_else(|| {
             format!("external buffer {uri:?} needs the glTF file's path (or LoadOptions::resolver)")
         })?;
-    let file = contained(&base, uri, opts.allow_outside_paths)?;
+    let file = crate::files::contained(&base, uri, opts.allow_outside_paths)?;
     let err = |e: std::io::Error| format!("external buffer {}: {e}", file.display());
     let (f, _) = crate::files::open_regular(&file, "the external buffer").map_err(err)?;
     let mut data = Vec::new();
@@ -115,64 +114,4 @@ fn from_resolver(resolver: &Resolver, uri: &str, len: usize) -> Result<Vec<u8>, 
     let mut d = resolver(uri).map_err(|e| format!("resolver for URI {uri:?}: {e}"))?;
     d.truncate(len);
     Ok(d)
-}
-
-/// The file `uri` names relative to `base`, canonicalised, refused when it leaves `base`
-/// (unless `allow_outside`).
-fn contained(base: &Path, uri: &str, allow_outside: bool) -> Result<PathBuf, String> {
-    let decoded = percent_decode(uri);
-    let rel = Path::new(&decoded);
-    let how = "external files must lie inside the glTF file's folder (allow with --allow-outside-paths / LoadOptions::allow_outside_paths)";
-    if rel.is_absolute() && !allow_outside {
-        return Err(format!("URI {uri:?} is an absolute path; {how}"));
-    }
-    let joined = base.join(rel);
-    let file = joined
-        .canonicalize()
-        .map_err(|e| format!("external buffer {}: {e}", joined.display()))?;
-    if allow_outside {
-        return Ok(file);
-    }
-    let root = base
-        .canonicalize()
-        .map_err(|e| format!("asset folder {}: {e}", base.display()))?;
-    if !file.starts_with(&root) {
-        return Err(format!(
-            "URI {uri:?} resolves to {}, outside the asset's folder {}; {how}",
-            file.display(),
-            root.display()
-        ));
-    }
-    Ok(file)
-}
-
-fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let hex = |c: u8| (c as char).to_digit(16).map(|d| d as u8);
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%'
-            && i + 2 < b.len()
-            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
-        {
-            out.push(h * 16 + l);
-            i += 3;
-            continue;
-        }
-        out.push(b[i]);
-        i += 1;
-    }
-    String::from_utf8_lossy(&out).into_owned()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn percent_decoding_keeps_invalid_escapes() {
-        assert_eq!(percent_decode("a%20b%2e.bin"), "a b..bin");
-        assert_eq!(percent_decode("%zz%4"), "%zz%4");
-    }
 }
