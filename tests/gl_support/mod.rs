@@ -190,7 +190,7 @@ pub fn cam(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
 
 pub fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
     let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
-    sh[0] = rgb.map(|c| (c - 0.5) / splatgl::sh::SH_C0 as f32);
+    sh[0] = rgb.map(|c| splatgl::sh::dc_from_color(c as f64));
     sh
 }
 
