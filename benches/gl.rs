@@ -83,7 +83,7 @@ fn main() {
     println!("context: {}", ctx.describe());
     let (w, h) = (1280u32, 720u32);
     // An RGBA8 framebuffer of the frame size, bound for the whole benchmark.
-    let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8).unwrap();
+    let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8, None).unwrap();
     frame.bind(gl).unwrap();
     let mut renderer = SplatRenderer::new(gl).unwrap();
     let mut offscreen = OffscreenTarget::new(gl, w, h).unwrap();

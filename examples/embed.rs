@@ -11,7 +11,7 @@
 use glam::Vec3;
 use glow::HasContext;
 use splatgl::camera::Camera;
-use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer};
+use splatgl::gl::{ColorFormat, DepthFormat, ReadbackTarget, SplatRenderer};
 use splatgl::headless::HeadlessContext;
 use splatgl::image::PngDepth;
 use splatgl::sort::Sorter;
@@ -32,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gl = ctx.gl();
     // (A real host has its window's framebuffer here; `ReadbackTarget` stands in for it and
     // reads the frames back.)
-    let mut host = ReadbackTarget::with_depth(gl, W, H, ColorFormat::Rgba8)?;
+    let mut host = ReadbackTarget::new(gl, W, H, ColorFormat::Rgba8, Some(DepthFormat::Depth24))?;
 
     // --- splatgl: created once, data uploaded once ---
     let mut renderer = SplatRenderer::new(gl)?;

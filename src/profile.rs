@@ -1,7 +1,7 @@
 //! The rendering profile's numbers, in one place: every constant both backends use, and the
 //! GPU data layout the GL backend and its shaders share.
 //!
-//! One section per section of `docs/rendering-profile.md`. The CPU reference
+//! One section per section of `docs/rendering-profile.md` (its §8 tables them all). The CPU reference
 //! ([`crate::reference`]) reads these constants directly; the GLSL in `glsl/` receives each
 //! one as a generated `#define` (the GL backend's program assembly), so no value is written
 //! twice. A unit test of the GL backend fails if a define disagrees with its constant or if a
@@ -21,7 +21,7 @@ use crate::cloud::sh_coeff_count;
 pub const SH_DC_BIAS: f64 = 0.5;
 
 // ---------------------------------------------------------------------------------------------
-// §1 Display: the sRGB transfer function (IEC 61966-2-1)
+// §1 Display of lin_rec709_display: the sRGB transfer function (IEC 61966-2-1)
 // ---------------------------------------------------------------------------------------------
 
 /// Linear values up to this are encoded by the linear segment.
@@ -82,7 +82,7 @@ pub const ALPHA_MIN: f32 = 1.0 / 255.0;
 pub const NEAR_CULL: f64 = 0.2;
 
 // ---------------------------------------------------------------------------------------------
-// §8 GPU data layout (the GL backend's textures, read by `glsl/splat.vert` and `glsl/sh.glsl`)
+// §8 GPU data layout (the GL backend's textures; docs/gl-backend.md "Data layout")
 // ---------------------------------------------------------------------------------------------
 
 /// `RGBA32F` texels per splat in the geometry texture.

@@ -447,7 +447,9 @@ fn shader_errors_carry_log_and_numbered_source() {
 #[test]
 fn embedding_depth_test_and_documented_state() {
     use glow::HasContext;
-    use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer, sort_back_to_front};
+    use splatgl::gl::{
+        ColorFormat, DepthFormat, ReadbackTarget, SplatRenderer, sort_back_to_front,
+    };
     let ctx = match HeadlessContext::new() {
         Ok(c) => c,
         Err(HeadlessError::EglUnavailable(m)) => {
@@ -459,7 +461,8 @@ fn embedding_depth_test_and_documented_state() {
     let gl = ctx.gl();
     let (w, h) = (32u32, 32u32);
     // The "host": an RGBA8 + DEPTH24 framebuffer with a viewport offset inside a larger one.
-    let mut host = ReadbackTarget::with_depth(gl, 2 * w, h, ColorFormat::Rgba8).unwrap();
+    let mut host =
+        ReadbackTarget::new(gl, 2 * w, h, ColorFormat::Rgba8, Some(DepthFormat::Depth24)).unwrap();
     host.bind(gl).unwrap();
     let fbo = host.framebuffer();
     let mut cloud = SplatCloud::new(0);

@@ -7,6 +7,9 @@
 //! Capacity: `W · GL_MAX_TEXTURE_SIZE / max(3, T_sh)` splats — 11.2M at SH degree 3 and 44.7M
 //! at degree 0 with llvmpipe's 16384; [`SplatTextures::upload`] reports an error beyond.
 //!
+//! The layout constants (texels per splat, which geometry texel holds what) are
+//! [`crate::profile`]'s; the shaders get them as `#define`s.
+//!
 //! | texture | format | texels/splat | content | bytes/splat |
 //! |---|---|---|---|---|
 //! | geometry | `RGBA32F` | 3 | (position.xyz, opacity), rotation xyzw, (scale.xyz, 0) | 48 |

@@ -9,7 +9,7 @@
 //! use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer, sort_back_to_front};
 //! let mut renderer = SplatRenderer::new(gl)?;
 //! renderer.upload(gl, cloud)?;                  // once: splat data → textures
-//! let mut target = ReadbackTarget::new(gl, camera.width, camera.height, ColorFormat::Rgba8)?;
+//! let mut target = ReadbackTarget::new(gl, camera.width, camera.height, ColorFormat::Rgba8, None)?;
 //! target.bind(gl)?;                              // or draw into the host's own framebuffer
 //! let mut order = Vec::new();
 //! sort_back_to_front(&cloud.positions, camera.eye(), &mut order); // per frame
@@ -47,7 +47,7 @@ mod target;
 pub use glsl::Errata;
 #[doc(hidden)]
 pub use program::build_program;
-pub use readback::{ColorFormat, ReadbackTarget};
+pub use readback::{ColorFormat, DepthFormat, ReadbackTarget};
 pub use renderer::{DrawSettings, SplatRenderer};
 pub use sort::{DistanceSorter, sort_back_to_front};
 pub use target::OffscreenTarget;

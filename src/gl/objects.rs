@@ -108,11 +108,6 @@ pub(crate) struct Creating<'gl> {
     objects: Vec<GlObject>,
 }
 
-/// Maps glow's `create_*` error to [`GlError::Create`].
-fn created<T>(r: Result<T, String>, what: &'static str) -> Result<T, GlError> {
-    r.map_err(|message| GlError::Create { what, message })
-}
-
 impl<'gl> Creating<'gl> {
     /// Nothing created yet.
     pub(crate) fn new(gl: &'gl glow::Context) -> Self {
@@ -125,62 +120,6 @@ impl<'gl> Creating<'gl> {
     /// The context the objects are created on.
     pub(crate) fn gl(&self) -> &'gl glow::Context {
         self.gl
-    }
-
-    /// A new program.
-    pub(crate) fn program(&mut self) -> Result<glow::Program, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_program() }, "program")?;
-        self.objects.push(GlObject::Program(o));
-        Ok(o)
-    }
-
-    /// A new shader of `kind` (`VERTEX_SHADER`, `FRAGMENT_SHADER`).
-    pub(crate) fn shader(&mut self, kind: u32) -> Result<glow::Shader, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_shader(kind) }, "shader")?;
-        self.objects.push(GlObject::Shader(o));
-        Ok(o)
-    }
-
-    /// A new texture.
-    pub(crate) fn texture(&mut self) -> Result<glow::Texture, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_texture() }, "texture")?;
-        self.objects.push(GlObject::Texture(o));
-        Ok(o)
-    }
-
-    /// A new framebuffer.
-    pub(crate) fn framebuffer(&mut self) -> Result<glow::Framebuffer, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_framebuffer() }, "framebuffer")?;
-        self.objects.push(GlObject::Framebuffer(o));
-        Ok(o)
-    }
-
-    /// A new renderbuffer.
-    pub(crate) fn renderbuffer(&mut self) -> Result<glow::Renderbuffer, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_renderbuffer() }, "renderbuffer")?;
-        self.objects.push(GlObject::Renderbuffer(o));
-        Ok(o)
-    }
-
-    /// A new buffer.
-    pub(crate) fn buffer(&mut self) -> Result<glow::Buffer, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_buffer() }, "buffer")?;
-        self.objects.push(GlObject::Buffer(o));
-        Ok(o)
-    }
-
-    /// A new vertex array.
-    pub(crate) fn vertex_array(&mut self) -> Result<glow::VertexArray, GlError> {
-        // SAFETY: plain object creation on the current context.
-        let o = created(unsafe { self.gl.create_vertex_array() }, "vertex array")?;
-        self.objects.push(GlObject::VertexArray(o));
-        Ok(o)
     }
 
     /// Creation succeeded and the caller takes the objects over itself (nothing is deleted).
@@ -196,6 +135,56 @@ impl<'gl> Creating<'gl> {
             destroyed: false,
         }
     }
+
+    /// Records a freshly created object (or maps glow's error to [`GlError::Create`]).
+    fn push<T: Copy>(
+        &mut self,
+        r: Result<T, String>,
+        what: &'static str,
+        wrap: fn(T) -> GlObject,
+    ) -> Result<T, GlError> {
+        let o = r.map_err(|message| GlError::Create { what, message })?;
+        self.objects.push(wrap(o));
+        Ok(o)
+    }
+
+    /// A new shader of `kind` (`VERTEX_SHADER`, `FRAGMENT_SHADER`).
+    pub(crate) fn shader(&mut self, kind: u32) -> Result<glow::Shader, GlError> {
+        // SAFETY: plain object creation on the current context.
+        let r = unsafe { self.gl.create_shader(kind) };
+        self.push(r, "shader", GlObject::Shader)
+    }
+}
+
+/// `Creating::$fn()`: a new object of one kind, from glow's `$create`.
+macro_rules! creators {
+    ($($(#[$doc:meta])* $fn:ident: $ty:ident = $create:ident, $what:literal;)*) => {
+        impl Creating<'_> {
+            $(
+                $(#[$doc])*
+                pub(crate) fn $fn(&mut self) -> Result<glow::$ty, GlError> {
+                    // SAFETY: plain object creation on the current context.
+                    let r = unsafe { self.gl.$create() };
+                    self.push(r, $what, GlObject::$ty)
+                }
+            )*
+        }
+    };
+}
+
+creators! {
+    /// A new program.
+    program: Program = create_program, "program";
+    /// A new texture.
+    texture: Texture = create_texture, "texture";
+    /// A new framebuffer.
+    framebuffer: Framebuffer = create_framebuffer, "framebuffer";
+    /// A new renderbuffer.
+    renderbuffer: Renderbuffer = create_renderbuffer, "renderbuffer";
+    /// A new buffer.
+    buffer: Buffer = create_buffer, "buffer";
+    /// A new vertex array.
+    vertex_array: VertexArray = create_vertex_array, "vertex array";
 }
 
 impl Drop for Creating<'_> {

@@ -35,8 +35,24 @@ impl ColorFormat {
     }
 }
 
+/// Depth buffer of a [`ReadbackTarget`] (a renderbuffer: not sampled, not read back).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum DepthFormat {
+    /// `DEPTH_COMPONENT24`.
+    Depth24,
+}
+
+impl DepthFormat {
+    fn internal_format(self) -> u32 {
+        match self {
+            DepthFormat::Depth24 => glow::DEPTH_COMPONENT24,
+        }
+    }
+}
+
 /// A `width × height` framebuffer: a colour texture of a [`ColorFormat`] and, optionally, a
-/// `DEPTH_COMPONENT24` renderbuffer. It works on any context, the host's included: it binds
+/// depth renderbuffer of a [`DepthFormat`] (e.g. for a host's opaque pass). It works on any context, the host's included: it binds
 /// only when asked ([`ReadbackTarget::bind`]) and [`ReadbackTarget::read_image`] restores the
 /// read-framebuffer binding it found.
 ///
@@ -49,37 +65,20 @@ pub struct ReadbackTarget {
     width: u32,
     height: u32,
     format: ColorFormat,
-    depth: bool,
+    depth: Option<DepthFormat>,
     owned: Owned,
 }
 
 impl ReadbackTarget {
-    /// A colour-only target.
+    /// Creates the target (`depth: None` for colour only). Fails with
+    /// [`GlError::Unsupported`] for `Rgba16f` on an ES context without
+    /// `EXT_color_buffer_(half_)float`, [`GlError::Framebuffer`] when incomplete.
     pub fn new(
         gl: &glow::Context,
         width: u32,
         height: u32,
         format: ColorFormat,
-    ) -> Result<Self, GlError> {
-        Self::create(gl, width, height, format, false)
-    }
-
-    /// A target with a `DEPTH_COMPONENT24` depth buffer too (e.g. a host's opaque pass).
-    pub fn with_depth(
-        gl: &glow::Context,
-        width: u32,
-        height: u32,
-        format: ColorFormat,
-    ) -> Result<Self, GlError> {
-        Self::create(gl, width, height, format, true)
-    }
-
-    fn create(
-        gl: &glow::Context,
-        width: u32,
-        height: u32,
-        format: ColorFormat,
-        depth: bool,
+        depth: Option<DepthFormat>,
     ) -> Result<Self, GlError> {
         if format == ColorFormat::Rgba16f && gl.version().is_embedded {
             let ext = gl.supported_extensions();
@@ -95,10 +94,9 @@ impl ReadbackTarget {
         let (w, h) = (width as i32, height as i32);
         let mut objects = Creating::new(gl);
         let color = objects.texture()?;
-        let depth_rb = if depth {
-            Some(objects.renderbuffer()?)
-        } else {
-            None
+        let depth_rb = match depth {
+            Some(d) => Some((objects.renderbuffer()?, d.internal_format())),
+            None => None,
         };
         let fbo = objects.framebuffer()?;
         // SAFETY: allocates and attaches objects created just above; the texture, renderbuffer
@@ -110,16 +108,16 @@ impl ReadbackTarget {
                 gl.tex_parameter_i32(glow::TEXTURE_2D, pname, glow::NEAREST as i32);
             }
             gl.bind_texture(glow::TEXTURE_2D, None);
-            if let Some(rb) = depth_rb {
+            if let Some((rb, internal)) = depth_rb {
                 gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
-                gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT24, w, h);
+                gl.renderbuffer_storage(glow::RENDERBUFFER, internal, w, h);
                 gl.bind_renderbuffer(glow::RENDERBUFFER, None);
             }
             let prev = gl.get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING);
             gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(fbo));
             let (target, attach) = (glow::DRAW_FRAMEBUFFER, glow::COLOR_ATTACHMENT0);
             gl.framebuffer_texture_2d(target, attach, glow::TEXTURE_2D, Some(color), 0);
-            if let Some(rb) = depth_rb {
+            if let Some((rb, _)) = depth_rb {
                 let attach = glow::DEPTH_ATTACHMENT;
                 gl.framebuffer_renderbuffer(target, attach, glow::RENDERBUFFER, Some(rb));
             }
@@ -152,8 +150,8 @@ impl ReadbackTarget {
         self.format
     }
 
-    /// Whether it has a depth buffer.
-    pub fn has_depth(&self) -> bool {
+    /// The depth buffer's format, if it has one.
+    pub fn depth_format(&self) -> Option<DepthFormat> {
         self.depth
     }
 

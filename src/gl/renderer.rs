@@ -32,75 +32,32 @@ impl Default for DrawSettings {
     }
 }
 
-/// The uniforms the renderer sets, in the order of [`UNIFORM_NAMES`].
-#[derive(Debug)]
-struct Uniforms {
-    geometry: Option<glow::UniformLocation>,
-    sh: Option<glow::UniformLocation>,
-    sh_texels: Option<glow::UniformLocation>,
-    sh_fetch_texels: Option<glow::UniformLocation>,
-    sh_degree: Option<glow::UniformLocation>,
-    view: Option<glow::UniformLocation>,
-    projection: Option<glow::UniformLocation>,
-    focal: Option<glow::UniformLocation>,
-    tan_half_fov: Option<glow::UniformLocation>,
-    camera_position: Option<glow::UniformLocation>,
-    viewport: Option<glow::UniformLocation>,
-    cull_depth: Option<glow::UniformLocation>,
-    splat_count: Option<glow::UniformLocation>,
+/// Declares `Uniforms`, one location per uniform the renderer sets, each field named exactly
+/// like its GLSL uniform (so the two cannot get out of step).
+macro_rules! uniforms {
+    ($($name:ident),* $(,)?) => {
+        /// The locations of the uniforms the renderer sets.
+        #[derive(Debug)]
+        struct Uniforms {
+            $($name: Option<glow::UniformLocation>,)*
+        }
+
+        impl Uniforms {
+            /// Looks them up; for the correct program (`check`), a debug build asserts that
+            /// they all exist.
+            fn new(gl: &glow::Context, program: glow::Program, check: bool) -> Self {
+                let names = [$(stringify!($name)),*];
+                let [$($name),*] = program::uniform_locations(gl, program, "splat", names, check);
+                Uniforms { $($name),* }
+            }
+        }
+    };
 }
 
-/// GLSL names of the [`Uniforms`], field by field.
-const UNIFORM_NAMES: [&str; 13] = [
-    "u_geometry",
-    "u_sh",
-    "u_sh_texels",
-    "u_sh_fetch_texels",
-    "u_sh_degree",
-    "u_view_matrix",
-    "u_projection_matrix",
-    "u_focal_length",
-    "u_tan_half_fov",
-    "u_camera_position",
-    "u_viewport",
-    "u_cull_depth",
-    "u_splat_count",
-];
-
-impl Uniforms {
-    /// Looks them up; for the correct program (`check`), a debug build asserts they all exist.
-    fn new(gl: &glow::Context, program: glow::Program, check: bool) -> Self {
-        let [
-            geometry,
-            sh,
-            sh_texels,
-            sh_fetch_texels,
-            sh_degree,
-            view,
-            projection,
-            focal,
-            tan_half_fov,
-            camera_position,
-            viewport,
-            cull_depth,
-            splat_count,
-        ] = program::uniform_locations(gl, program, "splat", UNIFORM_NAMES, check);
-        Uniforms {
-            geometry,
-            sh,
-            sh_texels,
-            sh_fetch_texels,
-            sh_degree,
-            view,
-            projection,
-            focal,
-            tan_half_fov,
-            camera_position,
-            viewport,
-            cull_depth,
-            splat_count,
-        }
-    }
+uniforms! {
+    u_geometry, u_sh, u_sh_texels, u_sh_fetch_texels, u_sh_degree, u_view_matrix,
+    u_projection_matrix, u_focal_length, u_tan_half_fov, u_camera_position, u_viewport,
+    u_cull_depth, u_splat_count,
 }
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
@@ -341,27 +298,31 @@ impl SplatRenderer {
         // the order buffer's size; the shader culls any index past the uploaded splats.
         unsafe {
             gl.use_program(Some(self.program));
-            gl.uniform_matrix_4_f32_slice(u.view.as_ref(), false, &view.to_cols_array());
-            gl.uniform_matrix_4_f32_slice(u.projection.as_ref(), false, &proj.to_cols_array());
-            gl.uniform_2_f32(u.focal.as_ref(), camera.fx, camera.fy);
-            gl.uniform_2_f32(u.tan_half_fov.as_ref(), tan.x, tan.y);
-            gl.uniform_3_f32(u.camera_position.as_ref(), eye.x, eye.y, eye.z);
+            gl.uniform_matrix_4_f32_slice(u.u_view_matrix.as_ref(), false, &view.to_cols_array());
+            gl.uniform_matrix_4_f32_slice(
+                u.u_projection_matrix.as_ref(),
+                false,
+                &proj.to_cols_array(),
+            );
+            gl.uniform_2_f32(u.u_focal_length.as_ref(), camera.fx, camera.fy);
+            gl.uniform_2_f32(u.u_tan_half_fov.as_ref(), tan.x, tan.y);
+            gl.uniform_3_f32(u.u_camera_position.as_ref(), eye.x, eye.y, eye.z);
             gl.uniform_4_f32(
-                u.viewport.as_ref(),
+                u.u_viewport.as_ref(),
                 viewport[0] as f32,
                 viewport[1] as f32,
                 viewport[2] as f32,
                 viewport[3] as f32,
             );
             let cull = (crate::profile::NEAR_CULL as f32).max(camera.near);
-            gl.uniform_1_f32(u.cull_depth.as_ref(), cull);
-            gl.uniform_1_i32(u.sh_degree.as_ref(), i32::from(degree));
-            gl.uniform_1_i32(u.sh_texels.as_ref(), tex.sh_texels as i32);
+            gl.uniform_1_f32(u.u_cull_depth.as_ref(), cull);
+            gl.uniform_1_i32(u.u_sh_degree.as_ref(), i32::from(degree));
+            gl.uniform_1_i32(u.u_sh_texels.as_ref(), tex.sh_texels as i32);
             let fetch = crate::profile::sh_texels(degree);
-            gl.uniform_1_i32(u.sh_fetch_texels.as_ref(), fetch as i32);
-            gl.uniform_1_i32(u.splat_count.as_ref(), tex.len as i32);
-            gl.uniform_1_i32(u.geometry.as_ref(), 0);
-            gl.uniform_1_i32(u.sh.as_ref(), 1);
+            gl.uniform_1_i32(u.u_sh_fetch_texels.as_ref(), fetch as i32);
+            gl.uniform_1_i32(u.u_splat_count.as_ref(), tex.len as i32);
+            gl.uniform_1_i32(u.u_geometry.as_ref(), 0);
+            gl.uniform_1_i32(u.u_sh.as_ref(), 1);
             // A host sampler object on these units would override the textures' NEAREST
             // filtering (RGBA32F is not filterable on ES 3.0): unbind samplers.
             gl.bind_sampler(0, None);

@@ -64,7 +64,7 @@ impl OffscreenTarget {
     /// Creates a `width × height` target. On OpenGL ES it needs `EXT_color_buffer_float` or
     /// `EXT_color_buffer_half_float` (rendering to `RGBA16F`).
     pub fn new(gl: &glow::Context, width: u32, height: u32) -> Result<Self, GlError> {
-        let mut target = ReadbackTarget::new(gl, width, height, ColorFormat::Rgba16f)?;
+        let mut target = ReadbackTarget::new(gl, width, height, ColorFormat::Rgba16f, None)?;
         match ResolvePass::new(gl) {
             Ok(pass) => Ok(OffscreenTarget {
                 target,

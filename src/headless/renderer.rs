@@ -208,7 +208,7 @@ impl HeadlessRenderer {
             if let Some(mut t) = self.target.take() {
                 t.destroy(gl);
             }
-            self.target = Some(ReadbackTarget::new(gl, w, h, format)?);
+            self.target = Some(ReadbackTarget::new(gl, w, h, format, None)?);
         }
         if kind == TargetKind::Rgba16fResolve
             && self.offscreen.as_ref().is_none_or(|t| t.size() != (w, h))
