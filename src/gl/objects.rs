@@ -192,3 +192,33 @@ impl Drop for Creating<'_> {
         delete_all(self.gl, &self.objects);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn owned(what: &'static str) -> Owned {
+        let name = std::num::NonZeroU32::new(7).unwrap();
+        Owned {
+            what,
+            objects: vec![GlObject::Texture(glow::NativeTexture(name))],
+            destroyed: false,
+        }
+    }
+
+    #[test]
+    fn a_live_owner_dropped_warns_and_a_gone_one_refuses_use() {
+        let warned = || WARNED.lock().unwrap().contains(&"LeakTestOwner");
+        drop(owned("LeakTestOwner"));
+        assert!(warned());
+        let mut gone = owned("GoneTestOwner");
+        assert!(gone.check().is_ok());
+        gone.abandon();
+        assert!(matches!(
+            gone.check(),
+            Err(GlError::Destroyed("GoneTestOwner"))
+        ));
+        drop(gone);
+        assert!(!WARNED.lock().unwrap().contains(&"GoneTestOwner"));
+    }
+}

@@ -131,12 +131,6 @@ impl OffscreenTarget {
         Ok(())
     }
 
-    /// The accumulated (linear, unresolved) values as they are now, top row first.
-    pub fn read_image(&self, gl: &glow::Context) -> Result<crate::image::Image, GlError> {
-        self.pass.owned.check()?;
-        self.target.read_image(gl)
-    }
-
     /// Deletes the target's objects (once; afterwards every method returns
     /// [`GlError::Destroyed`]).
     pub fn destroy(&mut self, gl: &glow::Context) {
