@@ -165,21 +165,26 @@ impl HeadlessRenderer {
             gl.clear_color(bg[0], bg[1], bg[2], 0.0);
             gl.clear(glow::COLOR_BUFFER_BIT);
         }
-        self.renderer.set_order(gl, order)?;
-        match opts.target {
-            TargetKind::Rgba8 => self.renderer.draw_current_with(gl, camera, &settings)?,
-            TargetKind::Rgba16fResolve => {
-                let offscreen = self.offscreen.as_mut().expect("prepared above");
-                offscreen.begin(gl, [bg[0], bg[1], bg[2], 0.0])?;
-                self.renderer.draw_current_with(gl, camera, &settings)?;
-                offscreen.resolve(gl, linear)?;
+        let (renderer, offscreen) = (&mut self.renderer, &mut self.offscreen);
+        let drawn = (|| {
+            renderer.set_order(gl, order)?;
+            match opts.target {
+                TargetKind::Rgba8 => renderer.draw_current_with(gl, camera, &settings),
+                TargetKind::Rgba16fResolve => {
+                    let offscreen = offscreen.as_mut().expect("prepared above");
+                    offscreen.begin(gl, [bg[0], bg[1], bg[2], 0.0])?;
+                    renderer.draw_current_with(gl, camera, &settings)?;
+                    offscreen.resolve(gl, linear)
+                }
             }
-        }
+        })();
         if desktop_srgb {
             // SAFETY: restoring the default (disabled).
             unsafe { gl.disable(glow::FRAMEBUFFER_SRGB) };
         }
-        let image = crate::gl::check_error(gl, "rendering").and_then(|()| target.read_image(gl));
+        let image = drawn
+            .and_then(|()| crate::gl::check_error(gl, "rendering"))
+            .and_then(|()| target.read_image(gl));
         // SAFETY: unbinding our framebuffer.
         unsafe { gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
         Ok(image?)
