@@ -21,8 +21,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use glow::HasContext;
 use splatgl::camera::Camera;
-use splatgl::gl::sort::DistanceSorter;
-use splatgl::gl::{OffscreenTarget, SplatRenderer};
+use splatgl::gl::{ColorFormat, DistanceSorter, OffscreenTarget, ReadbackTarget, SplatRenderer};
 use splatgl::headless::{HeadlessContext, HeadlessError};
 use splatgl::scene;
 
@@ -83,27 +82,9 @@ fn main() {
     let gl = ctx.gl();
     println!("context: {}", ctx.describe());
     let (w, h) = (1280u32, 720u32);
-    // SAFETY: creates and binds an RGBA8 renderbuffer FBO of the frame size on the current
-    // context; it stays bound for the whole benchmark and is deleted at the end.
-    let (fbo, rb) = unsafe {
-        let rb = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
-        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w as i32, h as i32);
-        let fbo = gl.create_framebuffer().unwrap();
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::COLOR_ATTACHMENT0,
-            glow::RENDERBUFFER,
-            Some(rb),
-        );
-        assert_eq!(
-            gl.check_framebuffer_status(glow::FRAMEBUFFER),
-            glow::FRAMEBUFFER_COMPLETE
-        );
-        gl.viewport(0, 0, w as i32, h as i32);
-        (fbo, rb)
-    };
+    // An RGBA8 framebuffer of the frame size, bound for the whole benchmark.
+    let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8, None).unwrap();
+    frame.bind(gl).unwrap();
     let mut renderer = SplatRenderer::new(gl).unwrap();
     let mut offscreen = OffscreenTarget::new(gl, w, h).unwrap();
     let mut sorter = DistanceSorter::default();
@@ -152,9 +133,9 @@ fn main() {
             let t2 = Instant::now();
             let c2 = cpu_time();
             if float_target {
-                offscreen.begin(gl, [0.0; 4]);
+                offscreen.begin(gl, [0.0; 4]).unwrap();
                 renderer.draw_current(gl, &cam).unwrap();
-                offscreen.resolve(gl, false);
+                offscreen.resolve(gl, false).unwrap();
             } else {
                 renderer.draw_current(gl, &cam).unwrap();
             }
@@ -191,10 +172,5 @@ fn main() {
     }
     renderer.destroy(gl);
     offscreen.destroy(gl);
-    // SAFETY: deleting the objects created above.
-    unsafe {
-        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-        gl.delete_framebuffer(fbo);
-        gl.delete_renderbuffer(rb);
-    }
+    frame.destroy(gl);
 }

@@ -10,7 +10,6 @@
 
 pub mod camera;
 pub mod cloud;
-pub mod color;
 pub mod compare;
 pub mod covariance;
 #[cfg(feature = "gl")]
@@ -19,6 +18,7 @@ pub mod gl;
 pub mod headless;
 pub mod image;
 pub mod load;
+pub mod profile;
 pub mod reference;
 pub mod scene;
 pub mod sh;

@@ -43,7 +43,7 @@ fn single_splats_many_anisotropies_and_rotations() {
                 &mut r,
                 &cloud,
                 &c,
-                &RenderOptions {
+                &HeadlessOptions {
                     background: [0.1, 0.2, 0.3],
                     ..Default::default()
                 },
@@ -76,7 +76,7 @@ fn sh_degrees_0_to_3_from_several_views() {
         let c = cam(eye, Vec3::ZERO, 45.0, 64, 64);
         let mut prev: Option<Image> = None;
         for degree in 0..=3u8 {
-            let opts = RenderOptions {
+            let opts = HeadlessOptions {
                 sh_degree: Some(degree),
                 ..Default::default()
             };
@@ -147,7 +147,7 @@ fn splats_crossing_the_near_plane() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
     // A camera near larger than 0.2 moves the cull depth (max(0.2, near)).
@@ -157,7 +157,7 @@ fn splats_crossing_the_near_plane() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }
@@ -187,7 +187,7 @@ fn splats_crossing_the_image_border_and_fov_clamp() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
     // Off-centre principal point.
@@ -198,7 +198,7 @@ fn splats_crossing_the_image_border_and_fov_clamp() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }
@@ -224,7 +224,7 @@ fn tiny_sub_pixel_splats() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_SPARSE,
     );
 }
@@ -240,11 +240,11 @@ fn lin_rec709_display_both_targets() {
         check("lin_rec709", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
     }
     // And it is really different from blending the stored values as sRGB.
-    let lin = r.render(&c, &RenderOptions::default()).unwrap();
+    let lin = r.render(&c, &HeadlessOptions::default()).unwrap();
     let srgb = r
         .render(
             &c,
-            &RenderOptions {
+            &HeadlessOptions {
                 color_space: Some(ColorSpace::SrgbRec709Display),
                 ..Default::default()
             },
@@ -256,7 +256,8 @@ fn lin_rec709_display_both_targets() {
 #[test]
 fn desktop_gl_330_core_matches_reference() {
     // The same GLSL files compiled as `#version 330 core` on a desktop GL 3.3 core context.
-    let mut r = match HeadlessRenderer::with_api(GlApi::DesktopCore33, Errata::default()) {
+    let desktop = HeadlessContext::with_api(GlApi::DesktopCore33);
+    let mut r = match desktop.and_then(HeadlessRenderer::with_context) {
         Ok(r) => r,
         Err(HeadlessError::EglUnavailable(msg)) => {
             eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
@@ -318,7 +319,7 @@ fn rgba16f_resolve_measured_against_rgba8() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
     let s16 = check(
@@ -326,7 +327,7 @@ fn rgba16f_resolve_measured_against_rgba8() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions {
+        &HeadlessOptions {
             target: TargetKind::Rgba16fResolve,
             ..Default::default()
         },
@@ -366,7 +367,7 @@ fn non_finite_splats_are_skipped_like_the_reference() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }
@@ -379,7 +380,7 @@ fn empty_cloud_and_partial_orders() {
     let img = r
         .render(
             &c,
-            &RenderOptions {
+            &HeadlessOptions {
                 background: [0.2, 0.4, 0.6],
                 ..Default::default()
             },
@@ -390,7 +391,7 @@ fn empty_cloud_and_partial_orders() {
     // An order longer than the cloud is an error, not a GPU read out of bounds.
     let cloud = scene::random_cloud(10, 0, 1.0, 2);
     r.upload(&cloud).unwrap();
-    let err = r.render_with_order(&c, &RenderOptions::default(), &[0; 11]);
+    let err = r.render_with_order(&c, &HeadlessOptions::default(), &[0; 11]);
     assert!(matches!(
         err,
         Err(HeadlessError::Gl(splatgl::gl::GlError::OrderTooLong {
@@ -402,7 +403,7 @@ fn empty_cloud_and_partial_orders() {
     let mut z = c;
     z.width = 0;
     assert!(
-        r.render(&z, &RenderOptions::default())
+        r.render(&z, &HeadlessOptions::default())
             .unwrap()
             .pixels
             .is_empty()
@@ -411,17 +412,17 @@ fn empty_cloud_and_partial_orders() {
     let mut order = Vec::new();
     splatgl::gl::sort_back_to_front(&cloud.positions[..5], c.eye(), &mut order);
     let five = r
-        .render_with_order(&c, &RenderOptions::default(), &order)
+        .render_with_order(&c, &HeadlessOptions::default(), &order)
         .unwrap();
     let mut bad = order.clone();
     bad.extend([10, u32::MAX, 1_000_000, 15, 99]);
     let with_bad = r
-        .render_with_order(&c, &RenderOptions::default(), &bad)
+        .render_with_order(&c, &HeadlessOptions::default(), &bad)
         .unwrap();
     assert_eq!(five, with_bad);
     // An empty order draws nothing.
     let img = r
-        .render_with_order(&c, &RenderOptions::default(), &[])
+        .render_with_order(&c, &HeadlessOptions::default(), &[])
         .unwrap();
     assert!(img.pixels.iter().all(|p| p[3] == 0.0));
 }
@@ -432,7 +433,7 @@ fn shader_errors_carry_log_and_numbered_source() {
     let gl = r.context().gl();
     let vs = "#version 300 es\nvoid main() {\n  gl_Position = vec4(0.0);\n}\n";
     let fs = "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() {\n  o = undefined_thing;\n}\n";
-    let err = splatgl::gl::program::build_program(gl, "broken", vs, fs).unwrap_err();
+    let err = splatgl::gl::build_program(gl, "broken", vs, fs).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, splatgl::gl::GlError::Compile { .. }), "{msg}");
     assert!(msg.contains("undefined_thing"), "{msg}");
@@ -446,8 +447,9 @@ fn shader_errors_carry_log_and_numbered_source() {
 #[test]
 fn embedding_depth_test_and_documented_state() {
     use glow::HasContext;
-    use splatgl::gl::{SplatRenderer, sort_back_to_front};
-    use splatgl::headless::HeadlessContext;
+    use splatgl::gl::{
+        ColorFormat, DepthFormat, ReadbackTarget, SplatRenderer, sort_back_to_front,
+    };
     let ctx = match HeadlessContext::new() {
         Ok(c) => c,
         Err(HeadlessError::EglUnavailable(m)) => {
@@ -459,39 +461,10 @@ fn embedding_depth_test_and_documented_state() {
     let gl = ctx.gl();
     let (w, h) = (32u32, 32u32);
     // The "host": an RGBA8 + DEPTH24 framebuffer with a viewport offset inside a larger one.
-    // SAFETY: object creation and binding on the current context; deleted at the end.
-    let (fbo, rbs) = unsafe {
-        let color = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
-        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 2 * w as i32, h as i32);
-        let depth = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-        gl.renderbuffer_storage(
-            glow::RENDERBUFFER,
-            glow::DEPTH_COMPONENT24,
-            2 * w as i32,
-            h as i32,
-        );
-        let fbo = gl.create_framebuffer().unwrap();
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::COLOR_ATTACHMENT0,
-            glow::RENDERBUFFER,
-            Some(color),
-        );
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::DEPTH_ATTACHMENT,
-            glow::RENDERBUFFER,
-            Some(depth),
-        );
-        assert_eq!(
-            gl.check_framebuffer_status(glow::FRAMEBUFFER),
-            glow::FRAMEBUFFER_COMPLETE
-        );
-        (fbo, [color, depth])
-    };
+    let mut host =
+        ReadbackTarget::new(gl, 2 * w, h, ColorFormat::Rgba8, Some(DepthFormat::Depth24)).unwrap();
+    host.bind(gl).unwrap();
+    let fbo = host.framebuffer();
     let mut cloud = SplatCloud::new(0);
     cloud.push(
         [0.0; 3],
@@ -518,20 +491,9 @@ fn embedding_depth_test_and_documented_state() {
         }
         renderer.settings_mut().depth_test = depth_test;
         renderer.draw(gl, &c, &order).unwrap();
-        let mut px = [0u8; 4];
-        // SAFETY: reads one RGBA8 pixel into a 4-byte buffer.
-        unsafe {
-            gl.read_pixels(
-                (w + w / 2) as i32,
-                (h / 2) as i32,
-                1,
-                1,
-                glow::RGBA,
-                glow::UNSIGNED_BYTE,
-                glow::PixelPackData::Slice(Some(&mut px)),
-            );
-        }
-        px[0]
+        // GL pixel (w + w/2, h/2), counted from the bottom row.
+        let px = host.read_image(gl).unwrap().get(w + w / 2, h - 1 - h / 2);
+        (px[0] * 255.0).round() as u8
     };
     assert!(centre_red(0.0, false) > 200, "drawn without depth test");
     assert!(centre_red(1.0, true) > 200, "host depth far: splat passes");
@@ -541,19 +503,10 @@ fn embedding_depth_test_and_documented_state() {
         "host geometry in front: splat hidden"
     );
     // The left half (outside the viewport) stays untouched.
-    let mut px = [9u8; 4];
-    // SAFETY: as above; then state queries.
+    let px = host.read_image(gl).unwrap().get(w / 2, h - 1 - h / 2);
+    // SAFETY: state queries.
     unsafe {
-        gl.read_pixels(
-            w as i32 / 2,
-            h as i32 / 2,
-            1,
-            1,
-            glow::RGBA,
-            glow::UNSIGNED_BYTE,
-            glow::PixelPackData::Slice(Some(&mut px)),
-        );
-        assert_eq!(px, [0; 4]);
+        assert_eq!(px, [0.0; 4]);
         // State left as documented in splatgl::gl::state.
         assert_eq!(gl.get_parameter_i32(glow::CURRENT_PROGRAM), 0);
         assert_eq!(gl.get_parameter_i32(glow::VERTEX_ARRAY_BINDING), 0);
@@ -579,14 +532,12 @@ fn embedding_depth_test_and_documented_state() {
         assert_eq!(vp, [w as i32, 0, w as i32, h as i32]);
     }
     renderer.destroy(gl);
-    // SAFETY: deleting the host objects created above.
-    unsafe {
-        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-        gl.delete_framebuffer(fbo);
-        for rb in rbs {
-            gl.delete_renderbuffer(rb);
-        }
-    }
+    host.destroy(gl);
+    // A destroyed renderer refuses to draw instead of touching deleted objects.
+    assert!(matches!(
+        renderer.draw(gl, &c, &order),
+        Err(splatgl::gl::GlError::Destroyed("SplatRenderer"))
+    ));
 }
 
 #[test]
@@ -594,7 +545,7 @@ fn one_shot_render_function_matches_the_renderer() {
     // `splatgl::headless::render` is what a CLI `--backend gl` calls.
     let cloud = scene::default_scene();
     let c = scene::default_camera(48, 36);
-    let opts = RenderOptions {
+    let opts = HeadlessOptions {
         background: [0.1, 0.1, 0.1],
         sh_degree: Some(3), // above the cloud's degree 1: clamped, like the reference
         ..Default::default()
@@ -639,21 +590,15 @@ fn real_files_render_without_gl_errors() {
         r.upload(&cloud)
             .unwrap_or_else(|e| panic!("{}: upload: {e}", path.display()));
         let img = r
-            .render(&c, &RenderOptions::default())
+            .render(&c, &HeadlessOptions::default())
             .unwrap_or_else(|e| panic!("{}: render: {e}", path.display()));
         assert!(
             img.pixels.iter().any(|p| p[3] > 0.05),
             "{}: nothing drawn",
             path.display()
         );
-        let mut want = reference::render(&cloud, &c, &ref_opts(3, [0.0; 3]));
-        if cloud.meta.color_space.effective() == ColorSpace::LinRec709Display {
-            for p in &mut want.pixels {
-                for v in &mut p[..3] {
-                    *v = srgb_encode(*v);
-                }
-            }
-        }
+        let space = cloud.meta.color_space.effective();
+        let want = reference::render_display(&cloud, &c, &ref_opts(3, [0.0; 3]), space).0;
         let s = score(&img, &want);
         eprintln!(
             "{}: {} splats, PSNR {:.2} dB vs reference",
@@ -692,10 +637,10 @@ fn splats_beyond_the_far_plane_are_drawn() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
-    let img = r.render(&c, &RenderOptions::default()).unwrap();
+    let img = r.render(&c, &HeadlessOptions::default()).unwrap();
     assert!(
         img.pixels.iter().any(|p| p[3] > 0.1),
         "splats must be visible"
@@ -726,7 +671,7 @@ fn long_thin_needles() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }

@@ -13,7 +13,7 @@ fn erratum_scores(
 ) -> Option<(Score, Score)> {
     let mut good = headless()?;
     good.upload(cloud).unwrap();
-    let ours = good.render(c, &RenderOptions::default()).unwrap();
+    let ours = good.render(c, &HeadlessOptions::default()).unwrap();
     drop(good);
     let mut bad = headless_with(errata)?;
     bad.upload(cloud).unwrap();
@@ -21,10 +21,10 @@ fn erratum_scores(
         let mut order = Vec::new();
         splatgl::gl::sort_back_to_front(&cloud.positions, c.eye(), &mut order);
         order.reverse(); // the appendix's front-to-back
-        bad.render_with_order(c, &RenderOptions::default(), &order)
+        bad.render_with_order(c, &HeadlessOptions::default(), &order)
             .unwrap()
     } else {
-        bad.render(c, &RenderOptions::default()).unwrap()
+        bad.render(c, &HeadlessOptions::default()).unwrap()
     };
     let want = reference::render(cloud, c, &ref_opts(3, [0.0; 3]));
     let (s_ours, s_lit) = (score(&ours, &want), score(&literal, &want));
@@ -266,7 +266,7 @@ fn erratum_j_one_vertex_attribute() {
     );
     let fs =
         "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() { o = vec4(1.0); }\n";
-    let err = splatgl::gl::program::build_program(gl, "appendix-21", &vs, fs);
+    let err = splatgl::gl::build_program(gl, "appendix-21", &vs, fs);
     match &err {
         Err(splatgl::gl::GlError::Link { log, .. }) => eprintln!("21-attribute program: {log}"),
         other => eprintln!(

@@ -295,7 +295,9 @@ fn go(a: &Args) -> Result<(), String> {
     let (img, backend, visible) = match gl {
         Some(img) => (img, "gl", None),
         None => {
-            let (img, stats) = render_reference(&cloud, &cam, &opts);
+            // As displayed (sRGB-encoded for lin_rec709_display): what the GL backend gives.
+            let space = cloud.meta.color_space.effective();
+            let (img, stats) = splatgl::reference::render_display(&cloud, &cam, &opts, space);
             (img, "reference", Some(stats.visible))
         }
     };
@@ -314,30 +316,6 @@ fn go(a: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The reference render as it is displayed: for `lin_rec709_display` clouds the background is
-/// taken as a display value (decoded), the splats blend in linear, and the result is
-/// sRGB-encoded once at the end — exactly what the GL backend does.
-fn render_reference(
-    cloud: &splatgl::SplatCloud,
-    cam: &Camera,
-    opts: &RenderOptions,
-) -> (Image, splatgl::reference::RenderStats) {
-    use splatgl::cloud::ColorSpace;
-    use splatgl::color::{srgb_decode, srgb_encode};
-    if cloud.meta.color_space.effective() != ColorSpace::LinRec709Display {
-        return splatgl::reference::render_with_stats(cloud, cam, opts);
-    }
-    let mut o = *opts;
-    o.background = opts.background.map(|v| srgb_decode(v as f64) as f32);
-    let (mut img, stats) = splatgl::reference::render_with_stats(cloud, cam, &o);
-    for p in &mut img.pixels {
-        for c in &mut p[..3] {
-            *c = srgb_encode(*c as f64) as f32;
-        }
-    }
-    (img, stats)
-}
-
 #[cfg(feature = "gl")]
 fn render_gl(
     a: &Args,
@@ -345,11 +323,11 @@ fn render_gl(
     cam: &Camera,
     opts: &RenderOptions,
 ) -> Result<Image, String> {
-    use splatgl::headless::{RenderOptions as GlOptions, TargetKind};
+    use splatgl::headless::{HeadlessOptions, TargetKind};
     if a.sort != SortArg::Distance {
         return Err("--sort view-depth is only implemented by --backend reference".into());
     }
-    let o = GlOptions {
+    let o = HeadlessOptions {
         target: match a.target {
             TargetArg::Rgba8 => TargetKind::Rgba8,
             TargetArg::Rgba16f => TargetKind::Rgba16fResolve,

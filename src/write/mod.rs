@@ -275,9 +275,9 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
             if ch == 3 {
                 return cloud.opacities[i];
             }
-            let v = (cloud.sh[i * k][ch] as f64 * crate::sh::SH_C0 + 0.5).clamp(0.0, 1.0);
+            let v = crate::sh::color_from_dc(cloud.sh[i * k][ch]).clamp(0.0, 1.0);
             (if srgb {
-                crate::color::srgb_decode(v)
+                crate::profile::srgb_decode(v)
             } else {
                 v
             }) as f32

@@ -31,7 +31,9 @@ pub use splatgl::camera::Camera;
 pub use splatgl::cloud::ColorSpace;
 pub use splatgl::compare::compare;
 pub use splatgl::gl::Errata;
-pub use splatgl::headless::{GlApi, HeadlessError, HeadlessRenderer, RenderOptions, TargetKind};
+pub use splatgl::headless::{
+    GlApi, HeadlessContext, HeadlessError, HeadlessOptions, HeadlessRenderer, TargetKind,
+};
 pub use splatgl::image::Image;
 pub use splatgl::reference;
 pub use splatgl::scene::{self, Rng};
@@ -66,15 +68,6 @@ pub fn ref_opts(degree: u8, background: [f32; 3]) -> reference::RenderOptions {
     }
 }
 
-pub fn srgb_encode(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// Measured agreement of two images: (PSNR dB, max RGB error, max alpha error).
 #[derive(Debug, Clone, Copy)]
 pub struct Score {
@@ -103,7 +96,8 @@ pub fn score(gl: &Image, want: &Image) -> Score {
     }
 }
 
-/// Reference image of `cloud` (SH degree `degree`, background `bg`), in display values.
+/// Reference image of `cloud` (SH degree `degree`, background `bg`), in display values
+/// (`linear`: as a `lin_rec709_display` cloud is shown).
 pub fn reference_image(
     cloud: &SplatCloud,
     cam: &Camera,
@@ -111,18 +105,12 @@ pub fn reference_image(
     bg: [f32; 3],
     linear: bool,
 ) -> Image {
-    if !linear {
-        return reference::render(cloud, cam, &ref_opts(degree, bg));
-    }
-    // lin_rec709_display: blend linear (background decoded), encode to sRGB at the end.
-    let bg_lin = bg.map(splatgl::headless::srgb_to_linear);
-    let mut img = reference::render(cloud, cam, &ref_opts(degree, bg_lin));
-    for p in &mut img.pixels {
-        for c in &mut p[..3] {
-            *c = srgb_encode(*c);
-        }
-    }
-    img
+    let space = if linear {
+        ColorSpace::LinRec709Display
+    } else {
+        ColorSpace::SrgbRec709Display
+    };
+    reference::render_display(cloud, cam, &ref_opts(degree, bg), space).0
 }
 
 /// How far the brightest splat colour seen by `cam` exceeds 1 (0 if none does).
@@ -145,7 +133,7 @@ pub fn check(
     r: &mut HeadlessRenderer,
     cloud: &SplatCloud,
     cam: &Camera,
-    opts: &RenderOptions,
+    opts: &HeadlessOptions,
     max_err: f32,
 ) -> Score {
     r.upload(cloud).unwrap();
@@ -202,14 +190,14 @@ pub fn cam(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
 
 pub fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
     let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
-    sh[0] = rgb.map(|c| (c - 0.5) / splatgl::sh::SH_C0 as f32);
+    sh[0] = rgb.map(|c| splatgl::sh::dc_from_color(c as f64));
     sh
 }
 
-pub fn both_targets() -> [RenderOptions; 2] {
+pub fn both_targets() -> [HeadlessOptions; 2] {
     [
-        RenderOptions::default(),
-        RenderOptions {
+        HeadlessOptions::default(),
+        HeadlessOptions {
             target: TargetKind::Rgba16fResolve,
             ..Default::default()
         },

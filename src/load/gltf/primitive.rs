@@ -277,10 +277,10 @@ fn dc_from_color0(c: [f32; 3], srgb: bool) -> [f32; 3] {
     c.map(|v| {
         let v = v.clamp(0.0, 1.0) as f64;
         let v = if srgb {
-            crate::color::srgb_encode(v)
+            crate::profile::srgb_encode(v)
         } else {
             v
         };
-        ((v - 0.5) / crate::sh::SH_C0) as f32
+        crate::sh::dc_from_color(v)
     })
 }

@@ -289,7 +289,7 @@ fn push_splat(
             (Some(lo), Some(hi)) => lerp(chunk_val(lo), chunk_val(hi), rgba[ch]),
             _ => rgba[ch],
         };
-        coeffs[0][ch] = ((v as f64 - 0.5) / crate::sh::SH_C0) as f32;
+        coeffs[0][ch] = crate::sh::dc_from_color(v as f64);
     }
     let finite = pos
         .iter()

@@ -243,7 +243,7 @@ fn convert_row(
         }
         sh[0][k] = match l.dc_is_color {
             None => d as f32,
-            Some(div) => ((d / div - 0.5) / crate::sh::SH_C0) as f32,
+            Some(div) => crate::sh::dc_from_color(d / div),
         };
         if !sh[0][k].is_finite() {
             return Err(bad(l.dc[k], "colour coefficient overflows f32"));
