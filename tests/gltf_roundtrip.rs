@@ -13,7 +13,7 @@ use std::path::Path;
 
 /// A cloud whose values are representable by the quantized types under test.
 fn quantizable(seed: u64, degree: u8) -> SplatCloud {
-    let mut c = random_cloud(seed, 64, degree);
+    let mut c = random_cloud(64, degree, 5.0, seed);
     for s in &mut c.scales {
         *s = s.map(|v| v.min(0.99));
     }

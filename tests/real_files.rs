@@ -2,7 +2,7 @@
 //! count and SH degree, with the warnings it deserves; the others fail with a precise error.
 
 mod common;
-use common::real;
+use common::{real, real_files};
 use splatgl::load::validate::{Status, validate_path};
 use splatgl::load::{LoadError, LoadOptions, ScaleSeen, load_path};
 
@@ -209,14 +209,9 @@ fn other_splat_formats_are_named_not_unknown() {
 /// validate lists exactly the findings of the load report, in the same order.
 #[test]
 fn validate_lists_the_findings_of_the_load_report() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipping: {} not found", dir.display());
-        return;
-    };
+    let Some(paths) = real_files() else { return };
     let mut compared = 0;
-    for e in entries {
-        let p = e.unwrap().path();
+    for p in paths {
         let Ok(l) = load_path(&p, &LoadOptions::default()) else {
             continue;
         };

@@ -23,7 +23,8 @@
 //! | `GL_CULL_FACE` | disabled | **disabled** (left) |
 //! | `GL_SCISSOR_TEST`, stencil, colour mask | not touched | unchanged |
 //!
-//! `tests/gl.rs::embedding_depth_test_and_documented_state` checks the "left afterwards" column.
+//! `tests/gl_embedding.rs::host_depth_buffer_viewport_and_gl_state_are_respected` checks the
+//! "left afterwards" column.
 //!
 //! A host that needs other values back (e.g. `glDepthMask(true)` for its next pass) sets them
 //! after the call; querying and restoring everything would cost a round-trip per state per frame.

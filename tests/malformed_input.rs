@@ -1,14 +1,17 @@
-//! A corpus of malformed inputs, each returning its specific error (never a panic, never a
-//! huge allocation): lying headers, truncation, wrong types, partial SH, out-of-range values,
-//! NaN, bad JSON, missing buffers, bad indices.
+//! Malformed and hostile input files, each ending in its specific error or a correct load
+//! (never a panic, a stack overflow, an endless read or an allocation far beyond the input
+//! size): lying headers, truncation, wrong types, partial SH, out-of-range values, NaN, bad
+//! JSON, missing buffers, bad indices, deep or cyclic node graphs, instance bombs; PNG and PFM
+//! images that `compare` reads.
 
 mod common;
 use base64::Engine;
 use common::random_cloud;
 use serde_json::{Value, json};
+use splatgl::image::Image;
 use splatgl::load::validate::{Status, validate_bytes};
 use splatgl::load::{LoadOptions, ScaleSpace, load_bytes};
-use splatgl::write::{GltfWriteOptions, build, to_glb};
+use splatgl::write::{Comp, GltfWriteOptions, build, to_glb};
 use std::path::Path;
 
 fn err_of(bytes: &[u8], name: &str) -> String {
@@ -32,7 +35,7 @@ fn ply_header(body: &str) -> Vec<u8> {
 }
 
 fn good_ply() -> Vec<u8> {
-    splatgl::write::to_inria_ply(&random_cloud(1, 4, 1))
+    splatgl::write::to_inria_ply(&random_cloud(4, 1, 5.0, 1))
 }
 
 /// Overwrites float property `prop` (column index in the INRIA layout of degree 1) of row `row`.
@@ -49,7 +52,7 @@ fn poke_ply(mut bytes: Vec<u8>, row: usize, col: usize, v: f32) -> Vec<u8> {
 }
 
 #[test]
-fn ply_corpus() {
+fn malformed_ply_files_give_precise_errors() {
     let mut cases: Vec<(Vec<u8>, &[&str])> = vec![
         (b"".to_vec(), &["header line 1"]),
         (b"plx\nformat ascii 1.0\nend_header\n".to_vec(), &["expected 'ply'"]),
@@ -139,7 +142,7 @@ fn ply_corpus() {
 
 /// A valid document (data-URI buffer) with `edit` applied to the JSON and the binary.
 fn gltf_with(edit: impl FnOnce(&mut Value, &mut Vec<u8>)) -> Vec<u8> {
-    let (mut doc, mut bin) = build(&random_cloud(2, 8, 1), &GltfWriteOptions::default());
+    let (mut doc, mut bin) = build(&random_cloud(8, 1, 5.0, 2), &GltfWriteOptions::default());
     edit(&mut doc, &mut bin);
     if doc["buffers"][0].get("uri").is_none() {
         let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
@@ -164,7 +167,7 @@ fn elem_offset(doc: &Value, name: &str, i: usize, esize: usize) -> usize {
 }
 
 #[test]
-fn gltf_corpus() {
+fn malformed_gltf_files_give_precise_errors() {
     let sc = format!("{P}SCALE");
     let op = format!("{P}OPACITY");
     let rot = format!("{P}ROTATION");
@@ -323,8 +326,8 @@ fn gltf_corpus() {
 }
 
 #[test]
-fn glb_framing() {
-    let good = to_glb(&random_cloud(4, 3, 0), &GltfWriteOptions::default());
+fn broken_glb_framing_is_an_error() {
+    let good = to_glb(&random_cloud(3, 0, 5.0, 4), &GltfWriteOptions::default());
     let mut truncated = good.clone();
     truncated.truncate(good.len() - 7);
     expect(&truncated, "t.glb", &["GLB"]);
@@ -436,4 +439,262 @@ fn spec_violations_the_loader_survives_are_validation_errors() {
     );
     // And the file the writer produces is valid.
     assert_eq!(validate(&gltf_with(|_, _| {})).status(), Status::Valid);
+}
+
+// ---------- glTF: hostile documents found in review ----------
+
+#[test]
+fn huge_byte_offsets_are_errors() {
+    let e = err_of(
+        &gltf_with(|d, _| d["accessors"][0]["byteOffset"] = json!(u64::MAX)),
+        "h.gltf",
+    );
+    assert!(e.contains("accessors[0]") && e.contains("needs"), "{e}");
+}
+
+#[test]
+fn deep_node_chain_loads_without_recursion() {
+    const DEPTH: usize = 20_000;
+    let bytes = gltf_with(|d, _| {
+        let mut nodes: Vec<Value> = (0..DEPTH).map(|i| json!({"children": [i + 1]})).collect();
+        nodes.push(json!({"mesh": 0, "translation": [0.0, 0.0, 1.0]}));
+        d["nodes"] = json!(nodes);
+    });
+    // Run on a small stack to prove the walk is iterative.
+    let l = std::thread::Builder::new()
+        .stack_size(256 * 1024)
+        .spawn(move || load_bytes(&bytes, Some(Path::new("h.gltf")), &LoadOptions::default()))
+        .unwrap()
+        .join()
+        .expect("no stack overflow")
+        .expect("loads");
+    assert_eq!(l.cloud.len(), 8);
+}
+
+#[test]
+fn long_chain_cycle_check_is_linear() {
+    // 200k nodes in one chain closed into a cycle: found quickly, not in O(n²).
+    const N: usize = 200_000;
+    let bytes = gltf_with(|d, _| {
+        let mut nodes: Vec<Value> = (0..N).map(|i| json!({"children": [(i + 1) % N]})).collect();
+        nodes[0]["mesh"] = json!(0);
+        d["nodes"] = json!(nodes);
+        d["scenes"] = json!([{"nodes": []}]);
+    });
+    assert!(err_of(&bytes, "h.gltf").contains("cycle"));
+}
+
+#[test]
+fn camera_type_without_its_object_is_skipped_with_a_warning() {
+    let bytes = gltf_with(|d, _| {
+        d["cameras"] = json!([{"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}]);
+        d["nodes"][0]["camera"] = json!(0);
+    });
+    // The splats still load; the camera is reported and skipped.
+    let scene = load_bytes(&bytes, None, &LoadOptions::default()).expect("loads");
+    let e = scene.report.warning_lines().join("\n");
+    assert!(e.contains("cameras[0]"), "{e}");
+    assert!(scene.cameras.is_empty());
+}
+
+#[test]
+fn glb_header_length_below_12_is_an_error() {
+    let mut glb = to_glb(&random_cloud(2, 0, 5.0, 1), &GltfWriteOptions::default());
+    glb[8..12].copy_from_slice(&5u32.to_le_bytes());
+    let e = load_bytes(&glb, Some(Path::new("h.glb")), &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("GLB: header length 5"), "{e}");
+}
+
+#[test]
+fn repeated_scene_roots_and_instance_bombs_are_errors() {
+    let e = err_of(
+        &gltf_with(|d, _| d["scenes"] = json!([{"nodes": [0, 0]}])),
+        "h.gltf",
+    );
+    assert!(e.contains("scenes[0].nodes[1]"), "{e}");
+    // 20k nodes instancing one mesh of 2M zero-filled splats (sparse-free, no bufferView):
+    // the budget stops it before the output is built.
+    let bytes = gltf_with(|d, _| {
+        for a in d["accessors"].as_array_mut().unwrap() {
+            a.as_object_mut().unwrap().remove("bufferView");
+            a.as_object_mut().unwrap().remove("min");
+            a.as_object_mut().unwrap().remove("max");
+            a["count"] = json!(2_000_000);
+        }
+        let nodes: Vec<Value> = (0..20_000).map(|_| json!({"mesh": 0})).collect();
+        d["nodes"] = json!(nodes);
+        d["scenes"] = json!([{"nodes": (0..20_000).collect::<Vec<_>>()}]);
+    });
+    let e = err_of(&bytes, "h.gltf");
+    assert!(e.contains("budget") || e.contains("justify"), "{e}");
+}
+
+#[test]
+fn external_buffer_must_be_a_regular_file() {
+    let dir = std::env::temp_dir().join(format!("splatgl-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bytes = gltf_with(|d, _| d["buffers"][0]["uri"] = json!("/dev/zero"));
+    let p = dir.join("z.gltf");
+    std::fs::write(&p, &bytes).unwrap();
+    let e = splatgl::load::load_path(&p, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not a regular file"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn log_scale_and_node_matrix_overflows_are_errors() {
+    let bytes = gltf_with(|d, b| {
+        let a = d["meshes"][0]["primitives"][0]["attributes"]["KHR_gaussian_splatting:SCALE"]
+            .as_u64()
+            .unwrap() as usize;
+        let v = d["accessors"][a]["bufferView"].as_u64().unwrap() as usize;
+        let o = d["bufferViews"][v]["byteOffset"].as_u64().unwrap() as usize;
+        b[o..o + 4].copy_from_slice(&(-1.0f32).to_le_bytes()); // makes it log space
+        b[o + 4..o + 8].copy_from_slice(&100.0f32.to_le_bytes());
+    });
+    assert!(err_of(&bytes, "h.gltf").contains("overflows"));
+    let huge = gltf_with(|d, _| {
+        d["nodes"][0]["matrix"] = json!([1e38, 0, 0, 0, 0, 1e38, 0, 0, 0, 0, 1e38, 0, 0, 0, 0, 1])
+    });
+    assert!(err_of(&huge, "h.gltf").contains("non-finite"));
+}
+
+#[test]
+fn position_types_and_alignment_are_validated() {
+    let validate = |b: &[u8]| validate_bytes(b, Some(Path::new("v.gltf")), &LoadOptions::default());
+    // u32 positions: not allowed even with quantization.
+    let u32pos = gltf_with(|d, _| d["accessors"][0]["componentType"] = json!(5125));
+    let v = validate(&u32pos);
+    assert!(
+        v.findings
+            .iter()
+            .any(|f| f.message.contains("unsigned int")),
+        "{:#?}",
+        v.findings
+    );
+    // Quantized positions written by us are valid (KHR_mesh_quantization, aligned stride).
+    let mut c = random_cloud(5, 0, 5.0, 3);
+    for p in &mut c.positions {
+        *p = p.map(|x| x / 10.0);
+    }
+    let o = GltfWriteOptions {
+        position: Comp::I8N,
+        scale: Comp::U8N,
+        opacity: Comp::U8N,
+        ..Default::default()
+    };
+    let (mut doc, bin) = build(&c, &o);
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    doc["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{b64}"));
+    let ok = serde_json::to_vec(&doc).unwrap();
+    assert_eq!(
+        validate(&ok).status(),
+        Status::Valid,
+        "{:#?}",
+        validate(&ok).findings
+    );
+    // Tightly packed u8 VEC3 (stride 3) breaks the 4-byte rule.
+    for view in doc["bufferViews"].as_array_mut().unwrap() {
+        if view["byteStride"] == json!(4) {
+            view.as_object_mut().unwrap().remove("byteStride");
+        }
+    }
+    let packed = serde_json::to_vec(&doc).unwrap();
+    assert!(
+        validate(&packed)
+            .findings
+            .iter()
+            .any(|f| f.message.contains("4-byte"))
+    );
+    // Without KHR_mesh_quantization, quantized positions are an error.
+    doc["extensionsUsed"] = json!(["KHR_gaussian_splatting"]);
+    doc.as_object_mut().unwrap().remove("extensionsRequired");
+    let noq = serde_json::to_vec(&doc).unwrap();
+    assert!(
+        validate(&noq)
+            .findings
+            .iter()
+            .any(|f| f.path.ends_with("[\"POSITION\"]"))
+    );
+}
+
+#[test]
+fn non_splat_primitive_without_position_is_fine() {
+    let bytes = gltf_with(|d, _| {
+        let other = json!({"attributes": {"NORMAL": 0}, "mode": 0});
+        d["meshes"][0]["primitives"]
+            .as_array_mut()
+            .unwrap()
+            .push(other);
+    });
+    let l = load_bytes(&bytes, Some(Path::new("h.gltf")), &LoadOptions::default()).unwrap();
+    assert_eq!(l.cloud.len(), 8);
+}
+
+#[test]
+fn sparse_all_zero_opacity_writes_a_valid_file() {
+    let mut c = random_cloud(6, 0, 5.0, 4);
+    c.opacities.iter_mut().for_each(|o| *o = 0.0);
+    let o = GltfWriteOptions {
+        sparse_opacity: true,
+        ..Default::default()
+    };
+    let glb = to_glb(&c, &o);
+    let v = validate_bytes(&glb, Some(Path::new("s.glb")), &LoadOptions::default());
+    assert_eq!(v.status(), Status::Valid, "{:#?}", v.findings);
+}
+
+// ---------- Images (PNG, PFM) read by `compare` ----------
+
+fn crc32(data: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in data {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+#[test]
+fn png_header_claiming_a_huge_image_is_rejected_before_allocation() {
+    let mut png = Image::filled(1, 1, [0.5; 4])
+        .encode_png(splatgl::image::PngDepth::Eight, false)
+        .unwrap();
+    // IHDR data starts at byte 16 (8 signature + 4 length + 4 type): width, height.
+    png[16..20].copy_from_slice(&(1u32 << 30).to_be_bytes());
+    png[20..24].copy_from_slice(&(1u32 << 30).to_be_bytes());
+    let crc = crc32(&png[12..29]);
+    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    assert!(Image::decode_png(&png).is_err());
+}
+
+#[test]
+fn pfm_accepts_crlf_and_rejects_a_nan_scale() {
+    let mut ok = b"PF\r\n1 1\r\n-1.0\r\n".to_vec();
+    for v in [0.25f32, 0.5, 0.75] {
+        ok.extend_from_slice(&v.to_le_bytes());
+    }
+    let img = Image::decode_pfm(&ok).unwrap();
+    assert_eq!(img.pixels[0][..3], [0.25, 0.5, 0.75]);
+    let mut nan = b"PF\n1 1\nnan\n".to_vec();
+    nan.extend_from_slice(&[0; 12]);
+    assert!(Image::decode_pfm(&nan).is_err());
+}
+
+#[test]
+fn comparing_an_image_with_itself_is_identical_even_with_inf() {
+    let mut a = Image::filled(2, 2, [0.5; 4]);
+    a.pixels[1] = [f32::INFINITY, f32::NAN, 0.0, 1.0];
+    let c = splatgl::compare::compare(&a, &a, 1.0 / 255.0).unwrap();
+    assert_eq!(c.max_abs, 0.0);
 }

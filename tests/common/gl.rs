@@ -1,5 +1,6 @@
-//! Shared helpers of the GL test crates (`tests/gl.rs`, `tests/gl_errata.rs`): GL backend
-//! (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU reference rasterizer.
+//! Shared helpers of the GL test crates (`tests/gl_vs_reference.rs`, `tests/gl_embedding.rs`,
+//! `tests/gl_errata.rs`): GL backend (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU
+//! reference rasterizer. `use common::gl::*` brings these and the general helpers.
 //!
 //! Every test renders small images (≤ 96 px) so the suite stays fast on llvmpipe. Tests skip
 //! (with a message) only when EGL cannot be opened at all; any other GL failure fails them.
@@ -25,6 +26,7 @@
 //! PSNR must be ≥ 45 dB everywhere.
 #![allow(dead_code, unused_imports)]
 
+pub use super::{look_at_fov_deg, real_files, sh_for};
 pub use glam::{Quat, Vec3};
 pub use splatgl::SplatCloud;
 pub use splatgl::camera::Camera;
@@ -182,16 +184,6 @@ pub fn check(
         s.max_alpha
     );
     s
-}
-
-pub fn cam(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
-    Camera::look_at(eye, target, Vec3::Y, fov_deg.to_radians(), w, h)
-}
-
-pub fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
-    let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
-    sh[0] = rgb.map(|c| splatgl::sh::dc_from_color(c as f64));
-    sh
 }
 
 pub fn both_targets() -> [HeadlessOptions; 2] {

@@ -1,17 +1,14 @@
-//! GL backend vs the CPU reference on Mesa EGL / llvmpipe (scene families, targets, embedding).
-//! Helpers and the error bound: `tests/gl_support/mod.rs`.
+//! GL backend vs the CPU reference on Mesa EGL / llvmpipe: scene families, SH degrees, colour
+//! spaces, both targets, edge cases (near plane, image border, non-finite splats, orders), real
+//! files. Helpers and the error bound: `tests/common/gl.rs`.
 
-mod gl_support;
-use gl_support::*;
-
-// ---------------------------------------------------------------------------------------------
-// GL vs reference
-// ---------------------------------------------------------------------------------------------
+mod common;
+use common::gl::*;
 
 #[test]
 fn single_splats_many_anisotropies_and_rotations() {
     let Some(mut r) = headless() else { return };
-    let c = cam(Vec3::new(0.3, 0.4, 4.0), Vec3::ZERO, 50.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.3, 0.4, 4.0), Vec3::ZERO, 50.0, 64, 64);
     let scales = [
         [0.4, 0.05, 0.05],
         [0.05, 0.5, 0.02],
@@ -73,7 +70,7 @@ fn sh_degrees_0_to_3_from_several_views() {
     .into_iter()
     .enumerate()
     {
-        let c = cam(eye, Vec3::ZERO, 45.0, 64, 64);
+        let c = look_at_fov_deg(eye, Vec3::ZERO, 45.0, 64, 64);
         let mut prev: Option<Image> = None;
         for degree in 0..=3u8 {
             let opts = HeadlessOptions {
@@ -106,7 +103,7 @@ fn sh_degrees_0_to_3_from_several_views() {
 fn dense_random_cloud_both_targets() {
     let Some(mut r) = headless() else { return };
     let cloud = scene::random_cloud(4000, 1, 1.0, 42);
-    let c = cam(Vec3::new(2.0, 1.0, 3.0), Vec3::ZERO, 50.0, 96, 72);
+    let c = look_at_fov_deg(Vec3::new(2.0, 1.0, 3.0), Vec3::ZERO, 50.0, 96, 72);
     for opts in both_targets() {
         check("dense", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
     }
@@ -140,7 +137,7 @@ fn splats_crossing_the_near_plane() {
         let rgb = [(); 3].map(|_| rng.range(0.1, 0.9));
         cloud.push(p, s, rng.quat(), rng.range(0.3, 1.0), &sh_for(rgb, 0));
     }
-    let mut c = cam(Vec3::ZERO, Vec3::Z, 70.0, 64, 64);
+    let mut c = look_at_fov_deg(Vec3::ZERO, Vec3::Z, 70.0, 64, 64);
     c.near = 0.05;
     check(
         "near plane",
@@ -181,7 +178,7 @@ fn splats_crossing_the_image_border_and_fov_clamp() {
         let rgb = [(); 3].map(|_| rng.range(0.1, 0.9));
         cloud.push(p, s, rng.quat(), 0.8, &sh_for(rgb, 0));
     }
-    let mut c = cam(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 55.0, 80, 60);
+    let mut c = look_at_fov_deg(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 55.0, 80, 60);
     check(
         "border",
         &mut r,
@@ -218,7 +215,7 @@ fn tiny_sub_pixel_splats() {
         let rgb = [(); 3].map(|_| rng.range(0.3, 1.0));
         cloud.push(p, s, rng.quat(), 1.0, &sh_for(rgb, 0));
     }
-    let c = cam(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
     check(
         "tiny",
         &mut r,
@@ -234,7 +231,7 @@ fn lin_rec709_display_both_targets() {
     let Some(mut r) = headless() else { return };
     let mut cloud = scene::random_cloud(1500, 2, 1.0, 9);
     cloud.meta.color_space = splatgl::cloud::Known::Known(ColorSpace::LinRec709Display);
-    let c = cam(Vec3::new(-2.0, 1.5, 3.0), Vec3::ZERO, 50.0, 80, 64);
+    let c = look_at_fov_deg(Vec3::new(-2.0, 1.5, 3.0), Vec3::ZERO, 50.0, 80, 64);
     for mut opts in both_targets() {
         opts.background = [0.2, 0.25, 0.3];
         check("lin_rec709", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
@@ -268,7 +265,7 @@ fn desktop_gl_330_core_matches_reference() {
     eprintln!("{}", r.context().describe());
     assert!(!glow::HasContext::version(r.context().gl()).is_embedded);
     let mut cloud = scene::random_cloud(1500, 3, 1.0, 31);
-    let c = cam(Vec3::new(1.5, -1.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(1.5, -1.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     for opts in both_targets() {
         check("desktop 330 core", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
     }
@@ -290,7 +287,7 @@ fn desktop_gl_330_core_matches_reference() {
 fn same_scene_twice_is_bit_identical() {
     let Some(mut r) = headless() else { return };
     let cloud = scene::random_cloud(2000, 3, 1.0, 1);
-    let c = cam(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     for opts in both_targets() {
         r.upload(&cloud).unwrap();
         let a = r.render(&c, &opts).unwrap();
@@ -306,14 +303,14 @@ fn same_scene_twice_is_bit_identical() {
 }
 
 #[test]
-fn rgba16f_resolve_measured_against_rgba8() {
+fn rgba16f_resolve_is_closer_to_the_reference_than_rgba8() {
     let Some(mut r) = headless() else { return };
     // Many low-opacity layers: where 8-bit blending loses most.
     let mut cloud = scene::random_cloud(3000, 0, 0.6, 21);
     for o in &mut cloud.opacities {
         *o *= 0.15;
     }
-    let c = cam(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 50.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 50.0, 64, 64);
     let s8 = check(
         "low-alpha RGBA8",
         &mut r,
@@ -361,7 +358,7 @@ fn non_finite_splats_are_skipped_like_the_reference() {
     cloud.sh[17 * 4] = [f32::NAN, 0.0, 0.0];
     cloud.sh[19 * 4 + 1] = [f32::INFINITY; 3];
     assert_eq!(cloud.len(), n);
-    let c = cam(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 64);
     check(
         "non-finite",
         &mut r,
@@ -375,7 +372,7 @@ fn non_finite_splats_are_skipped_like_the_reference() {
 #[test]
 fn empty_cloud_and_partial_orders() {
     let Some(mut r) = headless() else { return };
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 32, 32);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 32, 32);
     r.upload(&SplatCloud::new(0)).unwrap();
     let img = r
         .render(
@@ -428,119 +425,6 @@ fn empty_cloud_and_partial_orders() {
 }
 
 #[test]
-fn shader_errors_carry_log_and_numbered_source() {
-    let Some(r) = headless() else { return };
-    let gl = r.context().gl();
-    let vs = "#version 300 es\nvoid main() {\n  gl_Position = vec4(0.0);\n}\n";
-    let fs = "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() {\n  o = undefined_thing;\n}\n";
-    let err = splatgl::gl::build_program(gl, "broken", vs, fs).unwrap_err();
-    let msg = err.to_string();
-    assert!(matches!(err, splatgl::gl::GlError::Compile { .. }), "{msg}");
-    assert!(msg.contains("undefined_thing"), "{msg}");
-    assert!(msg.contains("   5 |   o = undefined_thing;"), "{msg}");
-}
-
-// ---------------------------------------------------------------------------------------------
-// Embedding API: the renderer on a host framebuffer, depth test, state left as documented.
-// ---------------------------------------------------------------------------------------------
-
-#[test]
-fn embedding_depth_test_and_documented_state() {
-    use glow::HasContext;
-    use splatgl::gl::{
-        ColorFormat, DepthFormat, ReadbackTarget, SplatRenderer, sort_back_to_front,
-    };
-    let ctx = match HeadlessContext::new() {
-        Ok(c) => c,
-        Err(HeadlessError::EglUnavailable(m)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
-    };
-    let gl = ctx.gl();
-    let (w, h) = (32u32, 32u32);
-    // The "host": an RGBA8 + DEPTH24 framebuffer with a viewport offset inside a larger one.
-    let mut host =
-        ReadbackTarget::new(gl, 2 * w, h, ColorFormat::Rgba8, Some(DepthFormat::Depth24)).unwrap();
-    host.bind(gl).unwrap();
-    let fbo = host.framebuffer();
-    let mut cloud = SplatCloud::new(0);
-    cloud.push(
-        [0.0; 3],
-        [0.3; 3],
-        [0.0, 0.0, 0.0, 1.0],
-        0.95,
-        &sh_for([1.0, 1.0, 1.0], 0),
-    );
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, w, h);
-    let mut renderer = SplatRenderer::new(gl).unwrap();
-    renderer.upload(gl, &cloud).unwrap();
-    let mut order = Vec::new();
-    sort_back_to_front(&cloud.positions, c.eye(), &mut order);
-    // Right half of the framebuffer is the host's viewport for the splats.
-    let mut centre_red = |depth_clear: f32, depth_test: bool| -> u8 {
-        // SAFETY: clears and reads one pixel of the bound framebuffer.
-        unsafe {
-            gl.viewport(0, 0, 2 * w as i32, h as i32);
-            gl.depth_mask(true);
-            gl.clear_color(0.0, 0.0, 0.0, 0.0);
-            gl.clear_depth_f32(depth_clear);
-            gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
-            gl.viewport(w as i32, 0, w as i32, h as i32);
-        }
-        renderer.settings_mut().depth_test = depth_test;
-        renderer.draw(gl, &c, &order).unwrap();
-        // GL pixel (w + w/2, h/2), counted from the bottom row.
-        let px = host.read_image(gl).unwrap().get(w + w / 2, h - 1 - h / 2);
-        (px[0] * 255.0).round() as u8
-    };
-    assert!(centre_red(0.0, false) > 200, "drawn without depth test");
-    assert!(centre_red(1.0, true) > 200, "host depth far: splat passes");
-    assert_eq!(
-        centre_red(0.0, true),
-        0,
-        "host geometry in front: splat hidden"
-    );
-    // The left half (outside the viewport) stays untouched.
-    let px = host.read_image(gl).unwrap().get(w / 2, h - 1 - h / 2);
-    // SAFETY: state queries.
-    unsafe {
-        assert_eq!(px, [0.0; 4]);
-        // State left as documented in splatgl::gl::state.
-        assert_eq!(gl.get_parameter_i32(glow::CURRENT_PROGRAM), 0);
-        assert_eq!(gl.get_parameter_i32(glow::VERTEX_ARRAY_BINDING), 0);
-        assert_eq!(gl.get_parameter_i32(glow::ARRAY_BUFFER_BINDING), 0);
-        assert_eq!(
-            gl.get_parameter_i32(glow::ACTIVE_TEXTURE),
-            glow::TEXTURE0 as i32
-        );
-        assert_eq!(gl.get_parameter_i32(glow::TEXTURE_BINDING_2D), 0);
-        assert!(gl.is_enabled(glow::BLEND));
-        assert_eq!(gl.get_parameter_i32(glow::BLEND_SRC_RGB), glow::ONE as i32);
-        assert_eq!(
-            gl.get_parameter_i32(glow::BLEND_DST_ALPHA),
-            glow::ONE_MINUS_SRC_ALPHA as i32
-        );
-        assert_eq!(gl.get_parameter_i32(glow::DEPTH_WRITEMASK), 0);
-        assert_eq!(
-            gl.get_parameter_i32(glow::DRAW_FRAMEBUFFER_BINDING),
-            fbo.0.get() as i32
-        );
-        let mut vp = [0i32; 4];
-        gl.get_parameter_i32_slice(glow::VIEWPORT, &mut vp);
-        assert_eq!(vp, [w as i32, 0, w as i32, h as i32]);
-    }
-    renderer.destroy(gl);
-    host.destroy(gl);
-    // A destroyed renderer refuses to draw instead of touching deleted objects.
-    assert!(matches!(
-        renderer.draw(gl, &c, &order),
-        Err(splatgl::gl::GlError::Destroyed("SplatRenderer"))
-    ));
-}
-
-#[test]
 fn one_shot_render_function_matches_the_renderer() {
     // `splatgl::headless::render` is what a CLI `--backend gl` calls.
     let cloud = scene::default_scene();
@@ -572,14 +456,8 @@ fn one_shot_render_function_matches_the_renderer() {
 /// after the upload and after the draw) and within the suite's PSNR of the reference.
 #[test]
 fn real_files_render_without_gl_errors() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipping: {} not found", dir.display());
-        return;
-    };
+    let Some(paths) = real_files() else { return };
     let Some(mut r) = headless() else { return };
-    let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
-    paths.sort();
     let mut rendered = 0;
     for path in paths {
         let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
@@ -624,7 +502,7 @@ fn splats_beyond_the_far_plane_are_drawn() {
     for s in &mut cloud.scales {
         *s = s.map(|v| v * 20.0);
     }
-    let mut c = cam(
+    let mut c = look_at_fov_deg(
         Vec3::new(0.0, 0.0, 3.0),
         Vec3::new(0.0, 0.0, -40.0),
         50.0,
@@ -665,7 +543,7 @@ fn long_thin_needles() {
             &sh_for([0.9, 0.5 + 0.08 * k as f32, 0.2], 0),
         );
     }
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 8.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 8.0, 64, 48);
     check(
         "needles",
         &mut r,
