@@ -16,13 +16,17 @@
 //! with scales × 0.2·(10⁵/n)^(1/3), so the covered screen area is about the same for both sizes;
 //! camera at distance 3.2, 50° vertical fov.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use std::time::{Duration, Instant};
 
+use common::gl::or_skip;
 use glam::Vec3;
 use glow::HasContext;
 use splatgl::camera::Camera;
 use splatgl::gl::{ColorFormat, DistanceSorter, OffscreenTarget, ReadbackTarget, SplatRenderer};
-use splatgl::headless::{HeadlessContext, HeadlessError};
+use splatgl::headless::HeadlessContext;
 use splatgl::scene;
 
 /// CPU time of the whole process (all threads, so llvmpipe's rasterizer threads count), which
@@ -71,13 +75,8 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1.0);
-    let ctx = match HeadlessContext::new() {
-        Ok(c) => c,
-        Err(HeadlessError::EglUnavailable(m)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
+    let Some(ctx) = or_skip(HeadlessContext::new(), "headless context") else {
+        return;
     };
     let gl = ctx.gl();
     println!("context: {}", ctx.describe());

@@ -46,16 +46,22 @@ pub const MAX_ERR_SPARSE: f32 = 1.5 / 255.0 + 0.0111;
 pub const MAX_ERR_DENSE: f32 = 8.0 / 255.0 + 0.0111;
 pub const MIN_PSNR: f64 = 45.0;
 
-/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
-pub fn headless_with(errata: Errata) -> Option<HeadlessRenderer> {
-    match HeadlessRenderer::with_errata(errata) {
-        Ok(r) => Some(r),
+/// The value, or `None` (test skipped, with a message) when EGL cannot be opened at all; any
+/// other error panics with `what`.
+pub fn or_skip<T>(r: Result<T, HeadlessError>, what: &str) -> Option<T> {
+    match r {
+        Ok(v) => Some(v),
         Err(HeadlessError::EglUnavailable(msg)) => {
             eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
             None
         }
-        Err(e) => panic!("headless GL failed: {e}"),
+        Err(e) => panic!("{what}: {e}"),
     }
+}
+
+/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
+pub fn headless_with(errata: Errata) -> Option<HeadlessRenderer> {
+    or_skip(HeadlessRenderer::with_errata(errata), "headless GL failed")
 }
 
 pub fn headless() -> Option<HeadlessRenderer> {
