@@ -7,7 +7,7 @@
 //! - positions by the full matrix;
 //! - covariance per the RC, Σ = M C Cᵀ Mᵀ, stored back as scale + rotation. For a similarity M
 //!   this is closed form (rotation composed, scale multiplied); otherwise Σ is eigen-decomposed
-//!   in f64, which represents every Σ exactly up to rounding (see [`crate::covariance`]);
+//!   in f64, which represents every Σ exactly up to rounding (`src/covariance.rs`);
 //! - SH rotated by the orthogonal factor of M's polar decomposition (real Wigner-D, see
 //!   [`crate::sh::ShRotation`]).
 //!
