@@ -15,8 +15,7 @@ vec3 sh_color(int splat, vec3 view_dir) {
     for (int i = 0; i < MAX_SH_TEXELS; ++i) {
         if (i >= u_sh_fetch_texels) break;
         int linear_index = splat * u_sh_texels + i;
-        sh_texels[i] = texelFetch(u_sh, ivec2(linear_index & (TEX_WIDTH - 1),
-                                              linear_index >> TEX_WIDTH_LOG2), 0);
+        sh_texels[i] = texelFetch(u_sh, texel_coord(linear_index), 0);
     }
     float x = view_dir.x, y = view_dir.y, z = view_dir.z;
     vec3 result = SH_C0 * sh_coef(0);

@@ -6,8 +6,8 @@
 //! comes from [`crate::profile`] and [`crate::sh`]; the tests below fail if a define disagrees
 //! with its Rust constant or a shader spells one of those values as a literal.
 
-use glow::HasContext;
-
+use super::context::{ContextInfo, Profile};
+use super::data::TextureLayout;
 use crate::profile;
 
 /// Vertex stage of the splat program.
@@ -31,9 +31,10 @@ pub(crate) enum GlslVersion {
 }
 
 impl GlslVersion {
-    /// The version for a context: ES contexts get `300 es`, desktop ones `330 core`.
-    pub(crate) fn for_context(gl: &glow::Context) -> Self {
-        if gl.version().is_embedded {
+    /// The version for a context: ES contexts get `300 es`, desktop ones (core or
+    /// compatibility profile) `330 core`.
+    pub(crate) fn for_context(ctx: ContextInfo) -> Self {
+        if ctx.profile == Profile::Es {
             GlslVersion::Es300
         } else {
             GlslVersion::Core330
@@ -101,9 +102,10 @@ fn float_lit(v: f64) -> String {
 }
 
 /// The `#define`s shared by all stages: kernel constants, SH constants, texture layout
-/// (data textures `2^tex_width_log2` texels wide). Floats are written as the f32 the GPU uses
-/// (the profile's f64 values rounded once), except the SH constants, written in full.
-pub(crate) fn defines(tex_width_log2: u32) -> String {
+/// (data textures `2^width_log2` texels wide, `2^layer_rows_log2` rows per full layer), the
+/// scene's cloud limit. Floats are written as the f32 the GPU uses (the profile's f64 values
+/// rounded once), except the SH constants, written in full.
+pub(crate) fn defines(layout: &TextureLayout) -> String {
     use crate::sh::{SH_C0, SH_C1, SH_C2, SH_C3};
     let mut s = String::new();
     let mut def = |name: &str, value: String| s.push_str(&format!("#define {name} {value}\n"));
@@ -130,8 +132,11 @@ pub(crate) fn defines(tex_width_log2: u32) -> String {
     def("SRGB_SCALE", f32_lit(profile::SRGB_SCALE));
     def("SRGB_OFFSET", f32_lit(profile::SRGB_OFFSET));
     def("SRGB_GAMMA", f32_lit(profile::SRGB_GAMMA));
-    def("TEX_WIDTH", (1u32 << tex_width_log2).to_string());
-    def("TEX_WIDTH_LOG2", tex_width_log2.to_string());
+    def("TEX_WIDTH", (1u32 << layout.width_log2).to_string());
+    def("TEX_WIDTH_LOG2", layout.width_log2.to_string());
+    def("LAYER_ROWS", (1u32 << layout.layer_rows_log2).to_string());
+    def("LAYER_ROWS_LOG2", layout.layer_rows_log2.to_string());
+    def("MAX_CLOUDS", super::SplatScene::MAX_CLOUDS.to_string());
     def("GEOM_TEXELS", profile::GEOM_TEXELS.to_string());
     let texel = profile::GEOM_TEXEL_POSITION_OPACITY.to_string();
     def("GEOM_TEXEL_POSITION_OPACITY", texel);
@@ -150,20 +155,21 @@ pub(crate) fn defines(tex_width_log2: u32) -> String {
 pub(crate) fn assemble(
     version: GlslVersion,
     errata: &Errata,
-    tex_width_log2: u32,
+    layout: &TextureLayout,
     body: &str,
 ) -> String {
     // Desktop GLSL accepts (and ignores) float/int precision; sampler precision is ES-only.
     let precision = match version {
         GlslVersion::Es300 => {
-            "precision highp float;\nprecision highp int;\nprecision highp sampler2D;\n"
+            "precision highp float;\nprecision highp int;\nprecision highp sampler2D;\n\
+             precision highp sampler2DArray;\n"
         }
         GlslVersion::Core330 => "precision highp float;\nprecision highp int;\n",
     };
     format!(
         "{}\n{precision}{}{}{}",
         version.line(),
-        defines(tex_width_log2),
+        defines(layout),
         errata.defines(),
         body.replace("//@include sh.glsl", SH_GLSL)
     )
@@ -193,9 +199,14 @@ mod tests {
         ("resolve.frag", RESOLVE_FRAG),
     ];
 
-    /// `#define NAME VALUE` lines of `defines(11)`, parsed.
+    /// The layout the tests use: 2048 × 2048 layers.
+    fn layout() -> TextureLayout {
+        TextureLayout::for_limits(2048, 256)
+    }
+
+    /// `#define NAME VALUE` lines of `defines(&layout())`, parsed.
     fn parsed_defines() -> BTreeMap<String, f64> {
-        defines(11)
+        defines(&layout())
             .lines()
             .map(|l| {
                 let mut it = l.strip_prefix("#define ").expect(l).split(' ');
@@ -238,6 +249,12 @@ mod tests {
             ("MAX_SH_TEXELS".into(), profile::sh_texels(3) as f64),
             ("TEX_WIDTH".into(), 2048.0),
             ("TEX_WIDTH_LOG2".into(), 11.0),
+            ("LAYER_ROWS".into(), 2048.0),
+            ("LAYER_ROWS_LOG2".into(), 11.0),
+            (
+                "MAX_CLOUDS".into(),
+                crate::gl::SplatScene::MAX_CLOUDS as f64,
+            ),
         ];
         v.extend(
             SH_C2
@@ -256,7 +273,7 @@ mod tests {
 
     #[test]
     fn defines_carry_rust_constants() {
-        let d = defines(11);
+        let d = defines(&layout());
         assert!(d.contains(&format!("#define DILATION {}", float_lit(0.3f32 as f64))));
         assert!(d.contains("#define SH_C3_5 1.445"));
         assert!(d.contains("#define MAX_SH_TEXELS 12"));
@@ -366,7 +383,12 @@ mod tests {
 
     #[test]
     fn assembled_source_starts_with_version_and_splices_sh() {
-        let s = assemble(GlslVersion::Es300, &Errata::default(), 11, SPLAT_VERT);
+        let s = assemble(
+            GlslVersion::Es300,
+            &Errata::default(),
+            &layout(),
+            SPLAT_VERT,
+        );
         assert!(s.starts_with("#version 300 es\n"));
         assert!(s.contains("vec3 sh_color(int splat, vec3 view_dir)"));
         assert!(!s.contains("ERRATUM_A\n#") && !s.contains("#define ERRATUM"));
@@ -374,7 +396,9 @@ mod tests {
             a_transposed_rotation: true,
             ..Errata::default()
         };
-        assert!(assemble(GlslVersion::Core330, &e, 11, SPLAT_VERT).contains("#define ERRATUM_A"));
+        assert!(
+            assemble(GlslVersion::Core330, &e, &layout(), SPLAT_VERT).contains("#define ERRATUM_A")
+        );
     }
 
     #[test]

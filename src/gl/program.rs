@@ -118,8 +118,18 @@ mod tests {
             Err(e) => panic!("{e}"),
         };
         let gl = ctx.gl();
-        let v = assemble(GlslVersion::Es300, &Errata::default(), 11, RESOLVE_VERT);
-        let f = assemble(GlslVersion::Es300, &Errata::default(), 11, RESOLVE_FRAG);
+        let v = assemble(
+            GlslVersion::Es300,
+            &Errata::default(),
+            &crate::gl::data::TextureLayout::for_limits(2048, 1),
+            RESOLVE_VERT,
+        );
+        let f = assemble(
+            GlslVersion::Es300,
+            &Errata::default(),
+            &crate::gl::data::TextureLayout::for_limits(2048, 1),
+            RESOLVE_FRAG,
+        );
         let program = build_program(gl, "resolve", &v, &f).unwrap();
         let all = uniform_locations(gl, program, "resolve", ["u_accum", "u_origin"], true);
         assert!(all.iter().all(Option::is_some));

@@ -8,6 +8,8 @@
 use glow::HasContext;
 
 use super::GlError;
+use super::error::ErrorScope;
+use super::fault;
 use super::objects::{Creating, Owned};
 use crate::image::Image;
 
@@ -71,8 +73,10 @@ pub struct ReadbackTarget {
 
 impl ReadbackTarget {
     /// Creates the target (`depth: None` for colour only). Fails with
-    /// [`GlError::Unsupported`] for `Rgba16f` on an ES context without
-    /// `EXT_color_buffer_(half_)float`, [`GlError::Framebuffer`] when incomplete.
+    /// [`GlError::MissingExtension`] for `Rgba16f` on an ES context without
+    /// `GL_EXT_color_buffer_float` or `GL_EXT_color_buffer_half_float`,
+    /// [`GlError::Framebuffer`] when incomplete, [`GlError::Gl`] on a GL error (the host's
+    /// pending errors are kept, see [`super::state`]).
     pub fn new(
         gl: &glow::Context,
         width: u32,
@@ -80,17 +84,17 @@ impl ReadbackTarget {
         format: ColorFormat,
         depth: Option<DepthFormat>,
     ) -> Result<Self, GlError> {
-        if format == ColorFormat::Rgba16f && gl.version().is_embedded {
-            let ext = gl.supported_extensions();
-            if !ext.contains("GL_EXT_color_buffer_float")
-                && !ext.contains("GL_EXT_color_buffer_half_float")
-            {
-                return Err(GlError::Unsupported(
-                    "rendering to RGBA16F needs EXT_color_buffer_(half_)float".into(),
-                ));
-            }
+        if format == ColorFormat::Rgba16f
+            && gl.version().is_embedded
+            && !fault::has_extension(gl, "GL_EXT_color_buffer_float")
+            && !fault::has_extension(gl, "GL_EXT_color_buffer_half_float")
+        {
+            return Err(GlError::MissingExtension {
+                extension: "GL_EXT_color_buffer_float or GL_EXT_color_buffer_half_float",
+                needed_for: "an RGBA16F render target on OpenGL ES",
+            });
         }
-        super::clear_pending_errors(gl);
+        let errors = ErrorScope::begin(gl)?;
         let (w, h) = (width as i32, height as i32);
         let mut objects = Creating::new(gl);
         let color = objects.texture()?;
@@ -125,7 +129,7 @@ impl ReadbackTarget {
             gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, prev);
             status
         };
-        super::check_error(gl, "creating a framebuffer")?;
+        errors.end("creating a framebuffer")?;
         if status != glow::FRAMEBUFFER_COMPLETE {
             return Err(GlError::Framebuffer(status));
         }
@@ -182,9 +186,11 @@ impl ReadbackTarget {
     ///
     /// State: binds `GL_READ_FRAMEBUFFER` and restores the binding it found; leaves the pack
     /// state at the defaults it relies on (`GL_PIXEL_PACK_BUFFER` 0, `GL_PACK_ALIGNMENT` 4,
-    /// `GL_PACK_ROW_LENGTH`, `GL_PACK_SKIP_ROWS`, `GL_PACK_SKIP_PIXELS` 0). Checks `glGetError`.
+    /// `GL_PACK_ROW_LENGTH`, `GL_PACK_SKIP_ROWS`, `GL_PACK_SKIP_PIXELS` 0). Checks `glGetError`
+    /// around its own calls (keeping the host's pending errors).
     pub fn read_image(&self, gl: &glow::Context) -> Result<Image, GlError> {
         self.owned.check()?;
+        let errors = ErrorScope::begin(gl)?;
         let (w, h) = (self.width as usize, self.height as usize);
         let image = match self.format {
             ColorFormat::Rgba8 | ColorFormat::Srgb8Alpha8 => {
@@ -204,7 +210,7 @@ impl ReadbackTarget {
                 }
             }
         };
-        super::check_error(gl, "reading back a framebuffer")?;
+        errors.end("reading back a framebuffer")?;
         Ok(image)
     }
 

@@ -11,6 +11,8 @@
 use glow::HasContext;
 
 use super::GlError;
+use super::context::ContextInfo;
+use super::data::TextureLayout;
 use super::glsl::{self, Errata, GlslVersion};
 use super::objects::{Creating, Owned};
 use super::program;
@@ -40,9 +42,10 @@ struct ResolvePass {
 
 impl ResolvePass {
     fn new(gl: &glow::Context) -> Result<Self, GlError> {
-        let version = GlslVersion::for_context(gl);
-        let vs = glsl::assemble(version, &Errata::default(), 11, glsl::RESOLVE_VERT);
-        let fs = glsl::assemble(version, &Errata::default(), 11, glsl::RESOLVE_FRAG);
+        let version = GlslVersion::for_context(ContextInfo::check(gl)?);
+        let layout = TextureLayout::for_context(gl);
+        let vs = glsl::assemble(version, &Errata::default(), &layout, glsl::RESOLVE_VERT);
+        let fs = glsl::assemble(version, &Errata::default(), &layout, glsl::RESOLVE_FRAG);
         let mut objects = Creating::new(gl);
         let program = program::build_program_in(&mut objects, "resolve", &vs, &fs)?;
         let vao = objects.vertex_array()?;

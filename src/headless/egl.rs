@@ -60,39 +60,50 @@ fn egl() -> Result<&'static Egl, HeadlessError> {
     .map_err(|e| HeadlessError::EglUnavailable(e.clone()))
 }
 
-/// Which client API a [`HeadlessContext`] speaks. More kinds of context (desktop
-/// compatibility profiles, other versions) may be added: match with a wildcard arm.
+/// Which client API a [`HeadlessContext`] speaks. More kinds of context may be added: match
+/// with a wildcard arm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum GlApi {
     /// OpenGL ES 3.0 or newer (shaders get `#version 300 es`). The default.
     #[default]
     Gles3,
-    /// Desktop OpenGL 3.3 core profile (shaders get `#version 330 core`).
+    /// Desktop OpenGL 3.3 (or newer) core profile (shaders get `#version 330 core`).
     DesktopCore33,
+    /// Desktop OpenGL compatibility profile, 3.3 or newer (Mesa gives 4.5 on llvmpipe): the
+    /// fixed-function pipeline, immediate mode and client arrays of legacy hosts are all
+    /// there beside the shaders (which get `#version 330 core`).
+    DesktopCompat,
 }
 
 impl GlApi {
+    /// The `(major, minor)` version asked for by default.
+    fn default_version(self) -> (i32, i32) {
+        match self {
+            GlApi::Gles3 => (3, 0),
+            GlApi::DesktopCore33 | GlApi::DesktopCompat => (3, 3),
+        }
+    }
+
     /// What to ask EGL for: the `eglBindAPI` value, the `EGL_RENDERABLE_TYPE` bit a config
-    /// needs, and the `eglCreateContext` attributes (`EGL_NONE`-terminated).
-    fn egl_request(self) -> (egl::Enum, egl::Int, Vec<egl::Int>) {
-        let version = |major, minor| {
-            vec![
-                egl::CONTEXT_MAJOR_VERSION,
-                major,
-                egl::CONTEXT_MINOR_VERSION,
-                minor,
-            ]
-        };
-        let (bind, renderable, mut attribs) = match self {
-            GlApi::Gles3 => (egl::OPENGL_ES_API, egl::OPENGL_ES3_BIT, version(3, 0)),
+    /// needs, and the `eglCreateContext` attributes (`EGL_NONE`-terminated) for `version`.
+    fn egl_request(self, (major, minor): (i32, i32)) -> (egl::Enum, egl::Int, Vec<egl::Int>) {
+        let mut attribs = vec![
+            egl::CONTEXT_MAJOR_VERSION,
+            major,
+            egl::CONTEXT_MINOR_VERSION,
+            minor,
+        ];
+        let profile = |bit| [egl::CONTEXT_OPENGL_PROFILE_MASK, bit];
+        let (bind, renderable) = match self {
+            GlApi::Gles3 => (egl::OPENGL_ES_API, egl::OPENGL_ES3_BIT),
             GlApi::DesktopCore33 => {
-                let mut a = version(3, 3);
-                a.extend([
-                    egl::CONTEXT_OPENGL_PROFILE_MASK,
-                    egl::CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                ]);
-                (egl::OPENGL_API, egl::OPENGL_BIT, a)
+                attribs.extend(profile(egl::CONTEXT_OPENGL_CORE_PROFILE_BIT));
+                (egl::OPENGL_API, egl::OPENGL_BIT)
+            }
+            GlApi::DesktopCompat => {
+                attribs.extend(profile(egl::CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT));
+                (egl::OPENGL_API, egl::OPENGL_BIT)
             }
         };
         attribs.push(egl::NONE);
@@ -100,8 +111,8 @@ impl GlApi {
     }
 }
 
-/// An OpenGL ES 3 (or desktop GL 3.3 core) context on the surfaceless platform (no window, no
-/// default framebuffer: render into framebuffer objects such as a
+/// An OpenGL ES 3, desktop core or desktop compatibility context ([`GlApi`]) on the surfaceless
+/// platform (no window, no default framebuffer: render into framebuffer objects such as a
 /// [`ReadbackTarget`](crate::gl::ReadbackTarget)). Current on the creating thread; not `Send`.
 pub struct HeadlessContext {
     context: egl::Context,
@@ -125,10 +136,18 @@ impl HeadlessContext {
 
     /// Creates a context of the given API and makes it current on this thread.
     pub fn with_api(api: GlApi) -> Result<Self, HeadlessError> {
+        Self::with_api_version(api, api.default_version())
+    }
+
+    /// Like [`HeadlessContext::with_api`], asking EGL for the given `(major, minor)` version
+    /// (which the driver may raise: Mesa gives the newest compatible one). **For tests**
+    /// (context-creation failures, old versions; hidden from the documented API).
+    #[doc(hidden)]
+    pub fn with_api_version(api: GlApi, version: (i32, i32)) -> Result<Self, HeadlessError> {
         let e = egl()?;
         let display = e.display();
         let err = |call| move |error| HeadlessError::Egl { call, error };
-        let (bind, renderable, attribs) = api.egl_request();
+        let (bind, renderable, attribs) = api.egl_request(version);
         e.instance.bind_api(bind).map_err(err("eglBindAPI"))?;
         // Surfaceless: no window surfaces, so don't let SURFACE_TYPE default to WINDOW_BIT.
         let config_attribs = [
@@ -177,6 +196,18 @@ impl HeadlessContext {
     /// The GL function table (valid while this context is current).
     pub fn gl(&self) -> &glow::Context {
         &self.gl
+    }
+
+    /// The address of a GL function (`eglGetProcAddress`), or null when the driver does not
+    /// know it. For functions `glow` does not load, such as the fixed-function and
+    /// client-array calls of compatibility-profile hosts (`glMatrixMode`, `glBegin`,
+    /// `glVertexPointer`, …): cast it to the function's `extern "system"` pointer type.
+    /// Valid while this context is current.
+    pub fn get_proc_address(&self, name: &str) -> *const std::ffi::c_void {
+        egl()
+            .ok()
+            .and_then(|e| e.instance.get_proc_address(name))
+            .map_or(std::ptr::null(), |f| f as *const std::ffi::c_void)
     }
 
     /// Makes this context current on the calling thread (needed only when another context was

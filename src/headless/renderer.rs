@@ -151,10 +151,13 @@ impl HeadlessRenderer {
         let settings = DrawSettings {
             sh_degree: opts.sh_degree,
             depth_test: false,
+            color_space: Some(space),
+            ..DrawSettings::default()
         };
         let gl = self.ctx.gl();
         let target = self.target.as_ref().expect("prepared above");
-        // Desktop GL converts to sRGB on write only with GL_FRAMEBUFFER_SRGB (ES always does).
+        // Desktop GL converts to sRGB on write only with GL_FRAMEBUFFER_SRGB (ES always does):
+        // the clear needs it too (the draw sets it itself, from `color_space`).
         let desktop_srgb = srgb_fbo && !gl.version().is_embedded;
         target.bind(gl)?;
         // SAFETY: a capability switch and a clear of our own framebuffer, bound just above.
@@ -178,8 +181,8 @@ impl HeadlessRenderer {
                 }
             }
         })();
-        if desktop_srgb {
-            // SAFETY: restoring the default (disabled).
+        if !gl.version().is_embedded {
+            // SAFETY: restoring the default (disabled; the draw may have enabled it).
             unsafe { gl.disable(glow::FRAMEBUFFER_SRGB) };
         }
         let image = drawn
