@@ -218,10 +218,10 @@ fn upload_texture(
     mut fill: impl FnMut(usize, &mut [f32]),
 ) -> Result<glow::Texture, GlError> {
     let width = layout.width();
-    let (height, mut layers) = layout.shape(n, per_splat);
+    let (mut height, mut layers) = layout.shape(n, per_splat);
     let allocated_layers = match fault::get(|f| f.oversize_layers) {
         Some(l) => {
-            layers = layers.min(l as usize);
+            (height, layers) = (layout.layer_rows(), 1);
             l as usize
         }
         None => layers,

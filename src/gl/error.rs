@@ -118,7 +118,7 @@ const MAX_PENDING: usize = 8;
 /// host's: [`ErrorScope::begin`] drains the codes the host left pending, [`ErrorScope::end`]
 /// reads the backend's own, and on drop the host's codes are raised again, in order, with a
 /// side-effect-free invalid call each (a `glGetIntegerv(0)`, a vertex-attribute query past
-/// the last attribute, a buffer-parameter query on an unbound target). A host with
+/// the last attribute, a result query on a query name never begun). A host with
 /// `KHR_debug` output sees those calls as messages.
 pub(crate) struct ErrorScope<'gl> {
     gl: &'gl glow::Context,
@@ -201,15 +201,6 @@ fn reraisable(code: u32) -> bool {
     )
 }
 
-/// Buffer targets that exist on GLES 3.0 and GL 3.3; a parameter query on one with no buffer
-/// bound is `GL_INVALID_OPERATION` and changes nothing.
-const BUFFER_TARGETS: [(u32, u32); 4] = [
-    (glow::COPY_READ_BUFFER, glow::COPY_READ_BUFFER_BINDING),
-    (glow::COPY_WRITE_BUFFER, glow::COPY_WRITE_BUFFER_BINDING),
-    (glow::PIXEL_PACK_BUFFER, glow::PIXEL_PACK_BUFFER_BINDING),
-    (glow::UNIFORM_BUFFER, glow::UNIFORM_BUFFER_BINDING),
-];
-
 /// Raises `code` (one of [`reraisable`]'s) with a call that has no other effect.
 fn raise(gl: &glow::Context, code: u32) {
     // SAFETY: each call is an invalid query: GL records the error and writes nothing (the
@@ -228,11 +219,11 @@ fn raise(gl: &glow::Context, code: u32) {
                 );
             }
             glow::INVALID_OPERATION => {
-                let unbound = BUFFER_TARGETS
-                    .iter()
-                    .find(|(_, binding)| gl.get_parameter_i32(*binding) == 0);
-                if let Some((target, _)) = unbound {
-                    gl.get_buffer_parameter_i32(*target, glow::BUFFER_SIZE);
+                // A query name never begun is not a query object yet: asking for its result
+                // is invalid. The name is the backend's own and deleted at once.
+                if let Ok(q) = gl.create_query() {
+                    gl.get_query_parameter_u32(q, glow::QUERY_RESULT_AVAILABLE);
+                    gl.delete_query(q);
                 }
             }
             _ => {}

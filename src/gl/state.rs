@@ -130,6 +130,7 @@ pub(crate) use upload::Bindings;
 
 /// The contexts a piece of state exists in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Contexts {
     /// Every context (ES 3.x, desktop core, desktop compatibility).
     All,
@@ -144,6 +145,7 @@ pub enum Contexts {
 
 /// The value a piece of state is left at by a draw or `set_order` with `restore_state: false`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum LeftValue {
     /// Binding 0 (no object).
     Zero,
@@ -166,6 +168,7 @@ pub enum LeftValue {
 
 /// One row of [the table](#left-afterwards-with-restore_state-false).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Left {
     /// The state's GL name, as in `glGet*` (e.g. `"GL_CURRENT_PROGRAM"`).
     pub name: &'static str,

@@ -140,50 +140,26 @@ pub(crate) fn enter(
     (saved, c.calls)
 }
 
-/// Binds the program, VAO and textures (both modes); returns the host's bindings when asked.
-fn bind(c: &mut Counted<'_>, want: &DrawState, query: bool) -> Option<Saved> {
-    let mut saved = query.then(|| Saved {
-        // SAFETY (this block): binding queries.
-        program: unsafe { c.q().get_parameter_program(glow::CURRENT_PROGRAM) },
-        vao: unsafe { c.q().get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING) },
-        active_texture: c.int(glow::ACTIVE_TEXTURE),
-        units: [(None, None); 2],
-        caps: [None; CAPS.len()],
-        blend_func: None,
-        blend_equation: None,
-        depth_func: None,
-        depth_mask: None,
-        color_mask: None,
-        polygon_mode: None,
-    });
+/// Binds the program, VAO and textures; unbinds the samplers of units 0 and 1 where
+/// `unbind_sampler` says (a host sampler object would override the textures' NEAREST
+/// filtering, and RGBA32F is not filterable on ES 3.0).
+fn bind(c: &mut Counted<'_>, want: &DrawState, unbind_sampler: [bool; 2]) {
     // SAFETY: binds objects the renderer owns (valid on this context) and unbinds samplers.
     unsafe {
         c.s().use_program(Some(want.program));
         c.s().bind_vertex_array(Some(want.vao));
         for (unit, tex) in want.textures.iter().enumerate() {
             c.s().active_texture(glow::TEXTURE0 + unit as u32);
-            // A host sampler object would override the textures' NEAREST filtering (RGBA32F
-            // is not filterable on ES 3.0): unbind it (always, in plain mode).
-            let unbind_sampler = match &mut saved {
-                Some(s) => {
-                    let t = c.q().get_parameter_texture(glow::TEXTURE_BINDING_2D_ARRAY);
-                    let smp = c.q().get_parameter_sampler(glow::SAMPLER_BINDING);
-                    s.units[unit] = (t, smp);
-                    smp.is_some()
-                }
-                None => true,
-            };
             c.s().bind_texture(glow::TEXTURE_2D_ARRAY, Some(*tex));
-            if unbind_sampler {
+            if unbind_sampler[unit] {
                 c.s().bind_sampler(unit as u32, None);
             }
         }
     }
-    saved
 }
 
 fn enter_plain(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) {
-    bind(c, want, false);
+    bind(c, want, [true; 2]);
     for (cap, contexts) in CAPS {
         if exists(contexts, ctx) {
             c.set_cap(cap, want.cap(cap));
@@ -206,64 +182,110 @@ fn enter_plain(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) {
     }
 }
 
-fn enter_restoring(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) -> Saved {
-    let mut s = bind(c, want, true).expect("queried");
-    for (k, (cap, contexts)) in CAPS.into_iter().enumerate() {
-        if exists(contexts, ctx) {
-            // SAFETY: a capability query that exists on this context.
-            let host = unsafe { c.q().is_enabled(cap) };
-            if host != want.cap(cap) {
-                c.set_cap(cap, want.cap(cap));
-                s.caps[k] = Some(host);
-            }
-        }
-    }
-    let blend = [
-        glow::BLEND_SRC_RGB,
-        glow::BLEND_DST_RGB,
-        glow::BLEND_SRC_ALPHA,
-        glow::BLEND_DST_ALPHA,
-    ]
-    .map(|p| c.int(p));
-    let equation = [glow::BLEND_EQUATION_RGB, glow::BLEND_EQUATION_ALPHA].map(|p| c.int(p));
-    // SAFETY: state queries and setters with valid enums for this context.
+/// Queries every host value a draw may change, before anything is set: with a threaded GL
+/// (Mesa's glthread, vendor "threaded optimisation") queries wait for the command queue, and
+/// one batch of them waits once. Only the per-unit queries need `glActiveTexture` between.
+fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved {
+    // SAFETY: state queries of pnames that exist on this context; `glActiveTexture` to read
+    // the per-unit bindings (put back by `leave`).
     unsafe {
-        if blend != want.blend_func() {
-            let [sr, dr, sa, da] = want.blend_func();
-            c.s().blend_func_separate(sr, dr, sa, da);
-            s.blend_func = Some(blend);
-        }
-        if equation != [glow::FUNC_ADD; 2] {
-            c.s()
-                .blend_equation_separate(glow::FUNC_ADD, glow::FUNC_ADD);
-            s.blend_equation = Some(equation);
-        }
-        if want.depth_test {
-            let host = c.int(glow::DEPTH_FUNC);
-            if host != want.depth_func {
-                c.s().depth_func(want.depth_func);
-                s.depth_func = Some(host);
+        let mut s = Saved {
+            program: c.q().get_parameter_program(glow::CURRENT_PROGRAM),
+            vao: c.q().get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING),
+            active_texture: c.int(glow::ACTIVE_TEXTURE),
+            units: [(None, None); 2],
+            caps: [None; CAPS.len()],
+            blend_func: None,
+            blend_equation: None,
+            depth_func: None,
+            depth_mask: None,
+            color_mask: None,
+            polygon_mode: None,
+        };
+        for (k, (cap, contexts)) in CAPS.into_iter().enumerate() {
+            if exists(contexts, ctx) {
+                s.caps[k] = Some(c.q().is_enabled(cap));
             }
         }
-        if c.q().get_parameter_bool(glow::DEPTH_WRITEMASK) {
-            c.s().depth_mask(false);
-            s.depth_mask = Some(true);
+        s.blend_func = Some(
+            [
+                glow::BLEND_SRC_RGB,
+                glow::BLEND_DST_RGB,
+                glow::BLEND_SRC_ALPHA,
+                glow::BLEND_DST_ALPHA,
+            ]
+            .map(|p| c.int(p)),
+        );
+        s.blend_equation =
+            Some([glow::BLEND_EQUATION_RGB, glow::BLEND_EQUATION_ALPHA].map(|p| c.int(p)));
+        if depth_test {
+            s.depth_func = Some(c.int(glow::DEPTH_FUNC));
         }
-        let mask = c.q().get_parameter_bool_array::<4>(glow::COLOR_WRITEMASK);
-        if mask != [true; 4] {
-            c.s().color_mask(true, true, true, true);
-            s.color_mask = Some(mask);
-        }
+        s.depth_mask = Some(c.q().get_parameter_bool(glow::DEPTH_WRITEMASK));
+        s.color_mask = Some(c.q().get_parameter_bool_array::<4>(glow::COLOR_WRITEMASK));
         if ctx.desktop() {
             let mut mode = [0i32; 2];
             c.q().get_parameter_i32_slice(glow::POLYGON_MODE, &mut mode);
-            let mode = mode.map(|m| m as u32);
-            if mode != [glow::FILL; 2] {
-                c.s().polygon_mode(glow::FRONT_AND_BACK, glow::FILL);
-                s.polygon_mode = Some(mode);
-            }
+            s.polygon_mode = Some(mode.map(|m| m as u32));
+        }
+        for unit in 0..2 {
+            c.s().active_texture(glow::TEXTURE0 + unit as u32);
+            let tex = c.q().get_parameter_texture(glow::TEXTURE_BINDING_2D_ARRAY);
+            s.units[unit] = (tex, c.q().get_parameter_sampler(glow::SAMPLER_BINDING));
+        }
+        s
+    }
+}
+
+/// Restore mode: the host's values first, then only what differs is set; the returned
+/// [`Saved`] keeps (as `Some`) just the pieces that were changed.
+fn enter_restoring(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) -> Saved {
+    let mut s = query_host(c, ctx, want.depth_test);
+    bind(c, want, s.units.map(|(_, sampler)| sampler.is_some()));
+    for (k, (cap, _)) in CAPS.into_iter().enumerate() {
+        match s.caps[k] {
+            Some(host) if host != want.cap(cap) => c.set_cap(cap, want.cap(cap)),
+            _ => s.caps[k] = None,
         }
     }
+    /// Keeps `saved` only if it differs from `want`, calling `set` then.
+    fn differs<T: PartialEq + Copy>(saved: &mut Option<T>, want: T, set: impl FnOnce()) {
+        match *saved {
+            Some(host) if host != want => set(),
+            _ => *saved = None,
+        }
+    }
+    let sets = std::cell::Cell::new(0);
+    let gl = c.gl;
+    // SAFETY: plain state setters with valid enums for this context.
+    unsafe {
+        let [sr, dr, sa, da] = want.blend_func();
+        differs(&mut s.blend_func, want.blend_func(), || {
+            gl.blend_func_separate(sr, dr, sa, da);
+            sets.set(sets.get() + 1);
+        });
+        differs(&mut s.blend_equation, [glow::FUNC_ADD; 2], || {
+            gl.blend_equation_separate(glow::FUNC_ADD, glow::FUNC_ADD);
+            sets.set(sets.get() + 1);
+        });
+        differs(&mut s.depth_func, want.depth_func, || {
+            gl.depth_func(want.depth_func);
+            sets.set(sets.get() + 1);
+        });
+        differs(&mut s.depth_mask, false, || {
+            gl.depth_mask(false);
+            sets.set(sets.get() + 1);
+        });
+        differs(&mut s.color_mask, [true; 4], || {
+            gl.color_mask(true, true, true, true);
+            sets.set(sets.get() + 1);
+        });
+        differs(&mut s.polygon_mode, [glow::FILL; 2], || {
+            gl.polygon_mode(glow::FRONT_AND_BACK, glow::FILL);
+            sets.set(sets.get() + 1);
+        });
+    }
+    c.calls.sets += sets.get();
     s
 }
 
