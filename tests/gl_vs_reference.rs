@@ -299,6 +299,35 @@ fn same_scene_twice_is_bit_identical() {
 }
 
 #[test]
+fn a_render_does_not_depend_on_the_colour_space_of_the_one_before() {
+    // The draw switches GL_FRAMEBUFFER_SRGB per colour space and leaves it so: the next
+    // render's clear of an sRGB target must not inherit it.
+    let cloud = scene::random_cloud(500, 1, 0.8, 2);
+    let c = look_at_fov_deg(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 48, 40);
+    let bg = [0.3, 0.5, 0.7];
+    let linear = HeadlessOptions {
+        background: bg,
+        color_space: Some(ColorSpace::LinRec709Display),
+        ..Default::default()
+    };
+    let srgb = HeadlessOptions {
+        color_space: Some(ColorSpace::SrgbRec709Display),
+        ..linear
+    };
+    for api in [GlApi::Gles3, GlApi::DesktopCore33] {
+        let Some(ctx) = or_skip(HeadlessContext::with_api(api), "context") else {
+            return;
+        };
+        let mut r = HeadlessRenderer::with_context(ctx).unwrap();
+        r.upload(&cloud).unwrap();
+        let first = r.render(&c, &linear).unwrap();
+        r.render(&c, &srgb).unwrap();
+        let again = r.render(&c, &linear).unwrap();
+        assert_eq!(first.to_rgba8(), again.to_rgba8(), "{api:?}");
+    }
+}
+
+#[test]
 fn rgba16f_resolve_is_closer_to_the_reference_than_rgba8() {
     let Some(mut r) = headless() else { return };
     // Many low-opacity layers: where 8-bit blending loses most.

@@ -156,13 +156,17 @@ impl HeadlessRenderer {
         };
         let gl = self.ctx.gl();
         let target = self.target.as_ref().expect("prepared above");
-        // Desktop GL converts to sRGB on write only with GL_FRAMEBUFFER_SRGB (ES always does):
-        // the clear needs it too (the draw sets it itself, from `color_space`).
-        let desktop_srgb = srgb_fbo && !gl.version().is_embedded;
+        // Where GL_FRAMEBUFFER_SRGB can be switched (desktop GL, ES with
+        // EXT_sRGB_write_control) the sRGB target encodes only with it on: the clear needs it
+        // as the draw does (which sets it itself, from `color_space`, and leaves it so).
+        let srgb_switch = !gl.version().is_embedded
+            || gl
+                .supported_extensions()
+                .contains("GL_EXT_sRGB_write_control");
         target.bind(gl)?;
         // SAFETY: a capability switch and a clear of our own framebuffer, bound just above.
         unsafe {
-            if desktop_srgb {
+            if srgb_switch && srgb_fbo {
                 gl.enable(glow::FRAMEBUFFER_SRGB);
             }
             gl.clear_color(bg[0], bg[1], bg[2], 0.0);
@@ -181,10 +185,6 @@ impl HeadlessRenderer {
                 }
             }
         })();
-        if !gl.version().is_embedded {
-            // SAFETY: restoring the default (disabled; the draw may have enabled it).
-            unsafe { gl.disable(glow::FRAMEBUFFER_SRGB) };
-        }
         let image = drawn
             .and_then(|()| crate::gl::check_error(gl, "rendering"))
             .and_then(|()| target.read_image(gl));
