@@ -20,18 +20,30 @@
 //! # Ok(()) }
 //! ```
 //!
-//! * [`SplatRenderer`] and its [`DrawSettings`]: upload once, draw per frame.
+//! * [`SplatRenderer`] and its [`DrawSettings`]: upload once, draw per frame — with a
+//!   [`Camera`](crate::camera::Camera) (`draw`) or the host's own view and projection
+//!   matrices (`draw_with_matrices`: reversed-Z, infinite far, any [`DepthFunc`]).
+//!   `DrawSettings::restore_state` puts back every piece of GL state a call changes.
+//! * [`SplatScene`]: several clouds, each with its own model matrix, in one back-to-front
+//!   order.
 //! * [`ReadbackTarget`]: a framebuffer (RGBA8 / SRGB8_ALPHA8 / RGBA16F colour, optional depth)
 //!   read back into an [`Image`](crate::image::Image), for headless use, tests and hosts.
 //! * [`OffscreenTarget`]: the RGBA16F accumulation target with a resolve pass.
 //! * [`sort_back_to_front`] / [`DistanceSorter`]: the draw order, over the crate's radix sorter
 //!   ([`crate::sort::Sorter`]). `examples/embed.rs` shows a host-owned context.
-//! * [`state`]: every piece of GL state the backend touches.
+//! * [`state`]: every piece of GL state the backend touches, in both modes
+//!   (`docs/embedding.md` is the guide for hosts).
 //!
 //! Every type that owns GL objects has `destroy(&mut self, gl)`; call it with the context
 //! current before dropping the value (a live value dropped leaks its objects and warns once;
 //! a destroyed one returns [`GlError::Destroyed`]). Shaders get every number of the rendering
 //! profile as a generated `#define` ([`crate::profile`]).
+//!
+//! Contexts: OpenGL ES 3.x, desktop GL ≥ 3.3 core or compatibility profile (checked by
+//! `SplatRenderer::new`: [`GlError::ContextVersion`]). GL faults are errors, never a panic
+//! or a black image: compile/link logs, missing extensions, clouds beyond the texture
+//! limits ([`GlError::Capacity`]; below them clouds larger than one texture are spread over
+//! array-texture layers), `GL_OUT_OF_MEMORY` ([`GlError::Gl`]).
 
 mod context;
 pub(crate) mod data;
