@@ -264,26 +264,76 @@ pub fn query_all(gl: &glow::Context, lgl: &LegacyGl, pieces: &[Piece]) -> Vec<Ve
         .collect()
 }
 
+/// A setter closure from an unsafe GL block.
+macro_rules! s {
+    (|$h:ident| $body:expr) => {
+        Some(Box::new(move |$h: &Host| unsafe {
+            $body;
+        }) as Setter)
+    };
+}
+
+/// The list being built.
+struct Pieces(Vec<Piece>);
+
+impl Pieces {
+    fn add(&mut self, name: &str, pname: u32, unit: Option<u32>, q: Q, set: Option<Setter>) {
+        self.0.push(Piece {
+            name: name.to_owned(),
+            pname,
+            unit,
+            q,
+            distinct: true,
+            vao_state: false,
+            set,
+        })
+    }
+}
+
+fn int(pname: u32) -> Q {
+    Q::Int(pname, 1)
+}
+
 /// The host's pieces for `api` (only those that exist there), one per line.
 #[rustfmt::skip]
 pub fn pieces(host: &Host) -> Vec<Piece> {
-    let desktop = host.api != GlApi::Gles3;
     let compat = host.api == GlApi::DesktopCompat;
-    let mut v = Vec::new();
-    let mut add = |name: &str, pname: u32, unit: Option<u32>, q: Q, set: Option<Setter>| {
-        v.push(Piece { name: name.to_owned(), pname, unit, q, distinct: true, vao_state: false, set })
-    };
-    macro_rules! s {
-        (|$h:ident| $body:expr) => {
-            Some(Box::new(move |$h: &Host| unsafe { $body; }) as Setter)
-        };
+    let mut p = Pieces(Vec::new());
+    bindings(&mut p, host.api != GlApi::Gles3);
+    fixed_state(&mut p, host.api);
+    if host.api != GlApi::Gles3 {
+        desktop_state(&mut p);
     }
+    if host.srgb_switch {
+        // Desktop default: off (the host turns it on); ES default: on (the host turns it off).
+        p.add("GL_FRAMEBUFFER_SRGB", glow::FRAMEBUFFER_SRGB, None, Q::Enabled(glow::FRAMEBUFFER_SRGB), s!(|h| {
+            if h.api == GlApi::Gles3 { h.gl.disable(glow::FRAMEBUFFER_SRGB) } else { h.gl.enable(glow::FRAMEBUFFER_SRGB) }
+        }));
+    }
+    if compat {
+        compatibility_state(&mut p);
+    }
+    // Last: the active unit (the per-unit setters above change it).
+    p.add("GL_ACTIVE_TEXTURE", glow::ACTIVE_TEXTURE, None, int(glow::ACTIVE_TEXTURE), s!(|h| h.gl.active_texture(glow::TEXTURE3)));
+    let mut v = p.0;
+    for p in &mut v {
+        // The default, which splatgl changes for its draw and must put back.
+        p.distinct &= p.pname != glow::DEPTH_WRITEMASK;
+        p.distinct &= !(compat && p.pname == glow::VERTEX_ARRAY_BINDING);
+        p.vao_state = p.pname == glow::ELEMENT_ARRAY_BUFFER_BINDING || matches!(p.q, Q::Attrib(2, _));
+    }
+    v
+}
+
+/// Bindings: program, VAO and its attribute state, buffers, framebuffers, textures and
+/// samplers on several units.
+#[rustfmt::skip]
+fn bindings(p: &mut Pieces, desktop: bool) {
     use Q::*;
-    let int = |p| Int(p, 1);
     // --- bindings ---
-    add("GL_CURRENT_PROGRAM", glow::CURRENT_PROGRAM, None, int(glow::CURRENT_PROGRAM), s!(|h| h.gl.use_program(Some(h.program))));
+    p.add("GL_CURRENT_PROGRAM", glow::CURRENT_PROGRAM, None, int(glow::CURRENT_PROGRAM), s!(|h| h.gl.use_program(Some(h.program))));
     // The compatibility host draws from client arrays on the default VAO 0 (not distinctive).
-    add("GL_VERTEX_ARRAY_BINDING", glow::VERTEX_ARRAY_BINDING, None, int(glow::VERTEX_ARRAY_BINDING), s!(|h| h.gl.bind_vertex_array(h.vao)));
+    p.add("GL_VERTEX_ARRAY_BINDING", glow::VERTEX_ARRAY_BINDING, None, int(glow::VERTEX_ARRAY_BINDING), s!(|h| h.gl.bind_vertex_array(h.vao)));
     for (name, target, binding, k) in [
         ("GL_ARRAY_BUFFER_BINDING", glow::ARRAY_BUFFER, glow::ARRAY_BUFFER_BINDING, ARRAY),
         ("GL_ELEMENT_ARRAY_BUFFER_BINDING", glow::ELEMENT_ARRAY_BUFFER, glow::ELEMENT_ARRAY_BUFFER_BINDING, ELEMENT),
@@ -294,24 +344,24 @@ pub fn pieces(host: &Host) -> Vec<Piece> {
         ("GL_COPY_WRITE_BUFFER_BINDING", glow::COPY_WRITE_BUFFER, glow::COPY_WRITE_BUFFER_BINDING, COPY_WRITE),
         ("GL_TRANSFORM_FEEDBACK_BUFFER_BINDING", glow::TRANSFORM_FEEDBACK_BUFFER, glow::TRANSFORM_FEEDBACK_BUFFER_BINDING, TF_BUFFER),
     ] {
-        add(name, binding, None, int(binding), s!(|h| h.gl.bind_buffer(target, Some(h.buffers[k]))));
+        p.add(name, binding, None, int(binding), s!(|h| h.gl.bind_buffer(target, Some(h.buffers[k]))));
     }
     // The host's vertex array (VAO 0 in the compatibility profile) keeps an attribute
     // pointer of its own, and a generic current value.
-    add("GL_VERTEX_ATTRIB_ARRAY_ENABLED[2]", glow::VERTEX_ATTRIB_ARRAY_ENABLED, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_ENABLED), s!(|h| {
+    p.add("GL_VERTEX_ATTRIB_ARRAY_ENABLED[2]", glow::VERTEX_ATTRIB_ARRAY_ENABLED, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_ENABLED), s!(|h| {
         h.gl.bind_buffer(glow::ARRAY_BUFFER, Some(h.buffers[ARRAY]));
         h.gl.vertex_attrib_pointer_f32(2, 3, glow::FLOAT, false, 20, 8);
         h.gl.vertex_attrib_divisor(2, 2);
         h.gl.enable_vertex_attrib_array(2)
     }));
-    add("GL_VERTEX_ATTRIB_ARRAY_STRIDE[2]", glow::VERTEX_ATTRIB_ARRAY_STRIDE, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_STRIDE), None);
-    add("GL_VERTEX_ATTRIB_ARRAY_DIVISOR[2]", glow::VERTEX_ATTRIB_ARRAY_DIVISOR, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_DIVISOR), None);
-    add("GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING[2]", glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING), None);
-    add("GL_CURRENT_VERTEX_ATTRIB[3]", glow::CURRENT_VERTEX_ATTRIB, None, Attrib(3, glow::CURRENT_VERTEX_ATTRIB), s!(|h| h.gl.vertex_attrib_4_f32(3, 0.1, 0.2, 0.3, 0.4)));
-    add("GL_TRANSFORM_FEEDBACK_BINDING", glow::TRANSFORM_FEEDBACK_BINDING, None, int(glow::TRANSFORM_FEEDBACK_BINDING), s!(|h| h.gl.bind_transform_feedback(glow::TRANSFORM_FEEDBACK, Some(h.tf))));
-    add("GL_RENDERBUFFER_BINDING", glow::RENDERBUFFER_BINDING, None, int(glow::RENDERBUFFER_BINDING), s!(|h| h.gl.bind_renderbuffer(glow::RENDERBUFFER, Some(h.rb))));
-    add("GL_DRAW_FRAMEBUFFER_BINDING", glow::DRAW_FRAMEBUFFER_BINDING, None, int(glow::DRAW_FRAMEBUFFER_BINDING), s!(|h| h.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(h.draw_fbo))));
-    add("GL_READ_FRAMEBUFFER_BINDING", glow::READ_FRAMEBUFFER_BINDING, None, int(glow::READ_FRAMEBUFFER_BINDING), s!(|h| h.gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(h.read_fbo))));
+    p.add("GL_VERTEX_ATTRIB_ARRAY_STRIDE[2]", glow::VERTEX_ATTRIB_ARRAY_STRIDE, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_STRIDE), None);
+    p.add("GL_VERTEX_ATTRIB_ARRAY_DIVISOR[2]", glow::VERTEX_ATTRIB_ARRAY_DIVISOR, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_DIVISOR), None);
+    p.add("GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING[2]", glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, None, Attrib(2, glow::VERTEX_ATTRIB_ARRAY_BUFFER_BINDING), None);
+    p.add("GL_CURRENT_VERTEX_ATTRIB[3]", glow::CURRENT_VERTEX_ATTRIB, None, Attrib(3, glow::CURRENT_VERTEX_ATTRIB), s!(|h| h.gl.vertex_attrib_4_f32(3, 0.1, 0.2, 0.3, 0.4)));
+    p.add("GL_TRANSFORM_FEEDBACK_BINDING", glow::TRANSFORM_FEEDBACK_BINDING, None, int(glow::TRANSFORM_FEEDBACK_BINDING), s!(|h| h.gl.bind_transform_feedback(glow::TRANSFORM_FEEDBACK, Some(h.tf))));
+    p.add("GL_RENDERBUFFER_BINDING", glow::RENDERBUFFER_BINDING, None, int(glow::RENDERBUFFER_BINDING), s!(|h| h.gl.bind_renderbuffer(glow::RENDERBUFFER, Some(h.rb))));
+    p.add("GL_DRAW_FRAMEBUFFER_BINDING", glow::DRAW_FRAMEBUFFER_BINDING, None, int(glow::DRAW_FRAMEBUFFER_BINDING), s!(|h| h.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(h.draw_fbo))));
+    p.add("GL_READ_FRAMEBUFFER_BINDING", glow::READ_FRAMEBUFFER_BINDING, None, int(glow::READ_FRAMEBUFFER_BINDING), s!(|h| h.gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(h.read_fbo))));
     // --- textures and samplers on several units ---
     let unit_bind = |target: u32, pick: fn(&Host, usize) -> glow::Texture, unit: u32| -> Setter {
         Box::new(move |h: &Host| unsafe {
@@ -320,35 +370,41 @@ pub fn pieces(host: &Host) -> Vec<Piece> {
         })
     };
     for u in 0..4 {
-        add("GL_TEXTURE_BINDING_2D", glow::TEXTURE_BINDING_2D, Some(u), int(glow::TEXTURE_BINDING_2D), Some(unit_bind(glow::TEXTURE_2D, |h, u| h.tex2d[u], u)));
+        p.add("GL_TEXTURE_BINDING_2D", glow::TEXTURE_BINDING_2D, Some(u), int(glow::TEXTURE_BINDING_2D), Some(unit_bind(glow::TEXTURE_2D, |h, u| h.tex2d[u], u)));
     }
     for u in 0..3 {
-        add("GL_TEXTURE_BINDING_2D_ARRAY", glow::TEXTURE_BINDING_2D_ARRAY, Some(u), int(glow::TEXTURE_BINDING_2D_ARRAY), Some(unit_bind(glow::TEXTURE_2D_ARRAY, |h, u| h.tex_array[u], u)));
-        add("GL_SAMPLER_BINDING", glow::SAMPLER_BINDING, Some(u), int(glow::SAMPLER_BINDING), Some(Box::new(move |h: &Host| unsafe { h.gl.bind_sampler(u, Some(h.samplers[u as usize])) })));
+        p.add("GL_TEXTURE_BINDING_2D_ARRAY", glow::TEXTURE_BINDING_2D_ARRAY, Some(u), int(glow::TEXTURE_BINDING_2D_ARRAY), Some(unit_bind(glow::TEXTURE_2D_ARRAY, |h, u| h.tex_array[u], u)));
+        p.add("GL_SAMPLER_BINDING", glow::SAMPLER_BINDING, Some(u), int(glow::SAMPLER_BINDING), Some(Box::new(move |h: &Host| unsafe { h.gl.bind_sampler(u, Some(h.samplers[u as usize])) })));
     }
-    add("GL_TEXTURE_BINDING_3D", glow::TEXTURE_BINDING_3D, Some(0), int(glow::TEXTURE_BINDING_3D), Some(unit_bind(glow::TEXTURE_3D, |h, _| h.tex3d, 0)));
-    add("GL_TEXTURE_BINDING_CUBE_MAP", glow::TEXTURE_BINDING_CUBE_MAP, Some(1), int(glow::TEXTURE_BINDING_CUBE_MAP), Some(unit_bind(glow::TEXTURE_CUBE_MAP, |h, _| h.cube, 1)));
+    p.add("GL_TEXTURE_BINDING_3D", glow::TEXTURE_BINDING_3D, Some(0), int(glow::TEXTURE_BINDING_3D), Some(unit_bind(glow::TEXTURE_3D, |h, _| h.tex3d, 0)));
+    p.add("GL_TEXTURE_BINDING_CUBE_MAP", glow::TEXTURE_BINDING_CUBE_MAP, Some(1), int(glow::TEXTURE_BINDING_CUBE_MAP), Some(unit_bind(glow::TEXTURE_CUBE_MAP, |h, _| h.cube, 1)));
     if desktop {
-        add("GL_TEXTURE_BINDING_1D", glow::TEXTURE_BINDING_1D, Some(2), int(glow::TEXTURE_BINDING_1D), Some(unit_bind(glow::TEXTURE_1D, |h, _| h.tex1d.unwrap(), 2)));
-        add("GL_TEXTURE_BINDING_RECTANGLE", glow::TEXTURE_BINDING_RECTANGLE, Some(3), int(glow::TEXTURE_BINDING_RECTANGLE), Some(unit_bind(glow::TEXTURE_RECTANGLE, |h, _| h.rect.unwrap(), 3)));
+        p.add("GL_TEXTURE_BINDING_1D", glow::TEXTURE_BINDING_1D, Some(2), int(glow::TEXTURE_BINDING_1D), Some(unit_bind(glow::TEXTURE_1D, |h, _| h.tex1d.unwrap(), 2)));
+        p.add("GL_TEXTURE_BINDING_RECTANGLE", glow::TEXTURE_BINDING_RECTANGLE, Some(3), int(glow::TEXTURE_BINDING_RECTANGLE), Some(unit_bind(glow::TEXTURE_RECTANGLE, |h, _| h.rect.unwrap(), 3)));
     }
+}
+
+/// Blend, depth, stencil, scissor, colour, viewport, polygon, rasterisation, hints, pixel store.
+#[rustfmt::skip]
+fn fixed_state(p: &mut Pieces, api: GlApi) {
+    use Q::*;
     // --- blending ---
-    add("GL_BLEND", glow::BLEND, None, Enabled(glow::BLEND), s!(|h| h.gl.enable(glow::BLEND)));
-    add("GL_BLEND_SRC_RGB", glow::BLEND_SRC_RGB, None, int(glow::BLEND_SRC_RGB), s!(|h| h.gl.blend_func_separate(glow::DST_COLOR, glow::SRC_COLOR, glow::ONE_MINUS_DST_ALPHA, glow::CONSTANT_ALPHA)));
-    add("GL_BLEND_DST_RGB", glow::BLEND_DST_RGB, None, int(glow::BLEND_DST_RGB), None);
-    add("GL_BLEND_SRC_ALPHA", glow::BLEND_SRC_ALPHA, None, int(glow::BLEND_SRC_ALPHA), None);
-    add("GL_BLEND_DST_ALPHA", glow::BLEND_DST_ALPHA, None, int(glow::BLEND_DST_ALPHA), None);
-    add("GL_BLEND_EQUATION_RGB", glow::BLEND_EQUATION_RGB, None, int(glow::BLEND_EQUATION_RGB), s!(|h| h.gl.blend_equation_separate(glow::FUNC_SUBTRACT, glow::MAX)));
-    add("GL_BLEND_EQUATION_ALPHA", glow::BLEND_EQUATION_ALPHA, None, int(glow::BLEND_EQUATION_ALPHA), None);
-    add("GL_BLEND_COLOR", glow::BLEND_COLOR, None, Float(glow::BLEND_COLOR, 4), s!(|h| h.gl.blend_color(0.1, 0.2, 0.3, 0.4)));
+    p.add("GL_BLEND", glow::BLEND, None, Enabled(glow::BLEND), s!(|h| h.gl.enable(glow::BLEND)));
+    p.add("GL_BLEND_SRC_RGB", glow::BLEND_SRC_RGB, None, int(glow::BLEND_SRC_RGB), s!(|h| h.gl.blend_func_separate(glow::DST_COLOR, glow::SRC_COLOR, glow::ONE_MINUS_DST_ALPHA, glow::CONSTANT_ALPHA)));
+    p.add("GL_BLEND_DST_RGB", glow::BLEND_DST_RGB, None, int(glow::BLEND_DST_RGB), None);
+    p.add("GL_BLEND_SRC_ALPHA", glow::BLEND_SRC_ALPHA, None, int(glow::BLEND_SRC_ALPHA), None);
+    p.add("GL_BLEND_DST_ALPHA", glow::BLEND_DST_ALPHA, None, int(glow::BLEND_DST_ALPHA), None);
+    p.add("GL_BLEND_EQUATION_RGB", glow::BLEND_EQUATION_RGB, None, int(glow::BLEND_EQUATION_RGB), s!(|h| h.gl.blend_equation_separate(glow::FUNC_SUBTRACT, glow::MAX)));
+    p.add("GL_BLEND_EQUATION_ALPHA", glow::BLEND_EQUATION_ALPHA, None, int(glow::BLEND_EQUATION_ALPHA), None);
+    p.add("GL_BLEND_COLOR", glow::BLEND_COLOR, None, Float(glow::BLEND_COLOR, 4), s!(|h| h.gl.blend_color(0.1, 0.2, 0.3, 0.4)));
     // --- depth ---
-    add("GL_DEPTH_TEST", glow::DEPTH_TEST, None, Enabled(glow::DEPTH_TEST), s!(|h| h.gl.enable(glow::DEPTH_TEST)));
-    add("GL_DEPTH_FUNC", glow::DEPTH_FUNC, None, int(glow::DEPTH_FUNC), s!(|h| h.gl.depth_func(glow::GEQUAL)));
-    add("GL_DEPTH_WRITEMASK", glow::DEPTH_WRITEMASK, None, int(glow::DEPTH_WRITEMASK), s!(|h| h.gl.depth_mask(true)));
-    add("GL_DEPTH_CLEAR_VALUE", glow::DEPTH_CLEAR_VALUE, None, Float(glow::DEPTH_CLEAR_VALUE, 1), s!(|h| h.gl.clear_depth_f32(0.25)));
-    add("GL_DEPTH_RANGE", glow::DEPTH_RANGE, None, Float(glow::DEPTH_RANGE, 2), s!(|h| h.gl.depth_range_f32(0.125, 0.875)));
+    p.add("GL_DEPTH_TEST", glow::DEPTH_TEST, None, Enabled(glow::DEPTH_TEST), s!(|h| h.gl.enable(glow::DEPTH_TEST)));
+    p.add("GL_DEPTH_FUNC", glow::DEPTH_FUNC, None, int(glow::DEPTH_FUNC), s!(|h| h.gl.depth_func(glow::GEQUAL)));
+    p.add("GL_DEPTH_WRITEMASK", glow::DEPTH_WRITEMASK, None, int(glow::DEPTH_WRITEMASK), s!(|h| h.gl.depth_mask(true)));
+    p.add("GL_DEPTH_CLEAR_VALUE", glow::DEPTH_CLEAR_VALUE, None, Float(glow::DEPTH_CLEAR_VALUE, 1), s!(|h| h.gl.clear_depth_f32(0.25)));
+    p.add("GL_DEPTH_RANGE", glow::DEPTH_RANGE, None, Float(glow::DEPTH_RANGE, 2), s!(|h| h.gl.depth_range_f32(0.125, 0.875)));
     // --- stencil ---
-    add("GL_STENCIL_TEST", glow::STENCIL_TEST, None, Enabled(glow::STENCIL_TEST), s!(|h| {
+    p.add("GL_STENCIL_TEST", glow::STENCIL_TEST, None, Enabled(glow::STENCIL_TEST), s!(|h| {
         h.gl.enable(glow::STENCIL_TEST);
         h.gl.stencil_func_separate(glow::FRONT, glow::GREATER, 5, 0x3C);
         h.gl.stencil_func_separate(glow::BACK, glow::LEQUAL, 7, 0x0F);
@@ -373,35 +429,35 @@ pub fn pieces(host: &Host) -> Vec<Piece> {
         ("GL_STENCIL_BACK_WRITEMASK", glow::STENCIL_BACK_WRITEMASK),
         ("GL_STENCIL_CLEAR_VALUE", glow::STENCIL_CLEAR_VALUE),
     ] {
-        add(name, pname, None, int(pname), None);
+        p.add(name, pname, None, int(pname), None);
     }
     // --- scissor, colour, viewport ---
-    add("GL_SCISSOR_TEST", glow::SCISSOR_TEST, None, Enabled(glow::SCISSOR_TEST), s!(|h| h.gl.enable(glow::SCISSOR_TEST)));
-    add("GL_SCISSOR_BOX", glow::SCISSOR_BOX, None, Int(glow::SCISSOR_BOX, 4), s!(|h| h.gl.scissor(1, 2, 30, 40)));
-    add("GL_COLOR_WRITEMASK", glow::COLOR_WRITEMASK, None, Int(glow::COLOR_WRITEMASK, 4), s!(|h| h.gl.color_mask(true, false, true, false)));
-    add("GL_COLOR_CLEAR_VALUE", glow::COLOR_CLEAR_VALUE, None, Float(glow::COLOR_CLEAR_VALUE, 4), s!(|h| h.gl.clear_color(0.5, 0.25, 0.125, 0.75)));
-    add("GL_VIEWPORT", glow::VIEWPORT, None, Int(glow::VIEWPORT, 4), s!(|h| h.gl.viewport(3, 4, 50, 60)));
-    add("GL_DITHER", glow::DITHER, None, Enabled(glow::DITHER), s!(|h| h.gl.disable(glow::DITHER)));
+    p.add("GL_SCISSOR_TEST", glow::SCISSOR_TEST, None, Enabled(glow::SCISSOR_TEST), s!(|h| h.gl.enable(glow::SCISSOR_TEST)));
+    p.add("GL_SCISSOR_BOX", glow::SCISSOR_BOX, None, Int(glow::SCISSOR_BOX, 4), s!(|h| h.gl.scissor(1, 2, 30, 40)));
+    p.add("GL_COLOR_WRITEMASK", glow::COLOR_WRITEMASK, None, Int(glow::COLOR_WRITEMASK, 4), s!(|h| h.gl.color_mask(true, false, true, false)));
+    p.add("GL_COLOR_CLEAR_VALUE", glow::COLOR_CLEAR_VALUE, None, Float(glow::COLOR_CLEAR_VALUE, 4), s!(|h| h.gl.clear_color(0.5, 0.25, 0.125, 0.75)));
+    p.add("GL_VIEWPORT", glow::VIEWPORT, None, Int(glow::VIEWPORT, 4), s!(|h| h.gl.viewport(3, 4, 50, 60)));
+    p.add("GL_DITHER", glow::DITHER, None, Enabled(glow::DITHER), s!(|h| h.gl.disable(glow::DITHER)));
     // --- polygon state and rasterisation ---
-    add("GL_CULL_FACE", glow::CULL_FACE, None, Enabled(glow::CULL_FACE), s!(|h| h.gl.enable(glow::CULL_FACE)));
-    add("GL_CULL_FACE_MODE", glow::CULL_FACE_MODE, None, int(glow::CULL_FACE_MODE), s!(|h| h.gl.cull_face(glow::FRONT_AND_BACK)));
-    add("GL_FRONT_FACE", glow::FRONT_FACE, None, int(glow::FRONT_FACE), s!(|h| h.gl.front_face(glow::CW)));
-    add("GL_POLYGON_OFFSET_FILL", glow::POLYGON_OFFSET_FILL, None, Enabled(glow::POLYGON_OFFSET_FILL), s!(|h| h.gl.enable(glow::POLYGON_OFFSET_FILL)));
-    add("GL_POLYGON_OFFSET_FACTOR", glow::POLYGON_OFFSET_FACTOR, None, Float(glow::POLYGON_OFFSET_FACTOR, 1), s!(|h| h.gl.polygon_offset(2.5, -1.5)));
-    add("GL_POLYGON_OFFSET_UNITS", glow::POLYGON_OFFSET_UNITS, None, Float(glow::POLYGON_OFFSET_UNITS, 1), None);
-    add("GL_RASTERIZER_DISCARD", glow::RASTERIZER_DISCARD, None, Enabled(glow::RASTERIZER_DISCARD), s!(|h| h.gl.enable(glow::RASTERIZER_DISCARD)));
-    add("GL_SAMPLE_ALPHA_TO_COVERAGE", glow::SAMPLE_ALPHA_TO_COVERAGE, None, Enabled(glow::SAMPLE_ALPHA_TO_COVERAGE), s!(|h| h.gl.enable(glow::SAMPLE_ALPHA_TO_COVERAGE)));
-    add("GL_SAMPLE_COVERAGE", glow::SAMPLE_COVERAGE, None, Enabled(glow::SAMPLE_COVERAGE), s!(|h| {
+    p.add("GL_CULL_FACE", glow::CULL_FACE, None, Enabled(glow::CULL_FACE), s!(|h| h.gl.enable(glow::CULL_FACE)));
+    p.add("GL_CULL_FACE_MODE", glow::CULL_FACE_MODE, None, int(glow::CULL_FACE_MODE), s!(|h| h.gl.cull_face(glow::FRONT_AND_BACK)));
+    p.add("GL_FRONT_FACE", glow::FRONT_FACE, None, int(glow::FRONT_FACE), s!(|h| h.gl.front_face(glow::CW)));
+    p.add("GL_POLYGON_OFFSET_FILL", glow::POLYGON_OFFSET_FILL, None, Enabled(glow::POLYGON_OFFSET_FILL), s!(|h| h.gl.enable(glow::POLYGON_OFFSET_FILL)));
+    p.add("GL_POLYGON_OFFSET_FACTOR", glow::POLYGON_OFFSET_FACTOR, None, Float(glow::POLYGON_OFFSET_FACTOR, 1), s!(|h| h.gl.polygon_offset(2.5, -1.5)));
+    p.add("GL_POLYGON_OFFSET_UNITS", glow::POLYGON_OFFSET_UNITS, None, Float(glow::POLYGON_OFFSET_UNITS, 1), None);
+    p.add("GL_RASTERIZER_DISCARD", glow::RASTERIZER_DISCARD, None, Enabled(glow::RASTERIZER_DISCARD), s!(|h| h.gl.enable(glow::RASTERIZER_DISCARD)));
+    p.add("GL_SAMPLE_ALPHA_TO_COVERAGE", glow::SAMPLE_ALPHA_TO_COVERAGE, None, Enabled(glow::SAMPLE_ALPHA_TO_COVERAGE), s!(|h| h.gl.enable(glow::SAMPLE_ALPHA_TO_COVERAGE)));
+    p.add("GL_SAMPLE_COVERAGE", glow::SAMPLE_COVERAGE, None, Enabled(glow::SAMPLE_COVERAGE), s!(|h| {
         h.gl.enable(glow::SAMPLE_COVERAGE);
         h.gl.sample_coverage(0.5, true)
     }));
-    add("GL_SAMPLE_COVERAGE_VALUE", glow::SAMPLE_COVERAGE_VALUE, None, Float(glow::SAMPLE_COVERAGE_VALUE, 1), None);
-    add("GL_SAMPLE_COVERAGE_INVERT", glow::SAMPLE_COVERAGE_INVERT, None, int(glow::SAMPLE_COVERAGE_INVERT), None);
-    add("GL_PRIMITIVE_RESTART_FIXED_INDEX", glow::PRIMITIVE_RESTART_FIXED_INDEX, None, Enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX), s!(|h| h.gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX)));
-    if host.api != GlApi::DesktopCore33 {
-        add("GL_GENERATE_MIPMAP_HINT", glow::GENERATE_MIPMAP_HINT, None, int(glow::GENERATE_MIPMAP_HINT), s!(|h| h.gl.hint(glow::GENERATE_MIPMAP_HINT, glow::NICEST)));
+    p.add("GL_SAMPLE_COVERAGE_VALUE", glow::SAMPLE_COVERAGE_VALUE, None, Float(glow::SAMPLE_COVERAGE_VALUE, 1), None);
+    p.add("GL_SAMPLE_COVERAGE_INVERT", glow::SAMPLE_COVERAGE_INVERT, None, int(glow::SAMPLE_COVERAGE_INVERT), None);
+    p.add("GL_PRIMITIVE_RESTART_FIXED_INDEX", glow::PRIMITIVE_RESTART_FIXED_INDEX, None, Enabled(glow::PRIMITIVE_RESTART_FIXED_INDEX), s!(|h| h.gl.enable(glow::PRIMITIVE_RESTART_FIXED_INDEX)));
+    if api != GlApi::DesktopCore33 {
+        p.add("GL_GENERATE_MIPMAP_HINT", glow::GENERATE_MIPMAP_HINT, None, int(glow::GENERATE_MIPMAP_HINT), s!(|h| h.gl.hint(glow::GENERATE_MIPMAP_HINT, glow::NICEST)));
     }
-    add("GL_FRAGMENT_SHADER_DERIVATIVE_HINT", glow::FRAGMENT_SHADER_DERIVATIVE_HINT, None, int(glow::FRAGMENT_SHADER_DERIVATIVE_HINT), s!(|h| h.gl.hint(glow::FRAGMENT_SHADER_DERIVATIVE_HINT, glow::FASTEST)));
+    p.add("GL_FRAGMENT_SHADER_DERIVATIVE_HINT", glow::FRAGMENT_SHADER_DERIVATIVE_HINT, None, int(glow::FRAGMENT_SHADER_DERIVATIVE_HINT), s!(|h| h.gl.hint(glow::FRAGMENT_SHADER_DERIVATIVE_HINT, glow::FASTEST)));
     // --- pixel store ---
     for (name, pname, value) in [
         ("GL_UNPACK_ALIGNMENT", glow::UNPACK_ALIGNMENT, 1),
@@ -415,33 +471,38 @@ pub fn pieces(host: &Host) -> Vec<Piece> {
         ("GL_PACK_SKIP_ROWS", glow::PACK_SKIP_ROWS, 1),
         ("GL_PACK_SKIP_PIXELS", glow::PACK_SKIP_PIXELS, 4),
     ] {
-        add(name, pname, None, int(pname), s!(|h| h.gl.pixel_store_i32(pname, value)));
+        p.add(name, pname, None, int(pname), s!(|h| h.gl.pixel_store_i32(pname, value)));
     }
-    // --- desktop GL ---
-    if desktop {
-        add("GL_POLYGON_MODE", glow::POLYGON_MODE, None, Int(glow::POLYGON_MODE, 2), s!(|h| h.gl.polygon_mode(glow::FRONT_AND_BACK, glow::LINE)));
-        add("GL_COLOR_LOGIC_OP", glow::COLOR_LOGIC_OP, None, Enabled(glow::COLOR_LOGIC_OP), s!(|h| {
+}
+
+/// Desktop GL only: polygon mode, logic op, desktop capabilities and pixel store.
+#[rustfmt::skip]
+fn desktop_state(p: &mut Pieces) {
+    use Q::*;
+    {
+        p.add("GL_POLYGON_MODE", glow::POLYGON_MODE, None, Int(glow::POLYGON_MODE, 2), s!(|h| h.gl.polygon_mode(glow::FRONT_AND_BACK, glow::LINE)));
+        p.add("GL_COLOR_LOGIC_OP", glow::COLOR_LOGIC_OP, None, Enabled(glow::COLOR_LOGIC_OP), s!(|h| {
             h.gl.enable(glow::COLOR_LOGIC_OP);
             (h.lgl.logic_op)(lg::XOR)
         }));
-        add("GL_LOGIC_OP_MODE", lg::LOGIC_OP_MODE, None, int(lg::LOGIC_OP_MODE), None);
+        p.add("GL_LOGIC_OP_MODE", lg::LOGIC_OP_MODE, None, int(lg::LOGIC_OP_MODE), None);
         for cap in [glow::PROGRAM_POINT_SIZE, glow::DEPTH_CLAMP, glow::TEXTURE_CUBE_MAP_SEAMLESS, glow::LINE_SMOOTH, glow::PRIMITIVE_RESTART] {
-            add(&format!("capability 0x{cap:04X}"), cap, None, Enabled(cap), s!(|h| h.gl.enable(cap)));
+            p.add(&format!("capability 0x{cap:04X}"), cap, None, Enabled(cap), s!(|h| h.gl.enable(cap)));
         }
-        add("GL_MULTISAMPLE", glow::MULTISAMPLE, None, Enabled(glow::MULTISAMPLE), s!(|h| h.gl.disable(glow::MULTISAMPLE)));
-        add("GL_POINT_SIZE", lg::POINT_SIZE, None, Float(lg::POINT_SIZE, 1), s!(|h| (h.lgl.point_size)(3.0)));
+        p.add("GL_MULTISAMPLE", glow::MULTISAMPLE, None, Enabled(glow::MULTISAMPLE), s!(|h| h.gl.disable(glow::MULTISAMPLE)));
+        p.add("GL_POINT_SIZE", lg::POINT_SIZE, None, Float(lg::POINT_SIZE, 1), s!(|h| (h.lgl.point_size)(3.0)));
         for pname in [glow::UNPACK_SWAP_BYTES, glow::UNPACK_LSB_FIRST, glow::PACK_SWAP_BYTES] {
-            add(&format!("pixel store 0x{pname:04X}"), pname, None, int(pname), s!(|h| h.gl.pixel_store_bool(pname, true)));
+            p.add(&format!("pixel store 0x{pname:04X}"), pname, None, int(pname), s!(|h| h.gl.pixel_store_bool(pname, true)));
         }
     }
-    if host.srgb_switch {
-        // Desktop default: off (the host turns it on); ES default: on (the host turns it off).
-        add("GL_FRAMEBUFFER_SRGB", glow::FRAMEBUFFER_SRGB, None, Enabled(glow::FRAMEBUFFER_SRGB), s!(|h| {
-            if h.api == GlApi::Gles3 { h.gl.disable(glow::FRAMEBUFFER_SRGB) } else { h.gl.enable(glow::FRAMEBUFFER_SRGB) }
-        }));
-    }
-    // --- compatibility profile: fixed function, client arrays, current values ---
-    if compat {
+}
+
+/// Compatibility profile: fixed-function matrices, texture enables and environment, lighting,
+/// fog, alpha test, current values, client arrays.
+#[rustfmt::skip]
+fn compatibility_state(p: &mut Pieces) {
+    use Q::*;
+    {
         let load = |mode: u32, m: Mat4, unit: u32| -> Setter {
             Box::new(move |h: &Host| unsafe {
                 h.gl.active_texture(glow::TEXTURE0 + unit);
@@ -449,57 +510,48 @@ pub fn pieces(host: &Host) -> Vec<Piece> {
                 (h.lgl.load_matrix)(m.to_cols_array().as_ptr());
             })
         };
-        add("GL_MODELVIEW_MATRIX", lg::MODELVIEW_MATRIX, None, Float(lg::MODELVIEW_MATRIX, 16), Some(load(lg::MODELVIEW, matrix(1.0), 0)));
-        add("GL_PROJECTION_MATRIX", lg::PROJECTION_MATRIX, None, Float(lg::PROJECTION_MATRIX, 16), Some(load(lg::PROJECTION, matrix(2.0), 0)));
-        add("GL_TEXTURE_MATRIX", lg::TEXTURE_MATRIX, Some(0), Float(lg::TEXTURE_MATRIX, 16), Some(load(lg::TEXTURE, matrix(3.0), 0)));
+        p.add("GL_MODELVIEW_MATRIX", lg::MODELVIEW_MATRIX, None, Float(lg::MODELVIEW_MATRIX, 16), Some(load(lg::MODELVIEW, matrix(1.0), 0)));
+        p.add("GL_PROJECTION_MATRIX", lg::PROJECTION_MATRIX, None, Float(lg::PROJECTION_MATRIX, 16), Some(load(lg::PROJECTION, matrix(2.0), 0)));
+        p.add("GL_TEXTURE_MATRIX", lg::TEXTURE_MATRIX, Some(0), Float(lg::TEXTURE_MATRIX, 16), Some(load(lg::TEXTURE, matrix(3.0), 0)));
         for u in 0..2 {
-            add("GL_TEXTURE_2D (enable)", glow::TEXTURE_2D, Some(u), Enabled(glow::TEXTURE_2D), Some(Box::new(move |h: &Host| unsafe {
+            p.add("GL_TEXTURE_2D (enable)", glow::TEXTURE_2D, Some(u), Enabled(glow::TEXTURE_2D), Some(Box::new(move |h: &Host| unsafe {
                 h.gl.active_texture(glow::TEXTURE0 + u);
                 h.gl.enable(glow::TEXTURE_2D)
             })));
         }
-        add("GL_TEXTURE_ENV_MODE", lg::TEXTURE_ENV_MODE, Some(0), EnvMode, Some(Box::new(|h: &Host| unsafe {
+        p.add("GL_TEXTURE_ENV_MODE", lg::TEXTURE_ENV_MODE, Some(0), EnvMode, Some(Box::new(|h: &Host| unsafe {
             h.gl.active_texture(glow::TEXTURE0);
             (h.lgl.tex_envi)(lg::TEXTURE_ENV, lg::TEXTURE_ENV_MODE, lg::DECAL as i32)
         })));
-        add("GL_CURRENT_TEXTURE_COORDS", lg::CURRENT_TEXTURE_COORDS, Some(0), Float(lg::CURRENT_TEXTURE_COORDS, 4), s!(|h| (h.lgl.tex_coord2)(0.5, 0.25)));
+        p.add("GL_CURRENT_TEXTURE_COORDS", lg::CURRENT_TEXTURE_COORDS, Some(0), Float(lg::CURRENT_TEXTURE_COORDS, 4), s!(|h| (h.lgl.tex_coord2)(0.5, 0.25)));
         for cap in [lg::LIGHTING, lg::FOG, lg::NORMALIZE, lg::COLOR_MATERIAL, lg::LINE_STIPPLE] {
-            add(&format!("fixed-function capability 0x{cap:04X}"), cap, None, Enabled(cap), s!(|h| h.gl.enable(cap)));
+            p.add(&format!("fixed-function capability 0x{cap:04X}"), cap, None, Enabled(cap), s!(|h| h.gl.enable(cap)));
         }
-        add("GL_ALPHA_TEST", lg::ALPHA_TEST, None, Enabled(lg::ALPHA_TEST), s!(|h| {
+        p.add("GL_ALPHA_TEST", lg::ALPHA_TEST, None, Enabled(lg::ALPHA_TEST), s!(|h| {
             h.gl.enable(lg::ALPHA_TEST);
             (h.lgl.alpha_func)(glow::GREATER, 0.5)
         }));
-        add("GL_ALPHA_TEST_FUNC", lg::ALPHA_TEST_FUNC, None, int(lg::ALPHA_TEST_FUNC), None);
-        add("GL_ALPHA_TEST_REF", lg::ALPHA_TEST_REF, None, Float(lg::ALPHA_TEST_REF, 1), None);
-        add("GL_SHADE_MODEL", lg::SHADE_MODEL, None, int(lg::SHADE_MODEL), s!(|h| (h.lgl.shade_model)(lg::FLAT)));
-        add("GL_CURRENT_COLOR", lg::CURRENT_COLOR, None, Float(lg::CURRENT_COLOR, 4), s!(|h| (h.lgl.color4)(0.2, 0.4, 0.6, 0.8)));
-        add("GL_CURRENT_NORMAL", lg::CURRENT_NORMAL, None, Float(lg::CURRENT_NORMAL, 3), s!(|h| (h.lgl.normal3)(1.0, 0.0, 0.0)));
-        add("GL_VERTEX_ARRAY", lg::VERTEX_ARRAY, None, Enabled(lg::VERTEX_ARRAY), s!(|h| {
+        p.add("GL_ALPHA_TEST_FUNC", lg::ALPHA_TEST_FUNC, None, int(lg::ALPHA_TEST_FUNC), None);
+        p.add("GL_ALPHA_TEST_REF", lg::ALPHA_TEST_REF, None, Float(lg::ALPHA_TEST_REF, 1), None);
+        p.add("GL_SHADE_MODEL", lg::SHADE_MODEL, None, int(lg::SHADE_MODEL), s!(|h| (h.lgl.shade_model)(lg::FLAT)));
+        p.add("GL_CURRENT_COLOR", lg::CURRENT_COLOR, None, Float(lg::CURRENT_COLOR, 4), s!(|h| (h.lgl.color4)(0.2, 0.4, 0.6, 0.8)));
+        p.add("GL_CURRENT_NORMAL", lg::CURRENT_NORMAL, None, Float(lg::CURRENT_NORMAL, 3), s!(|h| (h.lgl.normal3)(1.0, 0.0, 0.0)));
+        p.add("GL_VERTEX_ARRAY", lg::VERTEX_ARRAY, None, Enabled(lg::VERTEX_ARRAY), s!(|h| {
             h.gl.bind_buffer(glow::ARRAY_BUFFER, Some(h.buffers[ARRAY]));
             (h.lgl.vertex_pointer)(2, glow::FLOAT, 16, 4usize as *const std::ffi::c_void);
             (h.lgl.enable_client_state)(lg::VERTEX_ARRAY)
         }));
-        add("GL_VERTEX_ARRAY_BUFFER_BINDING", lg::VERTEX_ARRAY_BUFFER_BINDING, None, int(lg::VERTEX_ARRAY_BUFFER_BINDING), None);
-        add("GL_VERTEX_ARRAY_SIZE", lg::VERTEX_ARRAY_SIZE, None, int(lg::VERTEX_ARRAY_SIZE), None);
-        add("GL_VERTEX_ARRAY_STRIDE", lg::VERTEX_ARRAY_STRIDE, None, int(lg::VERTEX_ARRAY_STRIDE), None);
-        add("GL_COLOR_ARRAY", lg::COLOR_ARRAY, None, Enabled(lg::COLOR_ARRAY), s!(|h| (h.lgl.enable_client_state)(lg::COLOR_ARRAY)));
-        add("GL_TEXTURE_COORD_ARRAY (client unit 1)", lg::TEXTURE_COORD_ARRAY, None, Enabled(lg::TEXTURE_COORD_ARRAY), s!(|h| {
+        p.add("GL_VERTEX_ARRAY_BUFFER_BINDING", lg::VERTEX_ARRAY_BUFFER_BINDING, None, int(lg::VERTEX_ARRAY_BUFFER_BINDING), None);
+        p.add("GL_VERTEX_ARRAY_SIZE", lg::VERTEX_ARRAY_SIZE, None, int(lg::VERTEX_ARRAY_SIZE), None);
+        p.add("GL_VERTEX_ARRAY_STRIDE", lg::VERTEX_ARRAY_STRIDE, None, int(lg::VERTEX_ARRAY_STRIDE), None);
+        p.add("GL_COLOR_ARRAY", lg::COLOR_ARRAY, None, Enabled(lg::COLOR_ARRAY), s!(|h| (h.lgl.enable_client_state)(lg::COLOR_ARRAY)));
+        p.add("GL_TEXTURE_COORD_ARRAY (client unit 1)", lg::TEXTURE_COORD_ARRAY, None, Enabled(lg::TEXTURE_COORD_ARRAY), s!(|h| {
             (h.lgl.client_active_texture)(glow::TEXTURE1);
             (h.lgl.enable_client_state)(lg::TEXTURE_COORD_ARRAY)
         }));
-        add("GL_CLIENT_ACTIVE_TEXTURE", lg::CLIENT_ACTIVE_TEXTURE, None, int(lg::CLIENT_ACTIVE_TEXTURE), None);
-        add("GL_MATRIX_MODE", lg::MATRIX_MODE, None, int(lg::MATRIX_MODE), s!(|h| (h.lgl.matrix_mode)(lg::TEXTURE)));
+        p.add("GL_CLIENT_ACTIVE_TEXTURE", lg::CLIENT_ACTIVE_TEXTURE, None, int(lg::CLIENT_ACTIVE_TEXTURE), None);
+        p.add("GL_MATRIX_MODE", lg::MATRIX_MODE, None, int(lg::MATRIX_MODE), s!(|h| (h.lgl.matrix_mode)(lg::TEXTURE)));
     }
-    // Last: the active unit (the per-unit setters above change it).
-    add("GL_ACTIVE_TEXTURE", glow::ACTIVE_TEXTURE, None, int(glow::ACTIVE_TEXTURE), s!(|h| h.gl.active_texture(glow::TEXTURE3)));
-    for p in &mut v {
-        // The default, which splatgl changes for its draw and must put back.
-        p.distinct &= p.pname != glow::DEPTH_WRITEMASK;
-        p.distinct &= !(compat && p.pname == glow::VERTEX_ARRAY_BINDING);
-        p.vao_state = p.pname == glow::ELEMENT_ARRAY_BUFFER_BINDING || matches!(p.q, Q::Attrib(2, _));
-    }
-    v
 }
 
 /// A name GL never generated (an invalid-operation probe).
