@@ -108,7 +108,7 @@ pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> 
             report.readable = false;
             report.findings.push(Finding::fatal(
                 "",
-                "unknown file format (expected glTF, GLB or PLY)",
+                "unknown file format (expected glTF, GLB, PLY, SPZ, .splat, .ksplat or SOG)",
             ));
         }
         Some(Format::Ply) => match ply::load(bytes) {
@@ -125,6 +125,22 @@ pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> 
                 report.findings.push(Finding::fatal("", e.to_string()));
             }
         },
+        // Packed formats (SPZ, .splat, .ksplat, SOG): what the loader says.
+        Some(Format::Spz | Format::Splat | Format::Ksplat | Format::Sog) => {
+            match crate::load::load_bytes(bytes, path, opts) {
+                Ok(l) => {
+                    report.splat_count = Some(l.cloud.len());
+                    for w in l.report.warnings {
+                        let finding = Finding::warning(w.location, w.message);
+                        report.findings.push(finding);
+                    }
+                }
+                Err(e) => {
+                    report.readable = false;
+                    report.findings.push(Finding::fatal("", e.to_string()));
+                }
+            }
+        }
         Some(f) => match gltf::walk(bytes, f, path, opts) {
             Err(e) => {
                 report.readable = false;

@@ -364,13 +364,18 @@ fn render_gl(
     Err("this splatgl was built without the `gl` feature".into())
 }
 
-/// The cloud and whether it came from a PLY (COLMAP axes) rather than glTF (+Y up).
+/// The cloud and whether it is in PLY (COLMAP) axes rather than glTF's (+Y up).
 fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<(splatgl::SplatCloud, bool), String> {
     let l = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
     for w in l.report.summarized_warnings() {
         eprintln!("warning: {w}");
     }
-    Ok((l.cloud, l.report.format == splatgl::load::Format::Ply))
+    // Every format but glTF is in PLY axes (SPZ is converted to them).
+    let ply_axes = !matches!(
+        l.report.format,
+        splatgl::load::Format::Gltf | splatgl::load::Format::Glb
+    );
+    Ok((l.cloud, ply_axes))
 }
 
 /// Runs it. Exit status 0 on success, 2 on any error.

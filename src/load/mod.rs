@@ -1,6 +1,8 @@
-//! Loaders: glTF 2.0 (`.gltf`, `.glb`) with `KHR_gaussian_splatting`, and INRIA 3DGS PLY.
+//! Loaders: glTF 2.0 (`.gltf`, `.glb`) with `KHR_gaussian_splatting`, INRIA 3DGS PLY, and the
+//! packed formats of other tools: Niantic SPZ, antimatter15 `.splat`, mkkellogg `.ksplat` and
+//! PlayCanvas SOG (`docs/formats.md`).
 //!
-//! [`load_path`] picks the format by magic bytes (then by extension) and returns the
+//! [`load_path`] picks the format by content (then by extension) and returns the
 //! [`SplatCloud`] together with a [`LoadReport`] (format, scale space seen, warnings).
 //! Every failure is a [`LoadError`] naming the file, the element, the index and what was
 //! expected. No input panics, and sizes claimed by headers are checked against the bytes that
@@ -9,6 +11,16 @@
 pub mod finding;
 pub mod gltf;
 pub mod ply;
+
+pub mod codec;
+pub mod details;
+mod detect;
+pub mod ksplat;
+mod packed;
+pub mod sog;
+pub mod splat;
+pub mod spz;
+pub use details::Details;
 
 use crate::cloud::SplatCloud;
 use std::fmt;
@@ -55,6 +67,14 @@ pub enum Format {
     Glb,
     /// INRIA 3DGS PLY (binary little/big endian or ASCII).
     Ply,
+    /// Niantic SPZ, versions 1-4.
+    Spz,
+    /// antimatter15 `.splat`.
+    Splat,
+    /// mkkellogg `.ksplat`.
+    Ksplat,
+    /// PlayCanvas SOG (bundled `.sog` or `meta.json` + WebP).
+    Sog,
 }
 
 impl Format {
@@ -64,6 +84,10 @@ impl Format {
             Format::Gltf => "gltf",
             Format::Glb => "glb",
             Format::Ply => "ply",
+            Format::Spz => "spz",
+            Format::Splat => "splat",
+            Format::Ksplat => "ksplat",
+            Format::Sog => "sog",
         }
     }
 }
@@ -127,6 +151,8 @@ pub struct LoadReport {
     pub non_unit_quaternions: usize,
     /// Non-fatal findings.
     pub warnings: Vec<Warning>,
+    /// Container version, quantization and lossy steps (packed formats only).
+    pub details: Option<Details>,
 }
 
 impl LoadReport {
@@ -136,6 +162,7 @@ impl LoadReport {
             scale_space: None,
             non_unit_quaternions: 0,
             warnings: Vec::new(),
+            details: None,
         }
     }
     /// The warnings for people: identical messages merged into one line naming the first
@@ -189,18 +216,8 @@ pub enum LoadError {
         /// The OS error.
         source: std::io::Error,
     },
-    /// A splat format splatgl recognises but does not read yet.
-    #[error(
-        "{path}: {kind} files are not supported yet (splatgl reads glTF/GLB with KHR_gaussian_splatting and PLY)"
-    )]
-    NotYet {
-        /// The file.
-        path: PathBuf,
-        /// The format.
-        kind: &'static str,
-    },
-    /// Neither magic bytes nor extension say what the file is.
-    #[error("{path}: unknown file format (expected .gltf, .glb or .ply)")]
+    /// Neither content nor extension say what the file is.
+    #[error("{path}: unknown file format (expected glTF/GLB, PLY, SPZ, .splat, .ksplat or SOG)")]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -221,23 +238,38 @@ pub enum LoadError {
         /// What.
         source: gltf::GltfError,
     },
-}
-
-/// Splat formats splatgl recognises but does not read yet.
-fn known_unsupported(bytes: &[u8], path: Option<&Path>) -> Option<&'static str> {
-    let ext = path
-        .and_then(|p| p.extension())
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    if bytes.starts_with(b"NGSP") || ext.as_deref() == Some("spz") {
-        return Some("Niantic SPZ");
-    }
-    match ext.as_deref() {
-        Some("splat") => Some("antimatter15 .splat"),
-        Some("ksplat") => Some("mkkellogg .ksplat"),
-        Some("sog") => Some("PlayCanvas SOG"),
-        _ => None,
-    }
+    /// An SPZ problem.
+    #[error("{path}: SPZ: {source}")]
+    Spz {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: spz::SpzError,
+    },
+    /// A `.splat` problem.
+    #[error("{path}: .splat: {source}")]
+    Splat {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: splat::SplatError,
+    },
+    /// A `.ksplat` problem.
+    #[error("{path}: .ksplat: {source}")]
+    Ksplat {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: ksplat::KsplatError,
+    },
+    /// A SOG problem.
+    #[error("{path}: SOG: {source}")]
+    Sog {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: sog::SogError,
+    },
 }
 
 /// Loads a file of any supported format.
@@ -250,27 +282,10 @@ pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Loaded, L
     load_bytes(&bytes, Some(path), opts)
 }
 
-/// Detects the format from magic bytes, then the extension.
+/// Detects the format from the content (magic bytes, header, zip directory, JSON keys), then
+/// the extension, then `.splat` plausibility.
 pub fn detect_format(bytes: &[u8], path: Option<&Path>) -> Option<Format> {
-    if bytes.starts_with(b"glTF") {
-        return Some(Format::Glb);
-    }
-    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
-        return Some(Format::Ply);
-    }
-    let ext = path
-        .and_then(|p| p.extension())
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("gltf") => Some(Format::Gltf),
-        Some("glb") => Some(Format::Glb),
-        Some("ply") => Some(Format::Ply),
-        _ => {
-            let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
-            (first == Some(&b'{')).then_some(Format::Gltf)
-        }
-    }
+    detect::detect(bytes, path)
 }
 
 /// Loads from memory. `path` names the file in errors and resolves external glTF buffers
@@ -281,7 +296,8 @@ pub fn load_bytes(
     opts: &LoadOptions,
 ) -> Result<Loaded, LoadError> {
     let shown = path.map_or_else(|| PathBuf::from("<memory>"), Path::to_owned);
-    match detect_format(bytes, path) {
+    let format = detect_format(bytes, path);
+    let mut loaded = match format {
         Some(Format::Ply) => ply::load(bytes).map_err(|source| LoadError::Ply {
             path: shown,
             source,
@@ -292,11 +308,15 @@ pub fn load_bytes(
                 source,
             })
         }
-        None => match known_unsupported(bytes, path) {
-            Some(kind) => Err(LoadError::NotYet { path: shown, kind }),
-            None => Err(LoadError::UnknownFormat { path: shown }),
-        },
+        Some(f @ (Format::Spz | Format::Splat | Format::Ksplat | Format::Sog)) => {
+            packed::load(f, bytes, path, shown)
+        }
+        None => Err(LoadError::UnknownFormat { path: shown }),
+    }?;
+    if let Some(w) = format.and_then(|f| detect::extension_mismatch(f, path)) {
+        loaded.report.warn("", w);
     }
+    Ok(loaded)
 }
 
 /// Normalises a quaternion `[x, y, z, w]`; returns it and whether it was off unit length by

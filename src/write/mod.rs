@@ -1,4 +1,5 @@
-//! Writers: a [`SplatCloud`] as INRIA PLY ([`to_inria_ply`]), or as glTF 2.0 with `KHR_gaussian_splatting` (RC), as `.glb` or
+//! Writers: a [`SplatCloud`] as INRIA PLY ([`to_inria_ply`]), Niantic SPZ ([`to_spz`]),
+//! antimatter15 `.splat` ([`to_splat`]), or as glTF 2.0 with `KHR_gaussian_splatting` (RC), as `.glb` or
 //! `.gltf` with an embedded data-URI buffer. Every component type the RC allows can be chosen
 //! per attribute, with optional padding (byteStride) and a sparse OPACITY accessor, so the
 //! tests can round-trip every decoding path of the loader. The output passes
@@ -6,6 +7,10 @@
 
 mod ply;
 pub use ply::to_inria_ply;
+mod splat;
+mod spz;
+pub use splat::to_splat;
+pub use spz::{SpzWriteError, SpzWriteOptions, to_spz};
 
 use crate::cloud::{ColorSpace, Kernel, Projection, SortingMethod, SplatCloud};
 use base64::Engine;

@@ -3,6 +3,8 @@
 
 use splatgl::SplatCloud;
 
+pub mod packed;
+
 pub use splatgl::scene::Rng;
 
 /// A random cloud of `n` splats, SH degree `degree`.

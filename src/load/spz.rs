@@ -1,0 +1,533 @@
+//! Niantic SPZ, versions 1–4 (`docs/formats.md` § SPZ has the conventions and error bounds).
+//!
+//! - v1–v3: one gzip member holding a 16-byte header (`NGSP`, version, count, SH degree,
+//!   fractional bits, flags, reserved) and the attribute blocks one after the other:
+//!   positions, alphas, colours, scales, rotations, SH. An uncompressed legacy file (the
+//!   header straight away) is read too, with a warning.
+//! - v4: a 32-byte header (adds stream count and table-of-contents offset), optional extension
+//!   records, the table (u64 compressed, u64 uncompressed per stream) and one zstd frame per
+//!   non-empty attribute, in the same order.
+//!
+//! Stored axes are RUB (x right, y up, z back; Niantic's reference packs from its PLY frame RDF
+//! into RUB). splatgl keeps PLY files in their own (RDF) frame, so by default the reader maps
+//! RUB → RDF: y and z are negated, quaternions become (x, −y, −z, w) and each SH coefficient
+//! takes the sign of its basis function's parity. [`SpzAxes::Raw`] reads the numbers as they
+//! are (what `splat-transform` 3.x writes).
+
+use super::codec::{self, InflateError, budget_for, build_cloud, finish_cloud, sh_flip_signs};
+use super::details::Details;
+use super::finding::Finding;
+use crate::cloud::{MAX_SH_DEGREE, SplatCloud};
+use rayon::prelude::*;
+
+/// First four bytes of an SPZ header.
+pub const MAGIC: &[u8; 4] = b"NGSP";
+/// DC colour scale of the format: byte = f_dc · 0.15 · 255 + 127.5.
+pub const COLOR_SCALE: f32 = 0.15;
+/// Highest version read.
+pub const MAX_VERSION: u32 = 4;
+/// Header flag: trained with antialiasing.
+pub const FLAG_ANTIALIASED: u8 = 0x1;
+/// Header flag: extension records present.
+pub const FLAG_EXTENSIONS: u8 = 0x2;
+/// SPZ_ADOBE_coordinate_system extension: a u32 coordinate-system code.
+const EXT_COORDINATE_SYSTEM: u32 = 0xADBE_0003;
+
+/// Which axes the stored numbers are taken to be in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpzAxes {
+    /// Niantic's convention: RUB, converted to splatgl's PLY frame (RDF).
+    #[default]
+    Rub,
+    /// No conversion: the numbers are already in the PLY frame.
+    Raw,
+}
+
+/// What is wrong with an SPZ file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpzError {
+    /// Neither a gzip member nor an `NGSP` header.
+    #[error("not SPZ: expected gzip (1f 8b) or magic 'NGSP' at byte 0, found {found}")]
+    BadMagic {
+        /// The first bytes, in hex.
+        found: String,
+    },
+    /// The gzip member is corrupt, truncated or too large.
+    #[error("gzip: {0}")]
+    Gzip(InflateError),
+    /// A version this reader does not know, or one that does not fit the wrapping.
+    #[error("header: version {version} is not supported in {container} (expected {expected})")]
+    Version {
+        /// The stated version.
+        version: u32,
+        /// `"a gzip member"` or `"an uncompressed file"`.
+        container: &'static str,
+        /// Accepted versions.
+        expected: &'static str,
+    },
+    /// SH degree above 4.
+    #[error("header: SH degree {0} (expected 0-4)")]
+    ShDegree(u8),
+    /// The data ends before what the header claims.
+    #[error("header claims {count} points: {what} needs {needed} bytes, only {available} present")]
+    Truncated {
+        /// Claimed count.
+        count: u32,
+        /// The block (or header) that does not fit.
+        what: &'static str,
+        /// Bytes it needs.
+        needed: u64,
+        /// Bytes present.
+        available: u64,
+    },
+    /// The count would decompress to more than the budget allows.
+    #[error(
+        "header claims {count} points ({needed} bytes decompressed), over the budget of {limit} bytes for a {input}-byte file (16 MiB + 64 × input)"
+    )]
+    OverBudget {
+        /// Claimed count.
+        count: u32,
+        /// Bytes the streams would take.
+        needed: u64,
+        /// Budget.
+        limit: u64,
+        /// Input size.
+        input: usize,
+    },
+    /// The v4 table of contents is inconsistent.
+    #[error("v4 table of contents: {0}")]
+    Toc(String),
+    /// One v4 stream does not decompress to its size.
+    #[error("stream {index} ({attribute}): {source}")]
+    Stream {
+        /// Stream index.
+        index: usize,
+        /// Its attribute.
+        attribute: &'static str,
+        /// What went wrong.
+        source: InflateError,
+    },
+    /// An extension record runs past its block.
+    #[error("extension record at byte {offset}: {message}")]
+    Extension {
+        /// Offset within the extension block.
+        offset: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The header fields both layouts share.
+#[derive(Debug, Clone, Copy)]
+struct Header {
+    version: u32,
+    count: u32,
+    degree: u8,
+    fractional_bits: u8,
+    flags: u8,
+}
+
+/// Per-point byte sizes of the six blocks, in file order.
+const ATTRIBUTES: [&str; 6] = ["positions", "alphas", "colors", "scales", "rotations", "sh"];
+
+fn sizes(h: &Header) -> [u64; 6] {
+    let n = h.count as u64;
+    let sh_dim = ((h.degree as u64 + 1).pow(2) - 1) * 3;
+    let pos = if h.version == 1 { 6 } else { 9 };
+    let rot = if h.version >= 3 { 4 } else { 3 };
+    [pos, 1, 3, 3, rot, sh_dim].map(|b| b * n)
+}
+
+fn header(b: &[u8]) -> Header {
+    Header {
+        version: codec::u32_at(b, 4),
+        count: codec::u32_at(b, 8),
+        degree: b[12],
+        fractional_bits: b[13],
+        flags: b[14],
+    }
+}
+
+/// Reads an SPZ file in Niantic's axes. See [`read_with`].
+pub(crate) fn read(
+    bytes: &[u8],
+    findings: &mut Vec<Finding>,
+) -> Result<(SplatCloud, Details), SpzError> {
+    read_with(bytes, SpzAxes::Rub, findings)
+}
+
+/// Reads an SPZ file (gzip v1–v3, uncompressed legacy, or v4 zstd streams) from memory.
+pub fn read_with(
+    bytes: &[u8],
+    axes: SpzAxes,
+    findings: &mut Vec<Finding>,
+) -> Result<(SplatCloud, Details), SpzError> {
+    let limit = budget_for(bytes.len());
+    let mut d = Details::default();
+    let inner;
+    let (h, blocks, ext) = if bytes.starts_with(&[0x1f, 0x8b]) {
+        inner = codec::gunzip(bytes, limit).map_err(SpzError::Gzip)?;
+        d.container = "gzip".into();
+        legacy(&inner, "a gzip member", findings)?
+    } else if bytes.starts_with(MAGIC) && bytes.len() >= 8 && codec::u32_at(bytes, 4) >= 4 {
+        d.container = "zstd streams".into();
+        v4(bytes, limit)?
+    } else if bytes.starts_with(MAGIC) {
+        findings.push(Finding::warning(
+            "container",
+            "legacy SPZ without its gzip wrapping (read as is)",
+        ));
+        d.container = "none".into();
+        legacy(bytes, "an uncompressed file", findings)?
+    } else {
+        let found = bytes.iter().take(4).map(|b| format!("{b:02x}")).collect();
+        return Err(SpzError::BadMagic { found });
+    };
+    let flips = flips(axes, &ext, findings)?;
+    d.version = h.version.to_string();
+    d.antialiased = h.flags & FLAG_ANTIALIASED != 0;
+    describe(&h, &mut d);
+    let cloud = decode(&h, &blocks, flips, findings);
+    Ok((cloud, d))
+}
+
+/// The six attribute blocks (borrowed from the decompressed legacy buffer or owned v4 streams).
+type Blocks<'a> = Vec<std::borrow::Cow<'a, [u8]>>;
+
+fn check_degree(h: &Header) -> Result<(), SpzError> {
+    if h.degree > 4 {
+        return Err(SpzError::ShDegree(h.degree));
+    }
+    Ok(())
+}
+
+/// v1–v3 layout: 16-byte header, then the blocks back to back, then optional extensions.
+fn legacy<'a>(
+    data: &'a [u8],
+    container: &'static str,
+    findings: &mut Vec<Finding>,
+) -> Result<(Header, Blocks<'a>, &'a [u8]), SpzError> {
+    let short = |needed: u64, what| SpzError::Truncated {
+        count: 0,
+        what,
+        needed,
+        available: data.len() as u64,
+    };
+    if data.len() < 16 {
+        return Err(short(16, "the 16-byte header"));
+    }
+    if &data[..4] != MAGIC {
+        let found = data[..4].iter().map(|b| format!("{b:02x}")).collect();
+        return Err(SpzError::BadMagic { found });
+    }
+    let h = header(data);
+    if !(1..=3).contains(&h.version) {
+        return Err(SpzError::Version {
+            version: h.version,
+            container,
+            expected: "1-3; version 4 is not gzip-wrapped",
+        });
+    }
+    check_degree(&h)?;
+    let sz = sizes(&h);
+    let total: u64 = sz.iter().sum();
+    if 16 + total > data.len() as u64 {
+        let (mut off, mut what) = (16u64, ATTRIBUTES[0]);
+        for (s, a) in sz.iter().zip(ATTRIBUTES) {
+            off += s;
+            what = a;
+            if off > data.len() as u64 {
+                break;
+            }
+        }
+        return Err(SpzError::Truncated {
+            count: h.count,
+            what,
+            needed: 16 + total,
+            available: data.len() as u64,
+        });
+    }
+    let mut blocks = Vec::with_capacity(6);
+    let mut off = 16usize;
+    for s in sz {
+        blocks.push(std::borrow::Cow::Borrowed(&data[off..off + s as usize]));
+        off += s as usize;
+    }
+    let rest = &data[off..];
+    if h.flags & FLAG_EXTENSIONS == 0 && !rest.is_empty() {
+        findings.push(Finding::warning(
+            "container",
+            format!("{} bytes after the last block ignored", rest.len()),
+        ));
+    }
+    let ext = if h.flags & FLAG_EXTENSIONS != 0 {
+        rest
+    } else {
+        &[]
+    };
+    Ok((h, blocks, ext))
+}
+
+/// v4 layout: 32-byte header, extensions up to the TOC, TOC, zstd streams to the end.
+fn v4(bytes: &[u8], limit: u64) -> Result<(Header, Blocks<'static>, &[u8]), SpzError> {
+    if bytes.len() < 32 {
+        return Err(SpzError::Truncated {
+            count: 0,
+            what: "the 32-byte v4 header",
+            needed: 32,
+            available: bytes.len() as u64,
+        });
+    }
+    let h = header(bytes);
+    if h.version > MAX_VERSION {
+        return Err(SpzError::Version {
+            version: h.version,
+            container: "an uncompressed file",
+            expected: "4 (or 1-3 inside gzip)",
+        });
+    }
+    check_degree(&h)?;
+    let (streams, toc) = (bytes[15] as usize, codec::u32_at(bytes, 16) as usize);
+    let sz = sizes(&h);
+    let wanted: Vec<usize> = (0..6).filter(|&i| sz[i] > 0).collect();
+    let total: u64 = sz.iter().sum();
+    if total > limit {
+        return Err(SpzError::OverBudget {
+            count: h.count,
+            needed: total,
+            limit,
+            input: bytes.len(),
+        });
+    }
+    if streams != wanted.len() {
+        return Err(SpzError::Toc(format!(
+            "{streams} streams, expected {} for SH degree {}",
+            wanted.len(),
+            h.degree
+        )));
+    }
+    let toc_end = toc as u64 + 16 * streams as u64;
+    if toc < 32 || toc_end > bytes.len() as u64 {
+        return Err(SpzError::Toc(format!(
+            "offset {toc} + {streams} × 16 bytes lies outside 32..{}",
+            bytes.len()
+        )));
+    }
+    let mut off = toc_end;
+    let mut ranges = Vec::with_capacity(streams);
+    for (k, &attr) in wanted.iter().enumerate() {
+        let e = toc + 16 * k;
+        let (packed, unpacked) = (codec::u64_at(bytes, e), codec::u64_at(bytes, e + 8));
+        if unpacked != sz[attr] {
+            return Err(SpzError::Toc(format!(
+                "stream {k} ({}) holds {unpacked} bytes, expected {} for {} points",
+                ATTRIBUTES[attr], sz[attr], h.count
+            )));
+        }
+        if packed > bytes.len() as u64 - off {
+            return Err(SpzError::Truncated {
+                count: h.count,
+                what: ATTRIBUTES[attr],
+                needed: off.saturating_add(packed),
+                available: bytes.len() as u64,
+            });
+        }
+        ranges.push((k, attr, off as usize, (off + packed) as usize));
+        off += packed;
+    }
+    if off != bytes.len() as u64 {
+        return Err(SpzError::Toc(format!(
+            "streams end at byte {off}, the file at {}",
+            bytes.len()
+        )));
+    }
+    let out: Vec<Vec<u8>> = ranges
+        .par_iter()
+        .map(|&(k, attr, a, b)| {
+            codec::unzstd_exact(&bytes[a..b], sz[attr]).map_err(|source| SpzError::Stream {
+                index: k,
+                attribute: ATTRIBUTES[attr],
+                source,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut out = out.into_iter();
+    let blocks = (0..6)
+        .map(|i| {
+            std::borrow::Cow::Owned(if sz[i] > 0 {
+                out.next().unwrap()
+            } else {
+                vec![]
+            })
+        })
+        .collect();
+    let ext = if h.flags & FLAG_EXTENSIONS != 0 {
+        &bytes[32..toc]
+    } else {
+        &[]
+    };
+    Ok((h, blocks, ext))
+}
+
+/// Axis flips (x, y, z) from the stored frame to ours: Niantic's RUB unless a
+/// coordinate-system extension names another frame of the same family.
+fn flips(axes: SpzAxes, ext: &[u8], f: &mut Vec<Finding>) -> Result<[bool; 3], SpzError> {
+    let mut stored = 4u32; // RUB
+    let mut off = 0;
+    while off < ext.len() {
+        if ext.len() - off < 8 {
+            return Err(SpzError::Extension {
+                offset: off,
+                message: format!("{} bytes left, a record header needs 8", ext.len() - off),
+            });
+        }
+        let (ty, len) = (
+            codec::u32_at(ext, off),
+            codec::u32_at(ext, off + 4) as usize,
+        );
+        if len > ext.len() - off - 8 {
+            return Err(SpzError::Extension {
+                offset: off,
+                message: format!("payload of {len} bytes runs past the block"),
+            });
+        }
+        let payload = &ext[off + 8..off + 8 + len];
+        match (ty, payload.len()) {
+            (EXT_COORDINATE_SYSTEM, 4) => match codec::u32_at(payload, 0) {
+                0 => {}
+                c @ 1..=8 => stored = c,
+                c => f.push(Finding::warning(
+                    "extensions",
+                    format!("coordinate system {c} needs a quarter turn; read as RUB"),
+                )),
+            },
+            _ => f.push(Finding::warning(
+                "extensions",
+                format!("extension 0x{ty:08x} ({len} bytes) ignored"),
+            )),
+        }
+        off += 8 + len;
+    }
+    Ok(match axes {
+        SpzAxes::Raw => [false; 3],
+        // Codes − 1 are 3 bits: x right, y up, z front. RDF = 0b101.
+        SpzAxes::Rub => std::array::from_fn(|a| ((stored - 1) >> a) & 1 != ((6 - 1) >> a) & 1),
+    })
+}
+
+fn describe(h: &Header, d: &mut Details) {
+    let fb = h.fractional_bits;
+    if h.version == 1 {
+        d.bits("position", 16, "half float");
+    } else {
+        d.bits(
+            "position",
+            24,
+            format!("signed fixed point, {fb} fractional bits"),
+        );
+        d.lossy(format!("positions rounded to steps of 2^-{fb}"));
+    }
+    d.bits("scale", 8, "ln(scale) = b/16 − 10");
+    d.lossy("scales in steps of e^(1/16), clamped to [e^-10, e^5.94]");
+    if h.version >= 3 {
+        d.bits(
+            "rotation",
+            10,
+            "smallest three: 2-bit index, sign + 9-bit magnitude",
+        );
+    } else {
+        d.bits("rotation", 8, "x, y, z as b/127.5 − 1; w ≥ 0 rebuilt");
+    }
+    d.lossy("rotations quantised");
+    d.bits("opacity", 8, "b/255 (linear)");
+    d.bits("color", 8, "DC = (b/255 − 0.5)/0.15");
+    d.lossy("DC colour in steps of 1/38.25, clamped to [-3.33, 3.33]; opacity in steps of 1/255");
+    if h.degree > 0 {
+        d.bits("sh", 8, "(b − 128)/128");
+        d.lossy("SH in steps of 1/128 (writers keep 5 bits for degree 1, 4 above), clamped to [-1, 0.99]");
+    }
+    if h.degree > MAX_SH_DEGREE {
+        d.lossy("SH degree 4 dropped (splatgl renders up to degree 3)");
+    }
+}
+
+/// Smallest-three quaternion (v3+): 2-bit index of the largest component, then for the other
+/// three (from the highest index down in the low bits) a sign bit and a 9-bit magnitude of
+/// |c|/√½. Returns `[x, y, z, w]`.
+fn smallest_three(b: &[u8]) -> [f32; 4] {
+    let mut comp = codec::u32_at(b, 0);
+    let largest = (comp >> 30) as usize;
+    let mut q = [0.0f32; 4];
+    let mut sum = 0.0;
+    for i in (0..4).rev().filter(|&i| i != largest) {
+        let mag = (comp & 511) as f32 / 511.0 * std::f32::consts::FRAC_1_SQRT_2;
+        q[i] = if (comp >> 9) & 1 == 1 { -mag } else { mag };
+        sum += q[i] * q[i];
+        comp >>= 10;
+    }
+    q[largest] = (1.0 - sum).max(0.0).sqrt();
+    q
+}
+
+fn decode(h: &Header, b: &Blocks<'_>, flip: [bool; 3], f: &mut Vec<Finding>) -> SplatCloud {
+    let degree = h.degree.min(MAX_SH_DEGREE);
+    if h.degree > MAX_SH_DEGREE {
+        f.push(Finding::warning(
+            "header",
+            "SH degree 4 read as degree 3 (the extra 9 coefficients are dropped)",
+        ));
+    }
+    let sign = |a: usize| if flip[a] { -1.0f32 } else { 1.0 };
+    let (sx, sy, sz) = (sign(0), sign(1), sign(2));
+    // Σ' = F R S² Rᵀ F with F = diag(sx, sy, sz), and F R F is a rotation for any signs: its
+    // quaternion is (x·sy·sz, y·sx·sz, z·sx·sy, w).
+    let qs = [sy * sz, sx * sz, sx * sy];
+    let shs = sh_flip_signs(flip);
+    let file_dim = ((h.degree as usize + 1).pow(2) - 1) * 3;
+    let scale = (2.0f64).powi(-(h.fractional_bits as i32)) as f32;
+    let v1 = h.version == 1;
+    let rot_bytes = if h.version >= 3 { 4 } else { 3 };
+    let cloud = build_cloud::<std::convert::Infallible>(h.count as usize, degree, |i, s| {
+        let p = &b[0][i * if v1 { 6 } else { 9 }..];
+        let pos: [f32; 3] = std::array::from_fn(|a| {
+            if v1 {
+                codec::f16_to_f32(codec::u16_at(p, 2 * a))
+            } else {
+                let v = p[3 * a] as i32 | (p[3 * a + 1] as i32) << 8 | (p[3 * a + 2] as i32) << 16;
+                ((v << 8) >> 8) as f32 * scale
+            }
+        });
+        *s.position = [pos[0] * sx, pos[1] * sy, pos[2] * sz];
+        *s.scale = std::array::from_fn(|a| (b[3][3 * i + a] as f32 / 16.0 - 10.0).exp());
+        let r = &b[4][i * rot_bytes..];
+        let q = if rot_bytes == 4 {
+            smallest_three(r)
+        } else {
+            let xyz: [f32; 3] = std::array::from_fn(|a| r[a] as f32 / 127.5 - 1.0);
+            let w = (1.0 - xyz.iter().map(|v| v * v).sum::<f32>())
+                .max(0.0)
+                .sqrt();
+            [xyz[0], xyz[1], xyz[2], w]
+        };
+        *s.rotation = [q[0] * qs[0], q[1] * qs[1], q[2] * qs[2], q[3]];
+        *s.opacity = b[1][i] as f32 / 255.0;
+        s.sh[0] = std::array::from_fn(|c| (b[2][3 * i + c] as f32 / 255.0 - 0.5) / COLOR_SCALE);
+        let sh = &b[5][i * file_dim..];
+        for k in 0..s.sh.len() - 1 {
+            s.sh[k + 1] = std::array::from_fn(|c| (sh[3 * k + c] as f32 - 128.0) / 128.0 * shs[k]);
+        }
+        Ok(())
+    });
+    let Ok(mut cloud) = cloud;
+    let (dropped, first) = finish_cloud(&mut cloud);
+    if let Some(i) = first {
+        f.push(
+            Finding::warning(
+                "points",
+                format!("{dropped} points with unusable values dropped"),
+            )
+            .at(i as u64),
+        );
+    }
+    cloud
+}
