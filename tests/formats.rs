@@ -4,11 +4,10 @@
 //! as PlayCanvas compressed PLY and as SPZ v4 is the same scene.
 
 mod common;
-use common::{packed, random_cloud, real};
+use common::real;
 use splatgl::SplatCloud;
 use splatgl::load::spz::SpzAxes;
 use splatgl::load::{Format, LoadOptions, Loaded, load_bytes, load_path};
-use splatgl::write::{SpzWriteOptions, to_splat, to_spz};
 use std::path::Path;
 
 fn load(bytes: &[u8], name: &str) -> Loaded {
@@ -30,7 +29,7 @@ fn real_ok(name: &str, count: usize, degree: u8, format: Format) -> Option<Loade
 }
 
 #[test]
-fn real_spz_splat_and_ksplat_files_load_with_count_and_degree() {
+fn real_spz_files_report_their_container() {
     if let Some(l) = real_ok("playcanvas_biker_v4.spz", 152_746, 0, Format::Spz) {
         let d = l.report.details.unwrap();
         assert_eq!(
@@ -44,10 +43,20 @@ fn real_spz_splat_and_ksplat_files_load_with_count_and_degree() {
                 .any(|q| q.encoding.contains("12 fractional bits"))
         );
     }
-    for (name, version) in [("raw", "2"), ("v2", "2"), ("v3", "3"), ("v4", "4")] {
+    for (name, version, container) in [
+        ("raw", "2", "none"),
+        ("v2", "2", "gzip"),
+        ("v3", "3", "gzip"),
+        ("v4", "4", "zstd streams"),
+    ] {
         let name = format!("splat_transform_minimal-{name}.spz");
         if let Some(l) = real_ok(&name, 4, 0, Format::Spz) {
-            assert_eq!(l.report.details.unwrap().version, version, "{name}");
+            let d = l.report.details.unwrap();
+            assert_eq!(
+                (d.version.as_str(), d.container.as_str()),
+                (version, container),
+                "{name}"
+            );
         }
     }
     real_ok("splat_transform_minimal.splat", 4, 0, Format::Splat);

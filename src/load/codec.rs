@@ -2,10 +2,11 @@
 //! bounded gzip / raw-deflate / zstd decoding, half floats, the SH sign table for axis flips,
 //! the parallel cloud builder and the pass that drops splats a renderer cannot use.
 //!
-//! **Budget rule** (one for every compressed format): a file of `L` bytes may decompress or
-//! decode to at most [`BUDGET_BASE`] + [`BUDGET_PER_INPUT_BYTE`] × `L` bytes in total (16 MiB +
-//! 64 × L). Decoders stop as soon as they would pass it, before allocating, so a gzip bomb or a
-//! header that lies about its count costs at most that much memory.
+//! **Budget rule** (one for every compressed format): for a file of `L` bytes, the data it
+//! decompresses or decodes to plus the cloud built from it take at most [`BUDGET_BASE`] +
+//! [`BUDGET_PER_INPUT_BYTE`] × `L` bytes (16 MiB + 64 × L). Sizes claimed by headers are checked
+//! against it before anything is allocated, and decompression stops as soon as it would pass
+//! it, so a gzip bomb or a header that lies about its count costs at most that much memory.
 
 use crate::cloud::{SplatCloud, sh_coeff_count};
 use rayon::prelude::*;
@@ -19,6 +20,13 @@ pub const BUDGET_PER_INPUT_BYTE: u64 = 64;
 /// The decompression budget for an input of `input_len` bytes.
 pub fn budget_for(input_len: usize) -> u64 {
     BUDGET_BASE + BUDGET_PER_INPUT_BYTE * input_len as u64
+}
+
+/// Bytes a cloud of `n` splats of SH degree `degree` takes while being built (its arrays and
+/// the per-splat flags of [`finish_cloud`]); loaders charge it to the budget with the
+/// decompressed data before allocating.
+pub fn cloud_bytes(n: u64, degree: u8) -> u64 {
+    n.saturating_mul(12 + 12 + 16 + 4 + 1 + 12 * sh_coeff_count(degree) as u64)
 }
 
 /// Why a bounded decompression failed.
@@ -52,13 +60,6 @@ fn read_bounded(mut r: impl Read, limit: u64, hint: usize) -> Result<Vec<u8>, In
         }
         out.extend_from_slice(&buf[..n]);
     }
-}
-
-/// Decompresses a gzip member (CRC and length checked by `flate2`), at most `limit` bytes.
-pub fn gunzip(bytes: &[u8], limit: u64) -> Result<Vec<u8>, InflateError> {
-    let d = flate2::read::GzDecoder::new(bytes);
-    let out = read_bounded(d, limit, bytes.len().saturating_mul(4))?;
-    Ok(out)
 }
 
 /// Decompresses a raw deflate stream (zip method 8) that must give exactly `expected` bytes.
@@ -318,18 +319,22 @@ mod tests {
     }
 
     #[test]
-    fn bounded_gunzip_stops_at_the_limit() {
+    fn bounded_inflate_stops_at_the_expected_size() {
         use std::io::Write;
-        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        let mut e = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::best());
         e.write_all(&vec![0u8; 1 << 20]).unwrap();
-        let gz = e.finish().unwrap();
-        assert_eq!(gunzip(&gz, 1 << 20).unwrap().len(), 1 << 20);
+        let z = e.finish().unwrap();
+        assert_eq!(inflate_exact(&z, 1 << 20).unwrap().len(), 1 << 20);
         assert_eq!(
-            gunzip(&gz, 1000),
+            inflate_exact(&z, 1000),
             Err(InflateError::OverBudget { limit: 1000 })
         );
         assert!(matches!(
-            gunzip(&gz[..gz.len() - 9], 1 << 21),
+            inflate_exact(&z, 2 << 20),
+            Err(InflateError::Corrupt(_))
+        ));
+        assert!(matches!(
+            inflate_exact(&z[..z.len() / 2], 1 << 20),
             Err(InflateError::Corrupt(_))
         ));
     }

@@ -166,6 +166,8 @@ pub(super) fn decode(
         }
         decoders.push((d, file.as_str(), *role));
     }
+    let degree = sh.map_or(0, |s| s.0);
+    needed += crate::load::codec::cloud_bytes(m.count as u64, degree);
     if needed > limit {
         return Err(SogError::OverBudget { needed, limit });
     }

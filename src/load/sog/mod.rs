@@ -53,7 +53,7 @@ pub enum SogError {
     },
     /// Decoding the textures would pass the budget.
     #[error(
-        "textures decode to {needed} bytes, over the budget of {limit} bytes (16 MiB + 64 × input)"
+        "decoded textures and cloud take {needed} bytes, over the budget of {limit} bytes (16 MiB + 64 × input)"
     )]
     OverBudget {
         /// Bytes needed.

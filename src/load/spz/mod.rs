@@ -18,7 +18,9 @@ use super::codec::{self, InflateError, budget_for, build_cloud, finish_cloud, sh
 use super::details::Details;
 use super::finding::Finding;
 use crate::cloud::{MAX_SH_DEGREE, SplatCloud};
-use rayon::prelude::*;
+
+mod container;
+use container::Blocks;
 
 /// First four bytes of an SPZ header.
 pub const MAGIC: &[u8; 4] = b"NGSP";
@@ -82,7 +84,7 @@ pub enum SpzError {
     },
     /// The count would decompress to more than the budget allows.
     #[error(
-        "header claims {count} points ({needed} bytes decompressed), over the budget of {limit} bytes for a {input}-byte file (16 MiB + 64 × input)"
+        "header claims {count} points ({needed} bytes decompressed and decoded), over the budget of {limit} bytes for a {input}-byte file (16 MiB + 64 × input)"
     )]
     OverBudget {
         /// Claimed count.
@@ -119,18 +121,19 @@ pub enum SpzError {
 
 /// The header fields both layouts share.
 #[derive(Debug, Clone, Copy)]
-struct Header {
-    version: u32,
-    count: u32,
-    degree: u8,
-    fractional_bits: u8,
-    flags: u8,
+pub(crate) struct Header {
+    pub version: u32,
+    pub count: u32,
+    pub degree: u8,
+    pub fractional_bits: u8,
+    pub flags: u8,
 }
 
 /// Per-point byte sizes of the six blocks, in file order.
-const ATTRIBUTES: [&str; 6] = ["positions", "alphas", "colors", "scales", "rotations", "sh"];
+pub(crate) const ATTRIBUTES: [&str; 6] =
+    ["positions", "alphas", "colors", "scales", "rotations", "sh"];
 
-fn sizes(h: &Header) -> [u64; 6] {
+pub(crate) fn sizes(h: &Header) -> [u64; 6] {
     let n = h.count as u64;
     let sh_dim = ((h.degree as u64 + 1).pow(2) - 1) * 3;
     let pos = if h.version == 1 { 6 } else { 9 };
@@ -138,7 +141,7 @@ fn sizes(h: &Header) -> [u64; 6] {
     [pos, 1, 3, 3, rot, sh_dim].map(|b| b * n)
 }
 
-fn header(b: &[u8]) -> Header {
+pub(crate) fn header(b: &[u8]) -> Header {
     Header {
         version: codec::u32_at(b, 4),
         count: codec::u32_at(b, 8),
@@ -166,19 +169,20 @@ pub fn read_with(
     let mut d = Details::default();
     let inner;
     let (h, blocks, ext) = if bytes.starts_with(&[0x1f, 0x8b]) {
-        inner = codec::gunzip(bytes, limit).map_err(SpzError::Gzip)?;
+        let trailing;
+        (inner, trailing) = container::gunzip_legacy(bytes, limit)?;
         d.container = "gzip".into();
-        legacy(&inner, "a gzip member", findings)?
+        container::legacy(&inner, "a gzip member", trailing, limit, findings)?
     } else if bytes.starts_with(MAGIC) && bytes.len() >= 8 && codec::u32_at(bytes, 4) >= 4 {
         d.container = "zstd streams".into();
-        v4(bytes, limit)?
+        container::v4(bytes, limit)?
     } else if bytes.starts_with(MAGIC) {
         findings.push(Finding::warning(
             "container",
             "legacy SPZ without its gzip wrapping (read as is)",
         ));
         d.container = "none".into();
-        legacy(bytes, "an uncompressed file", findings)?
+        container::legacy(bytes, "an uncompressed file", 0, limit, findings)?
     } else {
         let found = bytes.iter().take(4).map(|b| format!("{b:02x}")).collect();
         return Err(SpzError::BadMagic { found });
@@ -189,184 +193,6 @@ pub fn read_with(
     describe(&h, &mut d);
     let cloud = decode(&h, &blocks, flips, findings);
     Ok((cloud, d))
-}
-
-/// The six attribute blocks (borrowed from the decompressed legacy buffer or owned v4 streams).
-type Blocks<'a> = Vec<std::borrow::Cow<'a, [u8]>>;
-
-fn check_degree(h: &Header) -> Result<(), SpzError> {
-    if h.degree > 4 {
-        return Err(SpzError::ShDegree(h.degree));
-    }
-    Ok(())
-}
-
-/// v1–v3 layout: 16-byte header, then the blocks back to back, then optional extensions.
-fn legacy<'a>(
-    data: &'a [u8],
-    container: &'static str,
-    findings: &mut Vec<Finding>,
-) -> Result<(Header, Blocks<'a>, &'a [u8]), SpzError> {
-    let short = |needed: u64, what| SpzError::Truncated {
-        count: 0,
-        what,
-        needed,
-        available: data.len() as u64,
-    };
-    if data.len() < 16 {
-        return Err(short(16, "the 16-byte header"));
-    }
-    if &data[..4] != MAGIC {
-        let found = data[..4].iter().map(|b| format!("{b:02x}")).collect();
-        return Err(SpzError::BadMagic { found });
-    }
-    let h = header(data);
-    if !(1..=3).contains(&h.version) {
-        return Err(SpzError::Version {
-            version: h.version,
-            container,
-            expected: "1-3; version 4 is not gzip-wrapped",
-        });
-    }
-    check_degree(&h)?;
-    let sz = sizes(&h);
-    let total: u64 = sz.iter().sum();
-    if 16 + total > data.len() as u64 {
-        let (mut off, mut what) = (16u64, ATTRIBUTES[0]);
-        for (s, a) in sz.iter().zip(ATTRIBUTES) {
-            off += s;
-            what = a;
-            if off > data.len() as u64 {
-                break;
-            }
-        }
-        return Err(SpzError::Truncated {
-            count: h.count,
-            what,
-            needed: 16 + total,
-            available: data.len() as u64,
-        });
-    }
-    let mut blocks = Vec::with_capacity(6);
-    let mut off = 16usize;
-    for s in sz {
-        blocks.push(std::borrow::Cow::Borrowed(&data[off..off + s as usize]));
-        off += s as usize;
-    }
-    let rest = &data[off..];
-    if h.flags & FLAG_EXTENSIONS == 0 && !rest.is_empty() {
-        findings.push(Finding::warning(
-            "container",
-            format!("{} bytes after the last block ignored", rest.len()),
-        ));
-    }
-    let ext = if h.flags & FLAG_EXTENSIONS != 0 {
-        rest
-    } else {
-        &[]
-    };
-    Ok((h, blocks, ext))
-}
-
-/// v4 layout: 32-byte header, extensions up to the TOC, TOC, zstd streams to the end.
-fn v4(bytes: &[u8], limit: u64) -> Result<(Header, Blocks<'static>, &[u8]), SpzError> {
-    if bytes.len() < 32 {
-        return Err(SpzError::Truncated {
-            count: 0,
-            what: "the 32-byte v4 header",
-            needed: 32,
-            available: bytes.len() as u64,
-        });
-    }
-    let h = header(bytes);
-    if h.version > MAX_VERSION {
-        return Err(SpzError::Version {
-            version: h.version,
-            container: "an uncompressed file",
-            expected: "4 (or 1-3 inside gzip)",
-        });
-    }
-    check_degree(&h)?;
-    let (streams, toc) = (bytes[15] as usize, codec::u32_at(bytes, 16) as usize);
-    let sz = sizes(&h);
-    let wanted: Vec<usize> = (0..6).filter(|&i| sz[i] > 0).collect();
-    let total: u64 = sz.iter().sum();
-    if total > limit {
-        return Err(SpzError::OverBudget {
-            count: h.count,
-            needed: total,
-            limit,
-            input: bytes.len(),
-        });
-    }
-    if streams != wanted.len() {
-        return Err(SpzError::Toc(format!(
-            "{streams} streams, expected {} for SH degree {}",
-            wanted.len(),
-            h.degree
-        )));
-    }
-    let toc_end = toc as u64 + 16 * streams as u64;
-    if toc < 32 || toc_end > bytes.len() as u64 {
-        return Err(SpzError::Toc(format!(
-            "offset {toc} + {streams} × 16 bytes lies outside 32..{}",
-            bytes.len()
-        )));
-    }
-    let mut off = toc_end;
-    let mut ranges = Vec::with_capacity(streams);
-    for (k, &attr) in wanted.iter().enumerate() {
-        let e = toc + 16 * k;
-        let (packed, unpacked) = (codec::u64_at(bytes, e), codec::u64_at(bytes, e + 8));
-        if unpacked != sz[attr] {
-            return Err(SpzError::Toc(format!(
-                "stream {k} ({}) holds {unpacked} bytes, expected {} for {} points",
-                ATTRIBUTES[attr], sz[attr], h.count
-            )));
-        }
-        if packed > bytes.len() as u64 - off {
-            return Err(SpzError::Truncated {
-                count: h.count,
-                what: ATTRIBUTES[attr],
-                needed: off.saturating_add(packed),
-                available: bytes.len() as u64,
-            });
-        }
-        ranges.push((k, attr, off as usize, (off + packed) as usize));
-        off += packed;
-    }
-    if off != bytes.len() as u64 {
-        return Err(SpzError::Toc(format!(
-            "streams end at byte {off}, the file at {}",
-            bytes.len()
-        )));
-    }
-    let out: Vec<Vec<u8>> = ranges
-        .par_iter()
-        .map(|&(k, attr, a, b)| {
-            codec::unzstd_exact(&bytes[a..b], sz[attr]).map_err(|source| SpzError::Stream {
-                index: k,
-                attribute: ATTRIBUTES[attr],
-                source,
-            })
-        })
-        .collect::<Result<_, _>>()?;
-    let mut out = out.into_iter();
-    let blocks = (0..6)
-        .map(|i| {
-            std::borrow::Cow::Owned(if sz[i] > 0 {
-                out.next().unwrap()
-            } else {
-                vec![]
-            })
-        })
-        .collect();
-    let ext = if h.flags & FLAG_EXTENSIONS != 0 {
-        &bytes[32..toc]
-    } else {
-        &[]
-    };
-    Ok((h, blocks, ext))
 }
 
 /// Axis flips (x, y, z) from the stored frame to ours: Niantic's RUB unless a
