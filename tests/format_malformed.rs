@@ -177,7 +177,10 @@ fn splat_and_ksplat_corpus() {
     );
 }
 
-fn sog_members(edit: &dyn Fn(&mut Vec<(String, Vec<u8>)>)) -> Vec<u8> {
+/// The files of a SOG bundle: (name, bytes).
+type Files = Vec<(String, Vec<u8>)>;
+
+fn sog_members(edit: &dyn Fn(&mut Files)) -> Vec<u8> {
     let mut files = packed::sog_files(&random_cloud(4, 50, 1));
     edit(&mut files);
     let m: Vec<(&str, &[u8])> = files
@@ -213,7 +216,7 @@ fn sog_corpus() {
         "a.sog",
         &["'means_l.webp' (means_l)", "not a WebP image"],
     );
-    let meta = |f: &mut Vec<(String, Vec<u8>)>, from: &str, to: &str| {
+    let meta = |f: &mut Files, from: &str, to: &str| {
         let m = f.last_mut().unwrap();
         m.1 = String::from_utf8(m.1.clone())
             .unwrap()

@@ -239,8 +239,8 @@ pub fn finish_cloud(c: &mut SplatCloud) -> (usize, Option<usize>) {
     }
     let first = ok.iter().position(|b| !*b);
     let mut j = 0;
-    for i in 0..ok.len() {
-        if ok[i] {
+    for (i, &keep) in ok.iter().enumerate() {
+        if keep {
             c.positions[j] = c.positions[i];
             c.scales[j] = c.scales[i];
             c.rotations[j] = c.rotations[i];

@@ -32,7 +32,7 @@ pub enum SplatError {
 /// finite scales below 10⁴ and a non-zero quaternion.
 pub(crate) fn looks_like(bytes: &[u8]) -> bool {
     let n = bytes.len() / RECORD;
-    if n == 0 || bytes.len() % RECORD != 0 {
+    if n == 0 || !bytes.len().is_multiple_of(RECORD) {
         return false;
     }
     (0..64.min(n)).all(|k| {
@@ -49,7 +49,7 @@ pub(crate) fn read(
     bytes: &[u8],
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SplatError> {
-    if bytes.len() % RECORD != 0 {
+    if !bytes.len().is_multiple_of(RECORD) {
         return Err(SplatError::Truncated {
             len: bytes.len(),
             records: bytes.len() / RECORD,

@@ -109,10 +109,9 @@ pub fn sog_files(c: &SplatCloud) -> Vec<(String, Vec<u8>)> {
             .max_by(|&a, &b| q[a].abs().total_cmp(&q[b].abs()))
             .unwrap();
         let s = if q[big] < 0.0 { -1.0 } else { 1.0 };
-        let mut k = 0;
-        for (_, v) in q.iter().enumerate().filter(|(j, _)| *j != big) {
+        let others = q.iter().enumerate().filter(|(j, _)| *j != big);
+        for (k, (_, v)) in others.enumerate() {
             tex[2][o + k] = ((v * s * std::f32::consts::SQRT_2 * 0.5 + 0.5) * 255.0).round() as u8;
-            k += 1;
         }
         tex[2][o + 3] = 252 + big as u8;
         tex[0][o + 3] = 255;
@@ -190,7 +189,7 @@ pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> 
     let n = c.len();
     let degree = c.sh_degree.min(2);
     let sh_vals = ((degree as usize + 1).pow(2) - 1) * 3;
-    let (full, partial) = (n / bucket, usize::from(n % bucket != 0));
+    let (full, partial) = (n / bucket, usize::from(!n.is_multiple_of(bucket)));
     let buckets = if level == 0 { 0 } else { full + partial };
     let mut out = vec![0u8; 4096 + 1024];
     out[1] = 1;
@@ -239,8 +238,8 @@ pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> 
         } else {
             let centre = c.positions[(i / bucket) * bucket];
             let f = 32767.0 / (0.5 * block);
-            for a in 0..3 {
-                let v = ((c.positions[i][a] - centre[a]) * f).round() + 32767.0;
+            for (p, c) in c.positions[i].iter().zip(centre) {
+                let v = ((p - c) * f).round() + 32767.0;
                 out.extend_from_slice(&(v.clamp(0.0, 65535.0) as u16).to_le_bytes());
             }
             for v in c.scales[i].iter().chain(&[w, x, y, z]) {

@@ -216,10 +216,9 @@ fn splats(
             tag @ 252..=255 => {
                 let largest = (tag - 252) as usize;
                 let mut wxyz = [0.0f32; 4];
-                let mut k = 0;
-                for (_, c) in wxyz.iter_mut().enumerate().filter(|(j, _)| *j != largest) {
+                let others = wxyz.iter_mut().enumerate().filter(|(j, _)| *j != largest);
+                for (k, (_, c)) in others.enumerate() {
                     *c = (q[k] as f32 / 255.0 * 2.0 - 1.0) / sqrt2;
-                    k += 1;
                 }
                 let sum: f32 = wxyz.iter().map(|v| v * v).sum();
                 wxyz[largest] = (1.0 - sum).max(0.0).sqrt();

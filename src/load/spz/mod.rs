@@ -187,7 +187,7 @@ pub fn read_with(
         let found = bytes.iter().take(4).map(|b| format!("{b:02x}")).collect();
         return Err(SpzError::BadMagic { found });
     };
-    let flips = flips(axes, &ext, findings)?;
+    let flips = flips(axes, ext, findings)?;
     d.version = h.version.to_string();
     d.antialiased = h.flags & FLAG_ANTIALIASED != 0;
     describe(&h, &mut d);
