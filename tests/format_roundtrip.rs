@@ -280,3 +280,60 @@ fn sog_bundled_and_unbundled_round_trip() {
     assert_eq!(u.cloud, l.cloud, "both forms decode identically");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Legacy SOG (version 1): the same textures with linear ranges in meta.json, which decode to
+/// the same values as v2's linear codebooks; the opacity byte is a logit in [−6, 6], so its
+/// error is ≤ ¼ · ½ · 12/255 (the logistic's slope is at most ¼).
+#[test]
+fn legacy_sog_v1_round_trips() {
+    let cloud = random_cloud(9, 700, 2);
+    let mut bounds = sog_bounds(&cloud);
+    bounds.opacity = 0.25 * 0.5 * 2.0 * packed::SOG_V1_LOGIT / 255.0 + 1e-5;
+    let files = packed::sog_files_v1(&cloud);
+    let members: Vec<(&str, &[u8])> = files
+        .iter()
+        .map(|(n, b)| (n.as_str(), b.as_slice()))
+        .collect();
+    let l = load(&packed::zip_stored(&members), "x.sog");
+    assert_eq!(l.report.details.as_ref().unwrap().version, "1");
+    assert_eq!(l.cloud.sh_degree, 2);
+    check("SOG v1 bundled", &cloud, &l.cloud, &bounds);
+}
+
+/// Two `.ksplat` sections of different SH degrees (2 and 1) read as one cloud: the second is
+/// zero-padded to degree 2, with a warning.
+#[test]
+fn ksplat_sections_of_different_degrees_merge() {
+    let (a, b) = (random_cloud(12, 300, 2), random_cloud(13, 200, 1));
+    let (fa, fb) = (
+        packed::ksplat(&a, 1, 64, 25.0),
+        packed::ksplat(&b, 1, 64, 25.0),
+    );
+    let mut file = fa[..4096].to_vec();
+    file[4..8].copy_from_slice(&2u32.to_le_bytes());
+    file[8..12].copy_from_slice(&2u32.to_le_bytes());
+    file[16..20].copy_from_slice(&500u32.to_le_bytes());
+    file.extend_from_slice(&fa[4096..5120]);
+    file.extend_from_slice(&fb[4096..5120]);
+    file.extend_from_slice(&fa[5120..]);
+    file.extend_from_slice(&fb[5120..]);
+    let l = load(&file, "two.ksplat");
+    assert_eq!((l.cloud.len(), l.cloud.sh_degree), (500, 2));
+    assert!(
+        l.report
+            .warnings
+            .iter()
+            .any(|w| w.to_string().contains("zero-padded to 2"))
+    );
+    let one = load(&packed::ksplat(&a, 1, 64, 25.0), "a.ksplat").cloud;
+    let mut both = one.clone();
+    let mut second = load(&packed::ksplat(&b, 1, 64, 25.0), "b.ksplat").cloud;
+    second.pad_sh(2);
+    both.append(second);
+    assert_eq!(l.cloud, both, "sections decode as the files they came from");
+    assert_eq!(
+        l.cloud.sh_of(450)[4..],
+        [[0.0; 3]; 5],
+        "padded coefficients are zero"
+    );
+}

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 /// Arguments of `info`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The file (.gltf, .glb or .ply).
+    /// The file (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
     pub file: std::path::PathBuf,
     /// Print JSON (keys: format, splat_count, sh_degree, color_space, kernel, projection,
     /// sorting_method, bounds_min, bounds_max, scale_space, non_unit_quaternions,

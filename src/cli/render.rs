@@ -42,7 +42,7 @@ pub enum SortArg {
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (.ply, .gltf, .glb). Without it: the bundled default scene.
+    /// Scene file (.ply, .gltf, .glb, .spz, .splat, .ksplat, .sog, SOG meta.json). Without it: the bundled default scene.
     pub scene: Option<PathBuf>,
     /// 3DGS cameras.json to take the view from (see --view).
     #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
@@ -61,7 +61,7 @@ pub struct Args {
     /// Use the N-th glTF camera node of the scene.
     ///
     /// Without any camera option the view frames the scene: glTF from +Z with +Y up, PLY
-    /// (COLMAP axes) from +Z with −Y up; the default scene has its own camera.
+    /// (COLMAP axes, also SPZ, .splat, .ksplat and SOG) from +Z with −Y up; the default scene has its own camera.
     #[arg(long, value_name = "N")]
     pub gltf_camera: Option<usize>,
     /// Image width (default 640, or the cameras.json view's, scaled).

@@ -4,7 +4,7 @@ use std::process::ExitCode;
 /// Arguments of `validate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The file to check (.gltf, .glb or .ply).
+    /// The file to check (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
     pub file: std::path::PathBuf,
     /// Print the findings as JSON (keys: file, format, status, valid, errors, warnings,
     /// splat_count, findings[{severity, path, message, index}]).

@@ -69,6 +69,20 @@ fn nearest(book: &[f32], v: f32) -> u8 {
 /// The SOG v2 files of `c` (name, bytes), meta.json last. One palette entry per splat (so
 /// SH is only quantised by its codebook), codebooks linear over each attribute's range.
 pub fn sog_files(c: &SplatCloud) -> Vec<(String, Vec<u8>)> {
+    sog_version(c, false)
+}
+
+/// Logit range of the legacy (v1) SOG opacity byte written here.
+pub const SOG_V1_LOGIT: f32 = 6.0;
+
+/// The same splats as a legacy version-1 SOG: no `version`, `means.shape`, linear ranges
+/// (`mins`/`maxs`) instead of codebooks, the opacity as a logit in [−6, 6], the palette size
+/// implied by the centroid texture.
+pub fn sog_files_v1(c: &SplatCloud) -> Vec<(String, Vec<u8>)> {
+    sog_version(c, true)
+}
+
+fn sog_version(c: &SplatCloud, v1: bool) -> Vec<(String, Vec<u8>)> {
     let n = c.len();
     let w = ((n as f64).sqrt().ceil() as u32).max(1);
     let h = (n as u32).div_ceil(w).max(1);
@@ -117,7 +131,14 @@ pub fn sog_files(c: &SplatCloud) -> Vec<(String, Vec<u8>)> {
         tex[0][o + 3] = 255;
         tex[1][o + 3] = 255;
         tex[3][o + 3] = 255;
-        tex[4][o + 3] = (c.opacities[i] * 255.0).round() as u8;
+        tex[4][o + 3] = if v1 {
+            let logit = (c.opacities[i] / (1.0 - c.opacities[i])).ln();
+            ((logit + SOG_V1_LOGIT) / (2.0 * SOG_V1_LOGIT) * 255.0)
+                .round()
+                .clamp(0.0, 255.0) as u8
+        } else {
+            (c.opacities[i] * 255.0).round() as u8
+        };
     }
     let names = [
         "means_l.webp",
@@ -163,6 +184,19 @@ pub fn sog_files(c: &SplatCloud) -> Vec<(String, Vec<u8>)> {
         files.push(("shN_labels.webp".into(), webp(&labels, w, h)));
         meta["shN"] = serde_json::json!({"count": n, "bands": c.sh_degree, "codebook": shbook,
             "files": ["shN_centroids.webp", "shN_labels.webp"]});
+        if v1 {
+            meta["shN"] = serde_json::json!({"mins": lo, "maxs": hi,
+                "files": ["shN_centroids.webp", "shN_labels.webp"]});
+        }
+    }
+    if v1 {
+        let m = meta.as_object_mut().unwrap();
+        m.remove("version");
+        m.remove("count");
+        m["means"]["shape"] = serde_json::json!([n, 3]);
+        m["scales"] = serde_json::json!({"mins": [slo, slo, slo], "maxs": [shi, shi, shi], "files": ["scales.webp"]});
+        let l = SOG_V1_LOGIT;
+        m["sh0"] = serde_json::json!({"mins": [clo, clo, clo, -l], "maxs": [chi, chi, chi, l], "files": ["sh0.webp"]});
     }
     files.push(("meta.json".into(), meta.to_string().into_bytes()));
     files
