@@ -41,7 +41,9 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Bytes(bytes.len() as u64));
     g.bench_function("memcpy_baseline", |b| b.iter(|| black_box(bytes.clone())));
     g.bench_function("splatgl_ply_load", |b| {
-        b.iter(|| splatgl::load::ply::load(black_box(&bytes)).expect("parses"))
+        b.iter(|| {
+            splatgl::load::load_bytes(black_box(&bytes), None, &Default::default()).expect("parses")
+        })
     });
     g.finish();
 }

@@ -16,7 +16,7 @@ fn main() {
     };
     for _ in 0..n {
         let t = std::time::Instant::now();
-        match splatgl::load::ply::load(&bytes) {
+        match splatgl::load::load_bytes(&bytes, None, &Default::default()) {
             Ok(l) => {
                 let s = t.elapsed().as_secs_f64();
                 println!(

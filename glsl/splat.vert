@@ -3,7 +3,8 @@
 // Mirrors the step structure of KHR_gaussian_splatting (review draft) Appendix A with every
 // erratum fixed; docs/appendix-errata.md lists each deviation. The `#version` line, precision
 // statements and every numeric constant (SH_C*, DILATION, CUTOFF_M2, ALPHA_MAX, ALPHA_MIN,
-// FOV_CLAMP, texture layout) are injected from Rust as `#define`s; `ERRATUM_*`
+// FOV_CLAMP, SH_DC_BIAS, texture layout GEOM_* / MAX_SH_TEXELS / TEX_WIDTH) are injected from
+// Rust (splatgl::profile, splatgl::sh) as `#define`s; `ERRATUM_*`
 // defines switch in the appendix's literal behaviour for the erratum tests only.
 //
 // Data path (erratum j): the appendix's 21 vertex attributes cannot link on GLES 3.0 (16
@@ -12,12 +13,14 @@
 
 layout(location = 0) in uint a_splat_index;
 
-// GEOM_TEXELS RGBA32F texels per splat: (position.xyz, opacity), rotation xyzw, (scale.xyz, 0).
+// GEOM_TEXELS RGBA32F texels per splat: (position.xyz, opacity), rotation xyzw, (scale.xyz, 0)
+// at GEOM_TEXEL_POSITION_OPACITY, GEOM_TEXEL_ROTATION, GEOM_TEXEL_SCALE.
 uniform highp sampler2D u_geometry;
 // ceil(3 * coefficients / 4) RGBA16F texels per splat: RGB triples, degree-major, m = -l..l.
 uniform highp sampler2D u_sh;
 uniform int u_sh_texels;      // SH texels per splat in u_sh
 uniform int u_sh_degree;      // degree to evaluate, 0..=cloud degree (run-time choice)
+uniform int u_sh_fetch_texels; // SH texels holding degrees 0..=u_sh_degree
 
 uniform mat4 u_view_matrix;        // world -> GL eye space (looks down -z)
 uniform mat4 u_projection_matrix;  // GL eye -> clip
@@ -59,9 +62,9 @@ void main() {
         return;
     }
     int splat = int(a_splat_index);
-    vec4 geom0 = fetch_geometry(splat, 0);
-    vec4 a_glob_rotation = fetch_geometry(splat, 1);
-    vec4 geom2 = fetch_geometry(splat, 2);
+    vec4 geom0 = fetch_geometry(splat, GEOM_TEXEL_POSITION_OPACITY);
+    vec4 a_glob_rotation = fetch_geometry(splat, GEOM_TEXEL_ROTATION);
+    vec4 geom2 = fetch_geometry(splat, GEOM_TEXEL_SCALE);
     vec3 a_glob_position = geom0.xyz;
     float a_glob_opacity = geom0.w;
 

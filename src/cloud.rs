@@ -334,23 +334,9 @@ impl SplatCloud {
             + std::mem::size_of_val(self.sh.as_slice())
     }
 
-    /// Lowers the SH degree to `degree` (no-op if already at or below), dropping coefficients.
-    pub fn truncate_sh(&mut self, degree: u8) {
-        if degree >= self.sh_degree {
-            return;
-        }
-        let (old, new) = (self.coeffs_per_splat(), sh_coeff_count(degree));
-        let mut out = Vec::with_capacity(self.len() * new);
-        for chunk in self.sh.chunks_exact(old) {
-            out.extend_from_slice(&chunk[..new]);
-        }
-        self.sh = out;
-        self.sh_degree = degree;
-    }
-
     /// Raises the SH degree to `degree` by appending zero coefficients (a zero coefficient
     /// adds nothing to the colour, so the rendered result is unchanged).
-    pub fn pad_sh(&mut self, degree: u8) {
+    fn pad_sh(&mut self, degree: u8) {
         if degree <= self.sh_degree {
             return;
         }

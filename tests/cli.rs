@@ -1,6 +1,9 @@
-//! The `info` and `validate` commands: JSON keys (a contract for users' scripts) and exit codes.
+//! The command line: `info` and `validate` JSON keys (a contract for users' scripts) and exit
+//! codes, `render` with both backends and from a glTF camera, `compare`, and errors reported as
+//! messages, not panics.
 
 mod common;
+use splatgl::image::Image;
 use std::process::Command;
 
 fn splatgl(args: &[&str]) -> (i32, String, String) {
@@ -25,7 +28,7 @@ fn tmp(name: &str, bytes: &[u8]) -> std::path::PathBuf {
 
 #[test]
 fn validate_exit_codes() {
-    let cloud = common::random_cloud(1, 10, 2);
+    let cloud = common::random_cloud(10, 2, 5.0, 1);
     let good = tmp(
         "good.glb",
         &splatgl::write::to_glb(&cloud, &Default::default()),
@@ -47,7 +50,7 @@ fn validate_exit_codes() {
 
 #[test]
 fn info_json_keys() {
-    let cloud = common::random_cloud(2, 33, 1);
+    let cloud = common::random_cloud(33, 1, 5.0, 2);
     let p = tmp("c.ply", &splatgl::write::to_inria_ply(&cloud));
     let (code, out, err) = splatgl(&["info", "--json", p.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
@@ -138,4 +141,120 @@ fn backends_agree_on_linear_colour_space() {
         (px[0] - 0.2).abs() < 1.0 / 255.0 && (px[2] - 0.4).abs() < 1.0 / 255.0,
         "{px:?}"
     );
+}
+
+/// `render --gltf-camera N` takes the view from the N-th camera node of the file it loaded:
+/// the image equals the reference render from that camera, and a missing index is an error
+/// that says how many cameras there are.
+#[test]
+fn render_takes_the_view_from_a_gltf_camera_node() {
+    use base64::Engine;
+    let cloud = common::random_cloud(200, 1, 5.0, 7);
+    let (mut doc, bin) = splatgl::write::build(&cloud, &Default::default());
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"camera": 0, "translation": [0.3, 0.2, 6.0]}));
+    doc["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    doc["cameras"] = serde_json::json!([{"type": "perspective",
+        "perspective": {"yfov": 0.7, "znear": 0.1, "aspectRatio": 1.5}}]);
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&bin);
+    doc["buffers"][0]["uri"] = format!("data:application/octet-stream;base64,{b64}").into();
+    let scene = tmp("cam.gltf", &serde_json::to_vec(&doc).unwrap());
+    let out = tmp("cam.pfm", b"");
+    let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let args = ["render", s, "--gltf-camera", "0", "--backend", "reference"];
+    let (code, _, err) = splatgl(&[&args[..], &["--height", "40", "-o", o]].concat());
+    assert_eq!(code, 0, "{err}");
+    let img = splatgl::image::Image::read(&out).unwrap();
+    assert_eq!(
+        (img.width, img.height),
+        (60, 40),
+        "width from the aspect ratio"
+    );
+
+    let loaded = splatgl::load::load_path(&scene, &Default::default()).unwrap();
+    assert_eq!(loaded.cameras.len(), 1);
+    let cam = splatgl::camera::Camera::from_gltf(&loaded.cameras[0], 60, 40).unwrap();
+    let want = splatgl::reference::render(&loaded.cloud, &cam, &Default::default());
+    let rgb = |p: &[f32; 4]| [p[0], p[1], p[2]];
+    assert!(
+        want.pixels.iter().any(|p| p[3] > 0.0),
+        "the camera sees the splats"
+    );
+    assert!(
+        img.pixels.iter().map(rgb).eq(want.pixels.iter().map(rgb)),
+        "same image as the reference from that camera"
+    );
+
+    let (code, _, err) = splatgl(&[&args[..2], &["--gltf-camera", "1", "-o", o]].concat());
+    assert_eq!(code, 2);
+    assert!(err.contains("1 perspective camera node"), "{err}");
+}
+
+#[test]
+fn renders_the_default_scene_and_compares() {
+    let dir = std::env::temp_dir().join(format!("splatgl-cli-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, pfm, png16) = (dir.join("a.png"), dir.join("a.pfm"), dir.join("b.png"));
+    let p = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    let size = ["--width", "64", "--height", "48"];
+    for (out, extra) in [(&png, None), (&pfm, None), (&png16, Some("--depth16"))] {
+        let mut args = vec!["render", "--backend", "reference", "-o"];
+        let out = p(out);
+        args.push(&out);
+        args.extend(size);
+        args.extend(extra);
+        let (code, _, err) = splatgl(&args);
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            err.contains("splats") && err.contains("ms"),
+            "progress line: {err}"
+        );
+    }
+    let a = Image::read(&png).unwrap();
+    let f = Image::read(&pfm).unwrap();
+    assert_eq!((a.width, a.height), (64, 48));
+    // The 8-bit PNG is the float image quantised.
+    for (q, x) in a.pixels.iter().zip(&f.pixels) {
+        for c in 0..3 {
+            assert!((q[c] - x[c].clamp(0.0, 1.0)).abs() <= 0.5 / 255.0 + 1e-6);
+        }
+    }
+    let (code, out, _) = splatgl(&["compare", &p(&pfm), &p(&pfm), "--json", "--max-abs", "0"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["identical"], true);
+    let diff = p(&dir.join("d.png"));
+    let (code, out, _) = splatgl(&[
+        "compare",
+        &p(&png),
+        &p(&png16),
+        "--diff",
+        &diff,
+        "--max-abs",
+        "0",
+    ]);
+    assert_eq!(code, 1, "8- and 16-bit quantisations differ: {out}");
+    assert!(Image::read(&diff).is_ok());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn errors_are_reported_not_panics() {
+    let cases: [&[&str]; 5] = [
+        &["render", "--look-at", "1,2,3", "-o", "x.png"],
+        &["render", "--gltf-camera", "0", "-o", "x.png"],
+        &["render", "-o", "x.jpg", "--width", "8", "--height", "8"],
+        &["render", "/nonexistent/scene.ply"],
+        &["compare", "/nonexistent/a.png", "/nonexistent/b.png"],
+    ];
+    for args in cases {
+        let (code, _, err) = splatgl(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
 }

@@ -71,7 +71,7 @@ fn hostile_packed_files_stay_within_the_budget() {
     cases.push(("lying.spz", e.finish().unwrap(), "100000000 points"));
     // SPZ v4 claiming u32::MAX points.
     let mut v4 = splatgl::write::to_spz(
-        &random_cloud(1, 10, 0),
+        &random_cloud(10, 0, 5.0, 1),
         &splatgl::write::SpzWriteOptions {
             version: 4,
             ..Default::default()
@@ -81,7 +81,7 @@ fn hostile_packed_files_stay_within_the_budget() {
     v4[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
     cases.push(("count.spz", v4, "budget"));
     // A zip member claiming 4 GiB.
-    let files = packed::sog_files(&random_cloud(2, 10, 0));
+    let files = packed::sog_files(&random_cloud(10, 0, 5.0, 2));
     let m: Vec<(&str, &[u8])> = files
         .iter()
         .map(|(n, b)| (n.as_str(), b.as_slice()))
@@ -91,7 +91,7 @@ fn hostile_packed_files_stay_within_the_budget() {
     z[cd + 24..cd + 28].copy_from_slice(&u32::MAX.to_le_bytes());
     cases.push(("member.sog", z, "budget"));
     // A few-KB lossless WebP of 4096 × 2048 texels (32 MiB decoded) as the scales texture.
-    let mut files = packed::sog_files(&random_cloud(2, 10, 0));
+    let mut files = packed::sog_files(&random_cloud(10, 0, 5.0, 2));
     files[3].1 = packed::webp(&vec![7u8; 4 * 4096 * 2048], 4096, 2048);
     let m: Vec<(&str, &[u8])> = files
         .iter()

@@ -3,14 +3,15 @@
 //! error (docs/formats.md). Each bound is derived from the format's step sizes.
 
 mod common;
+use common::packed::read_spz;
 use common::{packed, random_cloud};
 use splatgl::SplatCloud;
-use splatgl::load::{LoadOptions, Loaded, load_bytes, load_path};
+use splatgl::load::{LoadOptions, Scene, load_bytes, load_path};
 use splatgl::write::{SpzWriteOptions, to_splat, to_spz};
 use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::Path;
 
-fn load(bytes: &[u8], name: &str) -> Loaded {
+fn load(bytes: &[u8], name: &str) -> Scene {
     load_bytes(bytes, Some(Path::new(name)), &LoadOptions::default())
         .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
@@ -105,7 +106,7 @@ fn spz_bounds(version: u32) -> Bounds {
 
 #[test]
 fn spz_writer_round_trips_every_version() {
-    let cloud = random_cloud(7, 2000, 3);
+    let cloud = random_cloud(2000, 3, 5.0, 7);
     for version in 2..=4 {
         let o = SpzWriteOptions {
             version,
@@ -121,7 +122,7 @@ fn spz_writer_round_trips_every_version() {
             version == 4,
             "the antialiased flag round-trips"
         );
-        assert!(l.report.warnings.is_empty(), "{:?}", l.report.warnings);
+        assert!(l.report.findings.is_empty(), "{:?}", l.report.findings);
         check(
             &format!("SPZ v{version}"),
             &cloud,
@@ -133,14 +134,14 @@ fn spz_writer_round_trips_every_version() {
 
 #[test]
 fn spz_axes_flip_is_its_own_inverse_and_raw_keeps_numbers() {
-    let cloud = random_cloud(3, 300, 3);
+    let cloud = random_cloud(300, 3, 5.0, 3);
     let raw = SpzWriteOptions {
         version: 3,
         axes: splatgl::load::spz::SpzAxes::Raw,
         ..Default::default()
     };
     let bytes = to_spz(&cloud, &raw).unwrap();
-    let (c, _) = splatgl::load::spz::read_with(&bytes, raw.axes, &mut Vec::new()).unwrap();
+    let c = read_spz(&bytes, raw.axes);
     check("SPZ v3 raw axes", &cloud, &c, &spz_bounds(3));
     // Read in Niantic's axes, the raw file is the cloud turned by 180° about x.
     let turned = load(&bytes, "x.spz").cloud;
@@ -155,7 +156,7 @@ fn spz_axes_flip_is_its_own_inverse_and_raw_keeps_numbers() {
 
 #[test]
 fn spz_writer_rejects_what_it_cannot_store() {
-    let mut c = random_cloud(1, 3, 0);
+    let mut c = random_cloud(3, 0, 5.0, 1);
     c.positions[2][1] = 3000.0;
     let e = to_spz(&c, &SpzWriteOptions::default())
         .unwrap_err()
@@ -171,7 +172,7 @@ fn spz_writer_rejects_what_it_cannot_store() {
         ..Default::default()
     };
     assert!(
-        to_spz(&random_cloud(1, 3, 0), &o)
+        to_spz(&random_cloud(3, 0, 5.0, 1), &o)
             .unwrap_err()
             .to_string()
             .contains("version 5")
@@ -183,7 +184,7 @@ fn spz_writer_rejects_what_it_cannot_store() {
 /// can double it).
 #[test]
 fn splat_writer_round_trips() {
-    let cloud = random_cloud(11, 1000, 0);
+    let cloud = random_cloud(1000, 0, 5.0, 11);
     let l = load(&to_splat(&cloud), "x.splat");
     let c0 = splatgl::sh::SH_C0 as f32;
     let b = Bounds {
@@ -203,7 +204,7 @@ fn splat_writer_round_trips() {
 /// are truncated: DC < 1/255/Y₀₀, opacity < 1/255.
 #[test]
 fn ksplat_every_level_round_trips_with_buckets() {
-    let cloud = random_cloud(5, 600, 2);
+    let cloud = random_cloud(600, 2, 5.0, 5);
     let c0 = splatgl::sh::SH_C0 as f32;
     for level in 0..=2u16 {
         let bytes = packed::ksplat(&cloud, level, 256, 25.0);
@@ -261,7 +262,7 @@ fn sog_bounds(c: &SplatCloud) -> Bounds {
 
 #[test]
 fn sog_bundled_and_unbundled_round_trip() {
-    let cloud = random_cloud(9, 700, 3);
+    let cloud = random_cloud(700, 3, 5.0, 9);
     let bounds = sog_bounds(&cloud);
     let l = load(&packed::sog_bundle(&cloud), "x.sog");
     assert_eq!(
@@ -276,7 +277,7 @@ fn sog_bundled_and_unbundled_round_trip() {
         std::fs::write(dir.join(name), bytes).unwrap();
     }
     let u = load_path(dir.join("meta.json"), &LoadOptions::default()).unwrap();
-    assert!(u.report.warnings.is_empty(), "{:?}", u.report.warnings);
+    assert!(u.report.findings.is_empty(), "{:?}", u.report.findings);
     assert_eq!(u.cloud, l.cloud, "both forms decode identically");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -286,7 +287,7 @@ fn sog_bundled_and_unbundled_round_trip() {
 /// error is ≤ ¼ · ½ · 12/255 (the logistic's slope is at most ¼).
 #[test]
 fn legacy_sog_v1_round_trips() {
-    let cloud = random_cloud(9, 700, 2);
+    let cloud = random_cloud(700, 2, 5.0, 9);
     let mut bounds = sog_bounds(&cloud);
     bounds.opacity = 0.25 * 0.5 * 2.0 * packed::SOG_V1_LOGIT / 255.0 + 1e-5;
     let files = packed::sog_files_v1(&cloud);
@@ -304,7 +305,7 @@ fn legacy_sog_v1_round_trips() {
 /// zero-padded to degree 2, with a warning.
 #[test]
 fn ksplat_sections_of_different_degrees_merge() {
-    let (a, b) = (random_cloud(12, 300, 2), random_cloud(13, 200, 1));
+    let (a, b) = (random_cloud(300, 2, 5.0, 12), random_cloud(200, 1, 5.0, 13));
     let (fa, fb) = (
         packed::ksplat(&a, 1, 64, 25.0),
         packed::ksplat(&b, 1, 64, 25.0),
@@ -321,15 +322,14 @@ fn ksplat_sections_of_different_degrees_merge() {
     assert_eq!((l.cloud.len(), l.cloud.sh_degree), (500, 2));
     assert!(
         l.report
-            .warnings
+            .warning_lines()
             .iter()
-            .any(|w| w.to_string().contains("zero-padded to 2"))
+            .any(|w| w.contains("zero-padded to 2"))
     );
     let one = load(&packed::ksplat(&a, 1, 64, 25.0), "a.ksplat").cloud;
     let mut both = one.clone();
-    let mut second = load(&packed::ksplat(&b, 1, 64, 25.0), "b.ksplat").cloud;
-    second.pad_sh(2);
-    both.append(second);
+    let second = load(&packed::ksplat(&b, 1, 64, 25.0), "b.ksplat").cloud;
+    assert!(both.append(second), "the second section is padded");
     assert_eq!(l.cloud, both, "sections decode as the files they came from");
     assert_eq!(
         l.cloud.sh_of(450)[4..],

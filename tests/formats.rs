@@ -4,18 +4,19 @@
 //! as PlayCanvas compressed PLY and as SPZ v4 is the same scene.
 
 mod common;
-use common::real;
+use common::packed::read_spz;
+use common::{packed, random_cloud, real};
 use splatgl::SplatCloud;
 use splatgl::load::spz::SpzAxes;
-use splatgl::load::{Format, LoadOptions, Loaded, load_bytes, load_path};
+use splatgl::load::{Format, LoadOptions, Scene, load_bytes, load_path};
 use std::path::Path;
 
-fn load(bytes: &[u8], name: &str) -> Loaded {
+fn load(bytes: &[u8], name: &str) -> Scene {
     load_bytes(bytes, Some(Path::new(name)), &LoadOptions::default())
         .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
-fn real_ok(name: &str, count: usize, degree: u8, format: Format) -> Option<Loaded> {
+fn real_ok(name: &str, count: usize, degree: u8, format: Format) -> Option<Scene> {
     let l = load_path(real(name)?, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(l.report.format, format, "{name}");
     assert_eq!(
@@ -89,7 +90,7 @@ fn minimal_fixtures_agree_on_positions() {
     ] {
         let bytes =
             std::fs::read(real(&format!("splat_transform_minimal-{name}.spz")).unwrap()).unwrap();
-        let (c, _) = splatgl::load::spz::read_with(&bytes, axes, &mut Vec::new()).unwrap();
+        let c = read_spz(&bytes, axes);
         for i in 0..4 {
             for a in 0..3 {
                 let d = (c.positions[i][a] - base.positions[i][a]).abs();
@@ -181,8 +182,7 @@ fn biker_compressed_ply_and_spz_v4_are_the_same_scene() {
     }
     // Read without the RUB → RDF conversion, the SPZ is upside down against the PLY.
     let raw = std::fs::read(&s).unwrap();
-    let (unflipped, _) =
-        splatgl::load::spz::read_with(&raw, SpzAxes::Raw, &mut Vec::new()).unwrap();
+    let unflipped = read_spz(&raw, SpzAxes::Raw);
     let opts = splatgl::reference::RenderOptions::default();
     for (k, cam) in cameras(&ply).iter().enumerate() {
         let (a, stats) = splatgl::reference::render_with_stats(&ply, cam, &opts);
@@ -200,4 +200,71 @@ fn biker_compressed_ply_and_spz_v4_are_the_same_scene() {
         let wrong = splatgl::compare::compare(&a, &d, 0.1).unwrap().psnr;
         assert!(wrong < bound, "camera {k}: raw axes give {wrong} dB");
     }
+}
+
+fn spz_of(c: &SplatCloud, version: u32) -> Vec<u8> {
+    let o = splatgl::write::SpzWriteOptions {
+        version,
+        ..Default::default()
+    };
+    splatgl::write::to_spz(c, &o).unwrap()
+}
+
+#[test]
+fn content_decides_the_format_and_a_wrong_extension_warns() {
+    let cloud = random_cloud(30, 1, 5.0, 8);
+    let cases: Vec<(Vec<u8>, &str, Format, &str)> = vec![
+        (
+            spz_of(&cloud, 2),
+            "scene.ply",
+            Format::Spz,
+            "the extension '.ply' says ply, the content is spz",
+        ),
+        (
+            spz_of(&cloud, 4),
+            "scene.splat",
+            Format::Spz,
+            "says splat, the content is spz",
+        ),
+        (
+            packed::sog_bundle(&cloud),
+            "scene.splat",
+            Format::Sog,
+            "says splat, the content is sog",
+        ),
+        (
+            packed::ksplat(&cloud, 2, 8, 25.0),
+            "scene.spz",
+            Format::Ksplat,
+            "says spz, the content is ksplat",
+        ),
+        (
+            splatgl::write::to_splat(&cloud),
+            "scene.bin",
+            Format::Splat,
+            "'.bin' names no splat format; the content is splat",
+        ),
+        (
+            splatgl::write::to_inria_ply(&cloud),
+            "scene.spz",
+            Format::Ply,
+            "says spz, the content is ply",
+        ),
+    ];
+    for (bytes, name, format, warning) in cases {
+        let l = load_bytes(&bytes, Some(Path::new(name)), &LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(l.report.format, format, "{name}");
+        assert_eq!(l.cloud.len(), 30, "{name}");
+        let w = l.report.warning_lines();
+        assert!(w.iter().any(|m| m.contains(warning)), "{name}: {w:?}");
+    }
+    // The right extension: no warning about it.
+    let l = load_bytes(
+        &spz_of(&cloud, 3),
+        Some(Path::new("a.spz")),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    assert!(l.report.findings.is_empty(), "{:?}", l.report.findings);
 }

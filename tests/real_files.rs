@@ -3,11 +3,11 @@
 //! inside glTF) fail with a precise error.
 
 mod common;
-use common::real;
+use common::{real, real_files};
+use splatgl::load::validate::{Status, validate_path};
 use splatgl::load::{LoadError, LoadOptions, ScaleSeen, load_path};
-use splatgl::validate::{Status, validate_path};
 
-fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Loaded> {
+fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Scene> {
     let path = real(name)?;
     let l = load_path(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(l.cloud.len(), count, "{name}: splat count");
@@ -28,11 +28,8 @@ fn load_ok(name: &str, count: usize, degree: u8) -> Option<splatgl::load::Loaded
     Some(l)
 }
 
-fn has_warning(l: &splatgl::load::Loaded, needle: &str) -> bool {
-    l.report
-        .warnings
-        .iter()
-        .any(|w| w.to_string().contains(needle))
+fn has_warning(l: &splatgl::load::Scene, needle: &str) -> bool {
+    l.report.warning_lines().iter().any(|w| w.contains(needle))
 }
 
 #[test]
@@ -177,8 +174,7 @@ fn bevy_camera_node() {
     let Some(p) = real("bevy_khr_conformance_matrix.gltf") else {
         return;
     };
-    let bytes = std::fs::read(&p).unwrap();
-    let cams = splatgl::load::gltf::cameras(&bytes, splatgl::load::Format::Gltf, Some(&p)).unwrap();
+    let cams = load_path(&p, &LoadOptions::default()).unwrap().cameras;
     assert_eq!(cams.len(), 1);
     assert_eq!(
         cams[0].node_to_world.w_axis.truncate(),
@@ -206,4 +202,23 @@ fn spz_splat_and_ksplat_files_load() {
     ] {
         load_ok(name, count, 0);
     }
+}
+
+/// `validate` and `load` read a file with the same readers: for every real file that loads,
+/// validate lists exactly the findings of the load report, in the same order.
+#[test]
+fn validate_lists_the_findings_of_the_load_report() {
+    let Some(paths) = real_files() else { return };
+    let mut compared = 0;
+    for p in paths {
+        let Ok(l) = load_path(&p, &LoadOptions::default()) else {
+            continue;
+        };
+        let v = validate_path(&p, &LoadOptions::default());
+        assert_eq!(v.findings, l.report.findings, "{}", p.display());
+        assert_eq!(v.splat_count, Some(l.cloud.len()), "{}", p.display());
+        compared += 1;
+    }
+    // SOURCES.md lists nine glTF/PLY files splatgl reads.
+    assert!(compared >= 9, "only {compared} real files load");
 }

@@ -18,9 +18,10 @@
 //! them); without them the test prints "skipped: splat-transform not installed".
 
 mod common;
+use common::packed::{read_spz, truncate_sh};
 use common::random_cloud;
 use splatgl::SplatCloud;
-use splatgl::load::spz::{SpzAxes, read_with};
+use splatgl::load::spz::SpzAxes;
 use splatgl::load::{LoadOptions, load_bytes};
 use splatgl::write::{SpzWriteOptions, to_inria_ply, to_splat, to_spz};
 use std::f32::consts::FRAC_1_SQRT_2;
@@ -224,7 +225,7 @@ fn splat_transform_and_splatgl_agree_on_every_format() {
     let dir = std::env::temp_dir().join(format!("splatgl-st-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let f = |n: &str| dir.join(n);
-    let cloud = random_cloud(21, 1500, 3);
+    let cloud = random_cloud(1500, 3, 5.0, 21);
     std::fs::write(f("in.ply"), to_inria_ply(&cloud)).unwrap();
     let ply = load(&f("in.ply"));
 
@@ -237,7 +238,7 @@ fn splat_transform_and_splatgl_agree_on_every_format() {
             &["--spz-version", v],
         );
         let bytes = std::fs::read(f(&format!("v{v}.spz"))).unwrap();
-        let (raw, _) = read_with(&bytes, SpzAxes::Raw, &mut Vec::new()).unwrap();
+        let raw = read_spz(&bytes, SpzAxes::Raw);
         spz_check(
             &format!("splat-transform .spz v{v} (read raw)"),
             &ply,
@@ -246,8 +247,7 @@ fn splat_transform_and_splatgl_agree_on_every_format() {
         );
     }
     convert(&st, &f("in.ply"), &f("st.splat"), &[]);
-    let mut d0 = ply.clone();
-    d0.truncate_sh(0);
+    let d0 = truncate_sh(&ply, 0);
     compare(
         "splat-transform .splat",
         &d0,
@@ -457,8 +457,7 @@ fn ksplat(f: &dyn Fn(&str) -> PathBuf, ply: &SplatCloud) {
         return;
     };
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/create_ksplat.mjs");
-    let mut d2 = ply.clone();
-    d2.truncate_sh(2);
+    let d2 = truncate_sh(ply, 2);
     for level in 0..=2 {
         let out = f(&format!("l{level}.ksplat"));
         run(Command::new("node")

@@ -2,22 +2,13 @@
 use splatgl::cloud::{ColorSpace, Kernel, Projection, SortingMethod};
 use std::process::ExitCode;
 
-/// Arguments of `info`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// The file (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
-    pub file: std::path::PathBuf,
-    /// Print JSON (keys: format, splat_count, sh_degree, color_space, kernel, projection,
-    /// sorting_method, bounds_min, bounds_max, scale_space, non_unit_quaternions,
-    /// memory_bytes, warnings).
-    #[arg(long)]
-    pub json: bool,
-    #[command(flatten)]
-    pub load: super::LoadArgs,
-}
+/// Help of `info --json`.
+pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
+    kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
+    non_unit_quaternions, memory_bytes, warnings)";
 
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
-pub fn run(a: Args) -> ExitCode {
+pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
     let loaded = match splatgl::load::load_path(&a.file, &opts) {
         Ok(l) => l,
@@ -29,7 +20,6 @@ pub fn run(a: Args) -> ExitCode {
     let c = &loaded.cloud;
     let r = &loaded.report;
     let b = c.bounds();
-    let warnings: Vec<String> = r.warnings.iter().map(|w| w.to_string()).collect();
     let info = serde_json::json!({
         "file": a.file.display().to_string(),
         "format": r.format.name(),
@@ -44,7 +34,7 @@ pub fn run(a: Args) -> ExitCode {
         "scale_space": r.scale_space.map(|s| s.name()),
         "non_unit_quaternions": r.non_unit_quaternions,
         "memory_bytes": c.memory_bytes(),
-        "warnings": warnings,
+        "warnings": r.warning_lines(),
     });
     if a.json {
         println!("{info:#}");

@@ -9,7 +9,7 @@ mod render;
 mod validate;
 
 /// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
-/// INRIA PLY).
+/// INRIA PLY, Niantic SPZ, .splat, .ksplat, PlayCanvas SOG).
 #[derive(Parser, Debug)]
 #[command(name = "splatgl", version, about, long_about = None)]
 pub struct Cli {
@@ -21,16 +21,33 @@ pub struct Cli {
 enum Command {
     /// Print what a splat file holds: format, count, SH degree, colour space, bounds, warnings.
     /// Exit status: 0, or 2 when the file cannot be loaded.
-    Info(info::Args),
+    #[command(mut_arg("json", |a| a.help(info::JSON_HELP)))]
+    Info(FileArgs),
     /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
-    Validate(validate::Args),
+    #[command(mut_arg("json", |a| a.help(validate::JSON_HELP)))]
+    #[command(mut_arg("file", |a| a.help(
+        "The file to check (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json)"
+    )))]
+    Validate(FileArgs),
     /// Render an image (without a scene: the bundled default scene).
     /// Exit status: 0, or 2 on any error (message on stderr).
     Render(render::Args),
     /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
     /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
     Compare(compare::Args),
+}
+
+/// The arguments of `info` and `validate`: one file, read with the loader options.
+#[derive(clap::Args, Debug)]
+pub struct FileArgs {
+    /// The file (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
+    pub file: std::path::PathBuf,
+    /// Print JSON (each command lists its keys).
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub load: LoadArgs,
 }
 
 /// Loader options shared by every command that reads a scene.
@@ -40,6 +57,10 @@ pub struct LoadArgs {
     /// draft's log space), linear (RC) or log.
     #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
     pub scale_space: splatgl::load::ScaleSpace,
+    /// Axes of SPZ data (files and glTF SPZ compression): rub (Niantic's convention, converted
+    /// to splatgl's frame) or raw (no conversion: what splat-transform 3.x writes).
+    #[arg(long, default_value = "rub", value_name = "rub|raw")]
+    pub spz_axes: splatgl::load::spz::SpzAxes,
 }
 
 impl LoadArgs {
@@ -47,6 +68,7 @@ impl LoadArgs {
     pub fn options(&self) -> splatgl::load::LoadOptions {
         splatgl::load::LoadOptions {
             scale_space: self.scale_space,
+            spz_axes: self.spz_axes,
         }
     }
 }

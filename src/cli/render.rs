@@ -1,8 +1,10 @@
 //! `splatgl render`: one image of a scene (or of the bundled default scene).
 
 use glam::Vec3;
-use splatgl::camera::{Camera, load_cameras_json};
+use splatgl::SplatCloud;
+use splatgl::camera::{Camera, GltfPerspective, load_cameras_json};
 use splatgl::image::{Image, PngDepth};
+use splatgl::load::{Format, Scene};
 use splatgl::reference::{RenderOptions, SortMode};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -42,7 +44,8 @@ pub enum SortArg {
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (.ply, .gltf, .glb, .spz, .splat, .ksplat, .sog, SOG meta.json). Without it: the bundled default scene.
+    /// Scene file (.ply, .gltf, .glb, .spz, .splat, .ksplat, .sog, SOG meta.json). Without it:
+    /// the bundled default scene.
     pub scene: Option<PathBuf>,
     /// 3DGS cameras.json to take the view from (see --view).
     #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
@@ -61,7 +64,8 @@ pub struct Args {
     /// Use the N-th glTF camera node of the scene.
     ///
     /// Without any camera option the view frames the scene: glTF from +Z with +Y up, PLY
-    /// (COLMAP axes, also SPZ, .splat, .ksplat and SOG) from +Z with −Y up; the default scene has its own camera.
+    /// (COLMAP axes, also SPZ, .splat, .ksplat and SOG) from +Z with −Y up; the default scene
+    /// has its own camera.
     #[arg(long, value_name = "N")]
     pub gltf_camera: Option<usize>,
     /// Image width (default 640, or the cameras.json view's, scaled).
@@ -132,7 +136,14 @@ fn size_or(a: &Args, w: u32, h: u32) -> (u32, u32) {
     }
 }
 
-fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, String> {
+/// The view: from --camera, --gltf-camera (one of the scene file's `cameras`), --look-at, or
+/// framing `cloud` (read from a file of `format`, `None` for the default scene).
+fn camera(
+    a: &Args,
+    cloud: &SplatCloud,
+    format: Option<Format>,
+    cameras: &[GltfPerspective],
+) -> Result<Camera, String> {
     let fov = a.fov.to_radians();
     if !(fov > 0.0 && fov < std::f32::consts::PI) {
         return Err(format!("--fov {} must be in (0, 180)", a.fov));
@@ -155,19 +166,14 @@ fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, St
         let Some(path) = &a.scene else {
             return Err("--gltf-camera needs a glTF scene file".into());
         };
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let format = splatgl::load::detect_format(&bytes, Some(path));
-        let format = match format {
-            Some(f @ (splatgl::load::Format::Gltf | splatgl::load::Format::Glb)) => f,
-            _ => return Err("--gltf-camera needs a .gltf or .glb scene".into()),
-        };
-        let cams = splatgl::load::gltf::cameras(&bytes, format, Some(path))
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        let g = cams.get(n).ok_or_else(|| {
+        if !matches!(format, Some(Format::Gltf | Format::Glb)) {
+            return Err("--gltf-camera needs a .gltf or .glb scene".into());
+        }
+        let g = cameras.get(n).ok_or_else(|| {
             format!(
                 "--gltf-camera {n}: {} has {} perspective camera node(s)",
                 path.display(),
-                cams.len()
+                cameras.len()
             )
         })?;
         // Keep the camera's aspect ratio when no size is given.
@@ -196,7 +202,8 @@ fn camera(a: &Args, cloud: &splatgl::SplatCloud, ply: bool) -> Result<Camera, St
     if a.scene.is_none() {
         return Ok(splatgl::scene::default_camera(w, h));
     }
-    let framed = if ply {
+    // Every format but glTF is in PLY axes (SPZ is converted to them).
+    let framed = if !matches!(format, Some(Format::Gltf | Format::Glb)) {
         // INRIA/COLMAP axes: −Y up. Look from +Z, slightly from above (−Y).
         let fwd = Vec3::new(0.0, 0.35, -1.0);
         Camera::frame_points_along(&cloud.positions, fwd, -Vec3::Y, fov, w, h)
@@ -236,11 +243,14 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
 
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
-    let (cloud, ply) = match &a.scene {
-        Some(p) => load(p, a.load.options())?,
-        None => (splatgl::scene::default_scene(), false),
+    let (cloud, format, cameras) = match &a.scene {
+        Some(p) => {
+            let s = load(p, a.load.options())?;
+            (s.cloud, Some(s.report.format), s.cameras)
+        }
+        None => (splatgl::scene::default_scene(), None, Vec::new()),
     };
-    let cam = camera(a, &cloud, ply)?;
+    let cam = camera(a, &cloud, format, &cameras)?;
     // cameras.json sizes and derived sizes are bounded like the flags (an image is 16 bytes
     // per pixel in f32).
     if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
@@ -288,7 +298,9 @@ fn go(a: &Args) -> Result<(), String> {
     let (img, backend, visible) = match gl {
         Some(img) => (img, "gl", None),
         None => {
-            let (img, stats) = render_reference(&cloud, &cam, &opts);
+            // As displayed (sRGB-encoded for lin_rec709_display): what the GL backend gives.
+            let space = cloud.meta.color_space.effective();
+            let (img, stats) = splatgl::reference::render_display(&cloud, &cam, &opts, space);
             (img, "reference", Some(stats.visible))
         }
     };
@@ -307,30 +319,6 @@ fn go(a: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The reference render as it is displayed: for `lin_rec709_display` clouds the background is
-/// taken as a display value (decoded), the splats blend in linear, and the result is
-/// sRGB-encoded once at the end — exactly what the GL backend does.
-fn render_reference(
-    cloud: &splatgl::SplatCloud,
-    cam: &Camera,
-    opts: &RenderOptions,
-) -> (Image, splatgl::reference::RenderStats) {
-    use splatgl::cloud::ColorSpace;
-    use splatgl::color::{srgb_decode, srgb_encode};
-    if cloud.meta.color_space.effective() != ColorSpace::LinRec709Display {
-        return splatgl::reference::render_with_stats(cloud, cam, opts);
-    }
-    let mut o = *opts;
-    o.background = opts.background.map(|v| srgb_decode(v as f64) as f32);
-    let (mut img, stats) = splatgl::reference::render_with_stats(cloud, cam, &o);
-    for p in &mut img.pixels {
-        for c in &mut p[..3] {
-            *c = srgb_encode(*c as f64) as f32;
-        }
-    }
-    (img, stats)
-}
-
 #[cfg(feature = "gl")]
 fn render_gl(
     a: &Args,
@@ -338,11 +326,11 @@ fn render_gl(
     cam: &Camera,
     opts: &RenderOptions,
 ) -> Result<Image, String> {
-    use splatgl::headless::{RenderOptions as GlOptions, TargetKind};
+    use splatgl::headless::{HeadlessOptions, TargetKind};
     if a.sort != SortArg::Distance {
         return Err("--sort view-depth is only implemented by --backend reference".into());
     }
-    let o = GlOptions {
+    let o = HeadlessOptions {
         target: match a.target {
             TargetArg::Rgba8 => TargetKind::Rgba8,
             TargetArg::Rgba16f => TargetKind::Rgba16fResolve,
@@ -364,18 +352,13 @@ fn render_gl(
     Err("this splatgl was built without the `gl` feature".into())
 }
 
-/// The cloud and whether it is in PLY (COLMAP) axes rather than glTF's (+Y up).
-fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<(splatgl::SplatCloud, bool), String> {
-    let l = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
-    for w in l.report.summarized_warnings() {
+/// The scene file, parsed once (cloud and cameras); its findings go to stderr as warnings.
+fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<Scene, String> {
+    let scene = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
+    for w in scene.report.summarized_warnings() {
         eprintln!("warning: {w}");
     }
-    // Every format but glTF is in PLY axes (SPZ is converted to them).
-    let ply_axes = !matches!(
-        l.report.format,
-        splatgl::load::Format::Gltf | splatgl::load::Format::Glb
-    );
-    Ok((l.cloud, ply_axes))
+    Ok(scene)
 }
 
 /// Runs it. Exit status 0 on success, 2 on any error.

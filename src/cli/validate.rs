@@ -1,23 +1,14 @@
 //! `splatgl validate FILE [--json]`.
 use std::process::ExitCode;
 
-/// Arguments of `validate`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// The file to check (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
-    pub file: std::path::PathBuf,
-    /// Print the findings as JSON (keys: file, format, status, valid, errors, warnings,
-    /// splat_count, findings[{severity, path, message, index}]).
-    #[arg(long)]
-    pub json: bool,
-    #[command(flatten)]
-    pub load: super::LoadArgs,
-}
+/// Help of `validate --json`.
+pub const JSON_HELP: &str = "Print the findings as JSON (keys: file, format, status, valid, \
+    errors, warnings, splat_count, findings[{severity, path, message, index}])";
 
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
-pub fn run(a: Args) -> ExitCode {
+pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
-    let report = splatgl::validate::validate_path(&a.file, &opts);
+    let report = splatgl::load::validate::validate_path(&a.file, &opts);
     if a.json {
         println!("{:#}", report.to_json(&a.file));
     } else {
@@ -25,9 +16,9 @@ pub fn run(a: Args) -> ExitCode {
             println!("{f}");
         }
         let verdict = match report.status() {
-            splatgl::validate::Status::Valid => "valid",
-            splatgl::validate::Status::Invalid => "INVALID",
-            splatgl::validate::Status::Unreadable => "UNREADABLE",
+            splatgl::load::validate::Status::Valid => "valid",
+            splatgl::load::validate::Status::Invalid => "INVALID",
+            splatgl::load::validate::Status::Unreadable => "UNREADABLE",
         };
         println!(
             "{}: {verdict} ({} errors, {} warnings)",

@@ -7,6 +7,9 @@
 //! Capacity: `W · GL_MAX_TEXTURE_SIZE / max(3, T_sh)` splats — 11.2M at SH degree 3 and 44.7M
 //! at degree 0 with llvmpipe's 16384; [`SplatTextures::upload`] reports an error beyond.
 //!
+//! The layout constants (texels per splat, which geometry texel holds what) are
+//! [`crate::profile`]'s; the shaders get them as `#define`s.
+//!
 //! | texture | format | texels/splat | content | bytes/splat |
 //! |---|---|---|---|---|
 //! | geometry | `RGBA32F` | 3 | (position.xyz, opacity), rotation xyzw, (scale.xyz, 0) | 48 |
@@ -24,27 +27,24 @@
 use glow::HasContext;
 
 use super::GlError;
-use crate::cloud::{SplatCloud, sh_coeff_count};
+use super::objects::{Creating, Owned};
+use crate::cloud::SplatCloud;
+use crate::profile::{
+    GEOM_TEXEL_POSITION_OPACITY, GEOM_TEXEL_ROTATION, GEOM_TEXEL_SCALE, GEOM_TEXELS, sh_texels,
+};
 
 /// log2 of the widest data texture used (8192 texels).
-pub const MAX_TEX_WIDTH_LOG2: u32 = 13;
+const MAX_TEX_WIDTH_LOG2: u32 = 13;
 
 /// log2 of the data textures' width for a context with this `GL_MAX_TEXTURE_SIZE`: the largest
 /// power of two ≤ min(8192, max_texture_size), and at least 2048 (the GLES 3.0 minimum).
-pub fn tex_width_log2(max_texture_size: i32) -> u32 {
+pub(crate) fn tex_width_log2(max_texture_size: i32) -> u32 {
     let m = max_texture_size.max(2048) as u32;
     (31 - m.leading_zeros()).min(MAX_TEX_WIDTH_LOG2)
 }
-/// Texels per splat in the geometry texture.
-pub const GEOM_TEXELS: usize = 3;
-
-/// RGBA16F texels per splat holding SH coefficients of degree `degree`.
-pub const fn sh_texels(degree: u8) -> usize {
-    (3 * sh_coeff_count(degree)).div_ceil(4)
-}
-
 /// GPU-resident bytes per splat for a cloud of SH degree `degree` (geometry + SH).
-pub const fn bytes_per_splat(degree: u8) -> usize {
+#[cfg(test)]
+const fn bytes_per_splat(degree: u8) -> usize {
     GEOM_TEXELS * 16 + sh_texels(degree) * 8
 }
 
@@ -55,48 +55,39 @@ fn rows(n: usize, per_splat: usize, width: usize) -> usize {
 
 /// The two data textures of an uploaded cloud.
 #[derive(Debug)]
-pub struct SplatTextures {
+pub(crate) struct SplatTextures {
     /// Geometry texture (`RGBA32F`).
-    pub geometry: glow::Texture,
+    pub(crate) geometry: glow::Texture,
     /// SH texture (`RGBA16F`).
-    pub sh: glow::Texture,
+    pub(crate) sh: glow::Texture,
     /// SH texels per splat.
-    pub sh_texels: usize,
+    pub(crate) sh_texels: usize,
     /// Splats uploaded.
-    pub len: usize,
+    pub(crate) len: usize,
+    owned: Owned,
 }
 
-/// Writes splat `i`'s geometry texels (12 floats).
+/// Writes splat `i`'s geometry texels (`GEOM_TEXELS` × 4 floats).
 fn geometry_of(cloud: &SplatCloud, i: usize, out: &mut [f32]) {
-    let p = cloud.positions[i];
-    let q = cloud.rotations[i];
-    let s = cloud.scales[i];
-    out.copy_from_slice(&[
-        p[0],
-        p[1],
-        p[2],
-        // Splats the reference skips (non-finite data) get opacity 0: the shader culls them.
-        if cloud.is_drawable(i) {
-            cloud.opacities[i]
-        } else {
-            0.0
-        },
-        q[0],
-        q[1],
-        q[2],
-        q[3],
-        s[0],
-        s[1],
-        s[2],
-        0.0,
-    ]);
+    let [x, y, z] = cloud.positions[i];
+    let [sx, sy, sz] = cloud.scales[i];
+    // Splats the reference skips (non-finite data) get opacity 0: the shader culls them.
+    let opacity = if cloud.is_drawable(i) {
+        cloud.opacities[i]
+    } else {
+        0.0
+    };
+    let texel = |k: usize| 4 * k..4 * k + 4;
+    out[texel(GEOM_TEXEL_POSITION_OPACITY)].copy_from_slice(&[x, y, z, opacity]);
+    out[texel(GEOM_TEXEL_ROTATION)].copy_from_slice(&cloud.rotations[i]);
+    out[texel(GEOM_TEXEL_SCALE)].copy_from_slice(&[sx, sy, sz, 0.0]);
 }
 
 /// Uploads a `width`-wide float texture whose linear texel stream is produced by `fill`
 /// (called per splat with a slice of `per_splat · 4` floats), a few rows at a time so the
 /// staging memory stays small for large clouds.
 fn upload_texture(
-    gl: &glow::Context,
+    objects: &mut Creating<'_>,
     internal_format: u32,
     width: usize,
     n: usize,
@@ -104,14 +95,12 @@ fn upload_texture(
     mut fill: impl FnMut(usize, &mut [f32]),
 ) -> Result<glow::Texture, GlError> {
     let height = rows(n, per_splat, width);
+    let gl = objects.gl();
+    let tex = objects.texture()?;
     // SAFETY: texture creation/allocation on the current context with sizes checked by the
     // caller against GL_MAX_TEXTURE_SIZE; sub-image uploads stay inside the allocated storage
     // (row ranges computed below) and read exactly width·rows·4 floats from `staging`.
     unsafe {
-        let tex = gl.create_texture().map_err(|message| GlError::Create {
-            what: "texture",
-            message,
-        })?;
         gl.bind_texture(glow::TEXTURE_2D, Some(tex));
         gl.tex_storage_2d(
             glow::TEXTURE_2D,
@@ -180,7 +169,7 @@ fn upload_texture(
 impl SplatTextures {
     /// Uploads a cloud into textures `2^width_log2` texels wide (checks the cloud's invariants
     /// and the texture size limit first).
-    pub fn upload(
+    pub(crate) fn upload(
         gl: &glow::Context,
         cloud: &SplatCloud,
         width_log2: u32,
@@ -199,43 +188,39 @@ impl SplatTextures {
                 "{n} splats need {need} texture rows; GL_MAX_TEXTURE_SIZE is {max_size}"
             )));
         }
-        let geometry = upload_texture(gl, glow::RGBA32F, width, n, GEOM_TEXELS, |i, out| {
-            geometry_of(cloud, i, out)
-        })?;
-        let sh = upload_texture(gl, glow::RGBA16F, width, n, sh_t, |i, out| {
+        let mut objects = Creating::new(gl);
+        let geometry = upload_texture(
+            &mut objects,
+            glow::RGBA32F,
+            width,
+            n,
+            GEOM_TEXELS,
+            |i, out| geometry_of(cloud, i, out),
+        )?;
+        let sh = upload_texture(&mut objects, glow::RGBA16F, width, n, sh_t, |i, out| {
             out.fill(0.0);
             for (j, c) in cloud.sh[i * k..(i + 1) * k].iter().enumerate() {
                 out[3 * j..3 * j + 3].copy_from_slice(c);
             }
-        });
-        let sh = match sh {
-            Ok(t) => t,
-            Err(e) => {
-                // SAFETY: deleting the texture created just above.
-                unsafe { gl.delete_texture(geometry) };
-                return Err(e);
-            }
-        };
-        let textures = SplatTextures {
+        })?;
+        super::check_error(gl, "uploading splat textures")?;
+        Ok(SplatTextures {
             geometry,
             sh,
             sh_texels: sh_t,
             len: n,
-        };
-        if let Err(e) = super::check_error(gl, "uploading splat textures") {
-            textures.destroy(gl);
-            return Err(e);
-        }
-        Ok(textures)
+            owned: objects.keep("SplatTextures"),
+        })
     }
 
-    /// Deletes both textures.
-    pub fn destroy(&self, gl: &glow::Context) {
-        // SAFETY: deleting textures this struct created.
-        unsafe {
-            gl.delete_texture(self.geometry);
-            gl.delete_texture(self.sh);
-        }
+    /// Deletes both textures (once).
+    pub(crate) fn destroy(&mut self, gl: &glow::Context) {
+        self.owned.destroy(gl);
+    }
+
+    /// Forgets the textures without GL calls (their context is already gone).
+    pub(crate) fn abandon(&mut self) {
+        self.owned.abandon();
     }
 }
 
@@ -245,7 +230,6 @@ mod tests {
 
     #[test]
     fn layout_sizes() {
-        assert_eq!([0, 1, 2, 3].map(sh_texels), [1, 3, 7, 12]);
         assert_eq!([0, 1, 2, 3].map(bytes_per_splat), [56, 72, 104, 144]);
         assert_eq!(rows(0, 3, 2048), 1);
         assert_eq!(rows(2048, 3, 2048), 3);

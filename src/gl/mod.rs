@@ -6,36 +6,50 @@
 //! ```no_run
 //! # fn demo(gl: &glow::Context, cloud: &splatgl::SplatCloud, camera: &splatgl::camera::Camera)
 //! # -> Result<(), splatgl::gl::GlError> {
-//! use splatgl::gl::{SplatRenderer, sort_back_to_front};
+//! use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer, sort_back_to_front};
 //! let mut renderer = SplatRenderer::new(gl)?;
 //! renderer.upload(gl, cloud)?;                  // once: splat data → textures
+//! let mut target = ReadbackTarget::new(gl, camera.width, camera.height, ColorFormat::Rgba8, None)?;
+//! target.bind(gl)?;                              // or draw into the host's own framebuffer
 //! let mut order = Vec::new();
 //! sort_back_to_front(&cloud.positions, camera.eye(), &mut order); // per frame
 //! renderer.draw(gl, camera, &order)?;            // per frame: 4 bytes/splat uploaded
+//! let image = target.read_image(gl)?;            // top row first
+//! target.destroy(gl);
 //! renderer.destroy(gl);
 //! # Ok(()) }
 //! ```
 //!
-//! * [`program`] — GLSL assembly (`#version` chosen at run time, constants injected as
-//!   `#define`s from [`consts`]) and compile/link with numbered-source error reports.
-//! * [`data`] — texture layout of the splat data (bytes per splat).
-//! * [`renderer`] — [`SplatRenderer`].
-//! * [`target`] — [`OffscreenTarget`], the RGBA16F accumulation target with a resolve pass.
-//! * [`sort`] — [`sort_back_to_front`] / [`sort::DistanceSorter`], over the crate's radix
-//!   sorter ([`crate::sort::Sorter`]). `examples/embed.rs` shows a host-owned context.
-//! * [`state`] — every piece of GL state the backend touches.
+//! * [`SplatRenderer`] and its [`DrawSettings`]: upload once, draw per frame.
+//! * [`ReadbackTarget`]: a framebuffer (RGBA8 / SRGB8_ALPHA8 / RGBA16F colour, optional depth)
+//!   read back into an [`Image`](crate::image::Image), for headless use, tests and hosts.
+//! * [`OffscreenTarget`]: the RGBA16F accumulation target with a resolve pass.
+//! * [`sort_back_to_front`] / [`DistanceSorter`]: the draw order, over the crate's radix sorter
+//!   ([`crate::sort::Sorter`]). `examples/embed.rs` shows a host-owned context.
+//! * [`state`]: every piece of GL state the backend touches.
+//!
+//! Every type that owns GL objects has `destroy(&mut self, gl)`; call it with the context
+//! current before dropping the value (a live value dropped leaks its objects and warns once;
+//! a destroyed one returns [`GlError::Destroyed`]). Shaders get every number of the rendering
+//! profile as a generated `#define` ([`crate::profile`]).
 
-pub mod consts;
-pub mod data;
-pub mod program;
-pub mod renderer;
-pub mod sort;
+mod data;
+mod glsl;
+mod objects;
+mod program;
+mod readback;
+mod renderer;
+mod sort;
 pub mod state;
-pub mod target;
+mod target;
 
-pub use program::{Errata, GlslVersion};
+#[doc(hidden)]
+pub use glsl::Errata;
+#[doc(hidden)]
+pub use program::build_program;
+pub use readback::{ColorFormat, DepthFormat, ReadbackTarget};
 pub use renderer::{DrawSettings, SplatRenderer};
-pub use sort::sort_back_to_front;
+pub use sort::{DistanceSorter, sort_back_to_front};
 pub use target::OffscreenTarget;
 
 /// Errors of the GL layer.
@@ -93,6 +107,9 @@ pub enum GlError {
     /// A framebuffer was incomplete.
     #[error("framebuffer incomplete: status 0x{0:04X}")]
     Framebuffer(u32),
+    /// A method was called after `destroy` (the name of the type).
+    #[error("{0} used after destroy()")]
+    Destroyed(&'static str),
     /// `glGetError` reported an error after an operation.
     #[error("GL error 0x{code:04X} after {during}")]
     Gl {
@@ -126,9 +143,4 @@ pub(crate) fn check_error(gl: &glow::Context, during: &'static str) -> Result<()
     } else {
         Err(GlError::Gl { code, during })
     }
-}
-
-/// Maps glow's `create_*` error to [`GlError::Create`].
-pub(crate) fn created<T>(r: Result<T, String>, what: &'static str) -> Result<T, GlError> {
-    r.map_err(|message| GlError::Create { what, message })
 }

@@ -5,11 +5,14 @@ use glow::HasContext;
 
 use super::GlError;
 use super::data::SplatTextures;
-use super::program::{self, Errata, GlslVersion};
+use super::glsl::{self, Errata, GlslVersion};
+use super::objects::{Creating, Owned};
+use super::program;
 use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
 
-/// Per-draw settings; change them between draws with [`SplatRenderer::settings_mut`].
+/// Per-draw settings: the renderer's own ([`SplatRenderer::settings_mut`], used by
+/// [`SplatRenderer::draw`]) or given for one draw ([`SplatRenderer::draw_current_with`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DrawSettings {
     /// SH degree to evaluate (clamped to the cloud's degree); `None` = the cloud's degree.
@@ -29,20 +32,32 @@ impl Default for DrawSettings {
     }
 }
 
-#[derive(Debug)]
-struct Uniforms {
-    geometry: Option<glow::UniformLocation>,
-    sh: Option<glow::UniformLocation>,
-    sh_texels: Option<glow::UniformLocation>,
-    sh_degree: Option<glow::UniformLocation>,
-    view: Option<glow::UniformLocation>,
-    projection: Option<glow::UniformLocation>,
-    focal: Option<glow::UniformLocation>,
-    tan_half_fov: Option<glow::UniformLocation>,
-    camera_position: Option<glow::UniformLocation>,
-    viewport: Option<glow::UniformLocation>,
-    cull_depth: Option<glow::UniformLocation>,
-    splat_count: Option<glow::UniformLocation>,
+/// Declares `Uniforms`, one location per uniform the renderer sets, each field named exactly
+/// like its GLSL uniform (so the two cannot get out of step).
+macro_rules! uniforms {
+    ($($name:ident),* $(,)?) => {
+        /// The locations of the uniforms the renderer sets.
+        #[derive(Debug)]
+        struct Uniforms {
+            $($name: Option<glow::UniformLocation>,)*
+        }
+
+        impl Uniforms {
+            /// Looks them up; for the correct program (`check`), a debug build asserts that
+            /// they all exist.
+            fn new(gl: &glow::Context, program: glow::Program, check: bool) -> Self {
+                let names = [$(stringify!($name)),*];
+                let [$($name),*] = program::uniform_locations(gl, program, "splat", names, check);
+                Uniforms { $($name),* }
+            }
+        }
+    };
+}
+
+uniforms! {
+    u_geometry, u_sh, u_sh_texels, u_sh_fetch_texels, u_sh_degree, u_view_matrix,
+    u_projection_matrix, u_focal_length, u_tan_half_fov, u_camera_position, u_viewport,
+    u_cull_depth, u_splat_count,
 }
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
@@ -60,6 +75,12 @@ struct Uniforms {
 /// sRGB-encoded once at the end: draw into an `SRGB8_ALPHA8` framebuffer (ES always converts;
 /// desktop GL needs `GL_FRAMEBUFFER_SRGB`), or into an [`super::OffscreenTarget`] resolved with
 /// `encode_srgb = true`.
+///
+/// # Lifetime
+///
+/// It owns GL objects but not the context: call [`SplatRenderer::destroy`] with the context
+/// current before dropping it (dropping a live renderer leaks its objects and warns once).
+/// After `destroy` every method returns [`GlError::Destroyed`].
 #[derive(Debug)]
 pub struct SplatRenderer {
     program: glow::Program,
@@ -74,6 +95,7 @@ pub struct SplatRenderer {
     settings: DrawSettings,
     errata: Errata,
     tex_width_log2: u32,
+    owned: Owned,
 }
 
 impl SplatRenderer {
@@ -84,54 +106,23 @@ impl SplatRenderer {
     }
 
     /// Like [`SplatRenderer::new`], with some of the review draft's Appendix A errata switched
-    /// back in. **Tests and demonstrations only.**
+    /// back in. **Erratum tests only** (hidden from the documented API).
+    #[doc(hidden)]
     pub fn with_errata(gl: &glow::Context, errata: Errata) -> Result<Self, GlError> {
         let version = GlslVersion::for_context(gl);
         // SAFETY: a plain integer query.
         let max_texture_size = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) };
         let tex_width_log2 = super::data::tex_width_log2(max_texture_size);
-        let vs = program::assemble(version, &errata, tex_width_log2, program::SPLAT_VERT);
-        let fs = program::assemble(version, &errata, tex_width_log2, program::SPLAT_FRAG);
-        let program = program::build_program(gl, "splat", &vs, &fs)?;
-        // SAFETY: queries on the program just linked, and creation of a VAO and a buffer; on
-        // failure everything created so far is deleted.
+        let vs = glsl::assemble(version, &errata, tex_width_log2, glsl::SPLAT_VERT);
+        let fs = glsl::assemble(version, &errata, tex_width_log2, glsl::SPLAT_FRAG);
+        let mut objects = Creating::new(gl);
+        let program = program::build_program_in(&mut objects, "splat", &vs, &fs)?;
+        // Erratum variants may compile some uniforms away: only the correct program is checked.
+        let uniforms = Uniforms::new(gl, program, errata == Errata::default());
+        let vao = objects.vertex_array()?;
+        let order_buffer = objects.buffer()?;
+        // SAFETY: configures the VAO and buffer created just above; both bindings are left 0.
         unsafe {
-            let loc = |name: &str| gl.get_uniform_location(program, name);
-            let uniforms = Uniforms {
-                geometry: loc("u_geometry"),
-                sh: loc("u_sh"),
-                sh_texels: loc("u_sh_texels"),
-                sh_degree: loc("u_sh_degree"),
-                view: loc("u_view_matrix"),
-                projection: loc("u_projection_matrix"),
-                focal: loc("u_focal_length"),
-                tan_half_fov: loc("u_tan_half_fov"),
-                camera_position: loc("u_camera_position"),
-                viewport: loc("u_viewport"),
-                cull_depth: loc("u_cull_depth"),
-                splat_count: loc("u_splat_count"),
-            };
-            let vao = match gl.create_vertex_array() {
-                Ok(v) => v,
-                Err(message) => {
-                    gl.delete_program(program);
-                    return Err(GlError::Create {
-                        what: "vertex array",
-                        message,
-                    });
-                }
-            };
-            let order_buffer = match gl.create_buffer() {
-                Ok(b) => b,
-                Err(message) => {
-                    gl.delete_vertex_array(vao);
-                    gl.delete_program(program);
-                    return Err(GlError::Create {
-                        what: "buffer",
-                        message,
-                    });
-                }
-            };
             // The only vertex attribute: the sorted splat index, one u32 per instance.
             gl.bind_vertex_array(Some(vao));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(order_buffer));
@@ -140,27 +131,29 @@ impl SplatRenderer {
             gl.vertex_attrib_divisor(0, 1);
             gl.bind_vertex_array(None);
             gl.bind_buffer(glow::ARRAY_BUFFER, None);
-            Ok(SplatRenderer {
-                program,
-                uniforms,
-                vao,
-                order_buffer,
-                order_capacity: 0,
-                instances: 0,
-                textures: None,
-                cloud_degree: 0,
-                color_space: ColorSpace::default(),
-                settings: DrawSettings::default(),
-                errata,
-                tex_width_log2,
-            })
         }
+        Ok(SplatRenderer {
+            program,
+            uniforms,
+            vao,
+            order_buffer,
+            order_capacity: 0,
+            instances: 0,
+            textures: None,
+            cloud_degree: 0,
+            color_space: ColorSpace::default(),
+            settings: DrawSettings::default(),
+            errata,
+            tex_width_log2,
+            owned: objects.keep("SplatRenderer"),
+        })
     }
 
     /// Uploads a cloud's data into textures (once per cloud; replaces any previous cloud) and
     /// sizes the order buffer for `cloud.len()` indices.
     pub fn upload(&mut self, gl: &glow::Context, cloud: &SplatCloud) -> Result<(), GlError> {
-        let textures = SplatTextures::upload(gl, cloud, self.tex_width_log2)?;
+        self.owned.check()?;
+        let mut textures = SplatTextures::upload(gl, cloud, self.tex_width_log2)?;
         // The order buffer first: on failure the previous cloud stays complete and usable.
         // SAFETY: (re)allocates the renderer's own order buffer.
         unsafe {
@@ -177,7 +170,7 @@ impl SplatRenderer {
             self.instances = 0; // the buffer's old contents are gone
             return Err(e);
         }
-        if let Some(old) = self.textures.replace(textures) {
+        if let Some(mut old) = self.textures.replace(textures) {
             old.destroy(gl);
         }
         self.cloud_degree = cloud.sh_degree;
@@ -187,7 +180,8 @@ impl SplatRenderer {
         Ok(())
     }
 
-    /// The linked splat program (for inspection, e.g. its active attributes).
+    /// The linked splat program (for inspection, e.g. its active attributes; erratum tests).
+    #[doc(hidden)]
     pub fn program(&self) -> glow::Program {
         self.program
     }
@@ -226,6 +220,7 @@ impl SplatRenderer {
     /// Uploads a draw order (`glBufferSubData`, 4 bytes per index): splat indices back to front,
     /// each `< len()`. May be shorter than the cloud (culled or partial draws).
     pub fn set_order(&mut self, gl: &glow::Context, order: &[u32]) -> Result<(), GlError> {
+        self.owned.check()?;
         if self.textures.is_none() {
             return Err(GlError::NotUploaded);
         }
@@ -257,17 +252,29 @@ impl SplatRenderer {
         self.draw_current(gl, camera)
     }
 
-    /// Draws the splats of the last uploaded order into the bound framebuffer and viewport,
-    /// blending premultiplied colour with `ONE, ONE_MINUS_SRC_ALPHA`. When the camera's
-    /// `width`/`height` differ from the viewport's (e.g. a camera in logical pixels on a HiDPI
-    /// surface), its intrinsics are scaled to the viewport ([`Camera::resized`]).
+    /// Draws the splats of the last uploaded order into the bound framebuffer and viewport with
+    /// the renderer's [`DrawSettings`], blending premultiplied colour with
+    /// `ONE, ONE_MINUS_SRC_ALPHA`. When the camera's `width`/`height` differ from the
+    /// viewport's (e.g. a camera in logical pixels on a HiDPI surface), its intrinsics are
+    /// scaled to the viewport ([`Camera::resized`]).
     pub fn draw_current(&self, gl: &glow::Context, camera: &Camera) -> Result<(), GlError> {
+        self.draw_current_with(gl, camera, &self.settings)
+    }
+
+    /// [`SplatRenderer::draw_current`] with `settings` for this draw only (the renderer's own
+    /// settings are neither used nor changed).
+    pub fn draw_current_with(
+        &self,
+        gl: &glow::Context,
+        camera: &Camera,
+        settings: &DrawSettings,
+    ) -> Result<(), GlError> {
+        self.owned.check()?;
         let Some(tex) = &self.textures else {
             return Err(GlError::NotUploaded);
         };
         let u = &self.uniforms;
-        let degree = self
-            .settings
+        let degree = settings
             .sh_degree
             .unwrap_or(self.cloud_degree)
             .min(self.cloud_degree);
@@ -291,27 +298,31 @@ impl SplatRenderer {
         // the order buffer's size; the shader culls any index past the uploaded splats.
         unsafe {
             gl.use_program(Some(self.program));
-            gl.uniform_matrix_4_f32_slice(u.view.as_ref(), false, &view.to_cols_array());
-            gl.uniform_matrix_4_f32_slice(u.projection.as_ref(), false, &proj.to_cols_array());
-            gl.uniform_2_f32(u.focal.as_ref(), camera.fx, camera.fy);
-            gl.uniform_2_f32(u.tan_half_fov.as_ref(), tan.x, tan.y);
-            gl.uniform_3_f32(u.camera_position.as_ref(), eye.x, eye.y, eye.z);
+            gl.uniform_matrix_4_f32_slice(u.u_view_matrix.as_ref(), false, &view.to_cols_array());
+            gl.uniform_matrix_4_f32_slice(
+                u.u_projection_matrix.as_ref(),
+                false,
+                &proj.to_cols_array(),
+            );
+            gl.uniform_2_f32(u.u_focal_length.as_ref(), camera.fx, camera.fy);
+            gl.uniform_2_f32(u.u_tan_half_fov.as_ref(), tan.x, tan.y);
+            gl.uniform_3_f32(u.u_camera_position.as_ref(), eye.x, eye.y, eye.z);
             gl.uniform_4_f32(
-                u.viewport.as_ref(),
+                u.u_viewport.as_ref(),
                 viewport[0] as f32,
                 viewport[1] as f32,
                 viewport[2] as f32,
                 viewport[3] as f32,
             );
-            gl.uniform_1_f32(
-                u.cull_depth.as_ref(),
-                super::consts::NEAR_CULL.max(camera.near),
-            );
-            gl.uniform_1_i32(u.sh_degree.as_ref(), i32::from(degree));
-            gl.uniform_1_i32(u.sh_texels.as_ref(), tex.sh_texels as i32);
-            gl.uniform_1_i32(u.splat_count.as_ref(), tex.len as i32);
-            gl.uniform_1_i32(u.geometry.as_ref(), 0);
-            gl.uniform_1_i32(u.sh.as_ref(), 1);
+            let cull = (crate::profile::NEAR_CULL as f32).max(camera.near);
+            gl.uniform_1_f32(u.u_cull_depth.as_ref(), cull);
+            gl.uniform_1_i32(u.u_sh_degree.as_ref(), i32::from(degree));
+            gl.uniform_1_i32(u.u_sh_texels.as_ref(), tex.sh_texels as i32);
+            let fetch = crate::profile::sh_texels(degree);
+            gl.uniform_1_i32(u.u_sh_fetch_texels.as_ref(), fetch as i32);
+            gl.uniform_1_i32(u.u_splat_count.as_ref(), tex.len as i32);
+            gl.uniform_1_i32(u.u_geometry.as_ref(), 0);
+            gl.uniform_1_i32(u.u_sh.as_ref(), 1);
             // A host sampler object on these units would override the textures' NEAREST
             // filtering (RGBA32F is not filterable on ES 3.0): unbind samplers.
             gl.bind_sampler(0, None);
@@ -330,7 +341,7 @@ impl SplatRenderer {
             }
             gl.disable(glow::CULL_FACE);
             gl.depth_mask(false);
-            if self.settings.depth_test {
+            if settings.depth_test {
                 gl.enable(glow::DEPTH_TEST);
                 gl.depth_func(glow::LESS);
             } else {
@@ -351,18 +362,22 @@ impl SplatRenderer {
         Ok(())
     }
 
-    /// Deletes every GL object the renderer created. The renderer must not be used afterwards.
+    /// Deletes every GL object the renderer created (once; afterwards every method returns
+    /// [`GlError::Destroyed`]). Call it with the renderer's context current.
     pub fn destroy(&mut self, gl: &glow::Context) {
-        if let Some(t) = self.textures.take() {
+        if let Some(mut t) = self.textures.take() {
             t.destroy(gl);
         }
-        // SAFETY: deleting objects this renderer created.
-        unsafe {
-            gl.delete_buffer(self.order_buffer);
-            gl.delete_vertex_array(self.vao);
-            gl.delete_program(self.program);
-        }
+        self.owned.destroy(gl);
         self.order_capacity = 0;
         self.instances = 0;
+    }
+
+    /// Forgets the objects without GL calls (their context is already gone).
+    pub(crate) fn abandon(&mut self) {
+        if let Some(mut t) = self.textures.take() {
+            t.abandon();
+        }
+        self.owned.abandon();
     }
 }

@@ -1,7 +1,7 @@
 //! GL state the backend touches. The renderer never owns the context: the host keeps its
 //! framebuffer, viewport and scissor, and the renderer leaves state as listed here.
 //!
-//! # [`SplatRenderer::draw`](super::SplatRenderer::draw)
+//! # [`SplatRenderer::draw`](super::SplatRenderer::draw) (and `draw_current`, `draw_current_with`)
 //!
 //! Reads: the bound draw framebuffer and `GL_VIEWPORT` (splats are drawn into the host's
 //! viewport; a camera of another size is scaled to it with `Camera::resized`).
@@ -23,7 +23,8 @@
 //! | `GL_CULL_FACE` | disabled | **disabled** (left) |
 //! | `GL_SCISSOR_TEST`, stencil, colour mask | not touched | unchanged |
 //!
-//! `tests/gl.rs::embedding_depth_test_and_documented_state` checks the "left afterwards" column.
+//! `tests/gl_embedding.rs::host_depth_buffer_viewport_and_gl_state_are_respected` checks the
+//! "left afterwards" column.
 //!
 //! A host that needs other values back (e.g. `glDepthMask(true)` for its next pass) sets them
 //! after the call; querying and restoring everything would cost a round-trip per state per frame.
@@ -43,3 +44,12 @@
 //! framebuffer again and restores the viewport it found at `begin`, then draws one triangle with
 //! blending **disabled** and depth testing **disabled** (both left so) and leaves program 0,
 //! VAO 0, texture unit 0 bound to 0.
+//!
+//! # [`ReadbackTarget`](super::ReadbackTarget)
+//!
+//! Creation (`new`) leaves the `TEXTURE_2D` binding of the active unit and the
+//! `RENDERBUFFER` binding at 0 and restores the draw framebuffer binding. `bind` binds the
+//! target as `GL_FRAMEBUFFER` (draw and read) and sets the viewport to its size (both left so).
+//! `read_image` binds `GL_READ_FRAMEBUFFER` and restores the binding it found, and leaves
+//! `GL_PIXEL_PACK_BUFFER` 0, `GL_PACK_ALIGNMENT` 4, `GL_PACK_ROW_LENGTH`, `GL_PACK_SKIP_ROWS`
+//! and `GL_PACK_SKIP_PIXELS` 0 (the defaults).

@@ -1,9 +1,12 @@
-//! Findings: what the glTF reader and `splatgl validate` report about a file.
+//! [`Finding`]: the one diagnostics type of loading and validation. Every reader records what it
+//! notices as findings in its [`crate::load::LoadReport`]; `splatgl info` and `render` print
+//! them as warnings, `splatgl validate` judges them.
 
+use std::collections::HashMap;
 use std::fmt;
 
 /// How bad a finding is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Severity {
     /// The file breaks a MUST of glTF 2.0 or of `KHR_gaussian_splatting` (RC).
     Error,
@@ -21,14 +24,17 @@ impl Severity {
     }
 }
 
-/// One thing found in a file.
+/// One thing found in a file: where (JSON path or PLY element/property, and the first
+/// offending element index), how bad, and what.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Finding {
     /// Error or warning.
     pub severity: Severity,
     /// Whether the loader cannot go on (the data is unusable, not merely off-spec).
     pub blocks_loading: bool,
-    /// JSON path, e.g. `meshes[0].primitives[1].attributes["KHR_gaussian_splatting:SCALE"]`.
+    /// Where: a JSON path, e.g.
+    /// `meshes[0].primitives[1].attributes["KHR_gaussian_splatting:SCALE"]`, or a PLY element
+    /// and property (`vertex.rot_0..3`); empty when the finding concerns the whole file.
     pub path: String,
     /// What is wrong, and what was expected.
     pub message: String,
@@ -38,7 +44,7 @@ pub struct Finding {
 
 impl Finding {
     /// An error that stops loading.
-    pub fn fatal(path: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn fatal(path: impl Into<String>, message: impl Into<String>) -> Self {
         Finding {
             severity: Severity::Error,
             blocks_loading: true,
@@ -48,24 +54,61 @@ impl Finding {
         }
     }
     /// A spec violation the loader can work around.
-    pub fn error(path: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn error(path: impl Into<String>, message: impl Into<String>) -> Self {
         Finding {
             blocks_loading: false,
             ..Finding::fatal(path, message)
         }
     }
     /// A warning.
-    pub fn warning(path: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn warning(path: impl Into<String>, message: impl Into<String>) -> Self {
         Finding {
             severity: Severity::Warning,
             ..Finding::error(path, message)
         }
     }
     /// Sets the offending index.
-    pub fn at(mut self, index: u64) -> Self {
+    pub(crate) fn at(mut self, index: u64) -> Self {
         self.index = Some(index);
         self
     }
+    /// The line `splatgl info` and `render` print for it (and `info --json` lists under
+    /// `warnings`): `PATH [index I]: MESSAGE`, an error's message prefixed with what it breaks.
+    pub fn warning_line(&self) -> String {
+        let message = match self.severity {
+            Severity::Error => format!(
+                "invalid per KHR_gaussian_splatting RC / glTF 2.0: {}",
+                self.message
+            ),
+            Severity::Warning => self.message.clone(),
+        };
+        let location = match self.index {
+            Some(i) => format!("{} [index {i}]", self.path),
+            None => self.path.clone(),
+        };
+        if location.is_empty() {
+            message
+        } else {
+            format!("{location}: {message}")
+        }
+    }
+}
+
+/// Repeats collapsed: one entry per distinct (severity, message), holding the first finding
+/// that said it and how many said it, in first-seen order.
+pub(crate) fn collapse(findings: &[Finding]) -> Vec<(&Finding, usize)> {
+    let mut groups: Vec<(&Finding, usize)> = Vec::new();
+    let mut index: HashMap<(Severity, &str), usize> = HashMap::new();
+    for f in findings {
+        match index.get(&(f.severity, f.message.as_str())) {
+            Some(&g) => groups[g].1 += 1,
+            None => {
+                index.insert((f.severity, &f.message), groups.len());
+                groups.push((f, 1));
+            }
+        }
+    }
+    groups
 }
 
 impl fmt::Display for Finding {

@@ -14,8 +14,7 @@
 //! f16 / u8 in [min, max] for levels 0 / 1 / 2. PLY axes.
 
 use super::codec::{self, build_cloud, f16_to_f32, finish_cloud};
-use super::details::Details;
-use super::finding::Finding;
+use super::{Details, Finding, LoadReport, ScaleSeen};
 use crate::cloud::SplatCloud;
 
 /// Size of the main header.
@@ -208,11 +207,9 @@ impl Section {
     }
 }
 
-/// Reads a `.ksplat` file from memory.
-pub(crate) fn read(
-    bytes: &[u8],
-    findings: &mut Vec<Finding>,
-) -> Result<(SplatCloud, Details), KsplatError> {
+/// Reads a `.ksplat` file from memory into `report` (findings, details, linear scales).
+pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, KsplatError> {
+    let findings = &mut report.findings;
     let (secs, end) = sections(bytes)?;
     let level = codec::u16_at(bytes, 20);
     if end < bytes.len() as u64 {
@@ -247,7 +244,6 @@ pub(crate) fn read(
         })
         .collect();
     let (cb, shb) = component_bytes(level);
-    let c0 = crate::sh::SH_C0 as f32;
     let cloud = build_cloud::<std::convert::Infallible>(n, degree, |g, s| {
         let si = starts.partition_point(|&st| st <= g) - 1;
         let sec = &secs[si];
@@ -269,7 +265,7 @@ pub(crate) fn read(
         *s.scale = std::array::from_fn(|a| val(3 + a));
         *s.rotation = [val(7), val(8), val(9), val(6)];
         let col = &r[10 * cb..];
-        s.sh[0] = std::array::from_fn(|c| (col[c] as f32 / 255.0 - 0.5) / c0);
+        s.sh[0] = std::array::from_fn(|c| crate::sh::dc_from_color(col[c] as f64 / 255.0));
         *s.opacity = col[3] as f32 / 255.0;
         let sh = &col[4..];
         let value = |k: usize| match shb {
@@ -307,7 +303,9 @@ pub(crate) fn read(
             format!("sections of lower SH degree zero-padded to {degree}"),
         ));
     }
-    Ok((cloud, describe(bytes, level, degree)))
+    report.details = Some(describe(bytes, level, degree));
+    report.scale_space = Some(ScaleSeen::Linear);
+    Ok(cloud)
 }
 
 fn describe(bytes: &[u8], level: u16, degree: u8) -> Details {

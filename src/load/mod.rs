@@ -2,28 +2,35 @@
 //! packed formats of other tools: Niantic SPZ, antimatter15 `.splat`, mkkellogg `.ksplat` and
 //! PlayCanvas SOG (`docs/formats.md`).
 //!
-//! [`load_path`] picks the format by content (then by extension) and returns the
-//! [`SplatCloud`] together with a [`LoadReport`] (format, scale space seen, warnings).
+//! [`load_path`] picks the format by content (then by extension, see [`detect_format`])
+//! and parses the file once into a [`Scene`]: the [`SplatCloud`], the glTF cameras, and a
+//! [`LoadReport`] (format, scale space seen, [`Finding`]s). [`validate`] checks a file with the
+//! same readers and reports the same findings.
+//!
 //! Every failure is a [`LoadError`] naming the file, the element, the index and what was
 //! expected. No input panics, and sizes claimed by headers are checked against the bytes that
 //! are really there before anything is allocated.
 
-pub mod finding;
-pub mod gltf;
-pub mod ply;
-
 pub mod codec;
-pub mod details;
-mod detect;
+mod details;
+mod finding;
+mod format;
+pub mod gltf;
 pub mod ksplat;
-mod packed;
+pub mod ply;
+mod report;
 pub mod sog;
 pub mod splat;
 pub mod spz;
-pub use details::Details;
+pub mod validate;
 
+pub use details::{AttributeBits, Details};
+pub use finding::{Finding, Severity};
+pub use format::{Format, detect_format};
+pub use report::{LoadReport, ScaleSeen};
+
+use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// How `KHR_gaussian_splatting:SCALE` values are to be read.
@@ -56,152 +63,20 @@ impl std::str::FromStr for ScaleSpace {
 pub struct LoadOptions {
     /// How glTF SCALE values are read (PLY scales are always log, as INRIA writes them).
     pub scale_space: ScaleSpace,
+    /// Which axes SPZ payloads are taken to be in (files and glTF SPZ compression).
+    pub spz_axes: spz::SpzAxes,
 }
 
-/// The file formats splatgl reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    /// glTF JSON (`.gltf`).
-    Gltf,
-    /// Binary glTF (`.glb`).
-    Glb,
-    /// INRIA 3DGS PLY (binary little/big endian or ASCII).
-    Ply,
-    /// Niantic SPZ, versions 1-4.
-    Spz,
-    /// antimatter15 `.splat`.
-    Splat,
-    /// mkkellogg `.ksplat`.
-    Ksplat,
-    /// PlayCanvas SOG (bundled `.sog` or `meta.json` + WebP).
-    Sog,
-}
-
-impl Format {
-    /// Short lowercase name used in `info` output.
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Gltf => "gltf",
-            Format::Glb => "glb",
-            Format::Ply => "ply",
-            Format::Spz => "spz",
-            Format::Splat => "splat",
-            Format::Ksplat => "ksplat",
-            Format::Sog => "sog",
-        }
-    }
-}
-
-/// What the loader noticed while reading; nothing here stops the load.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Warning {
-    /// Where (a JSON path, PLY element/property), may be empty.
-    pub location: String,
-    /// What.
-    pub message: String,
-}
-
-impl fmt::Display for Warning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.location.is_empty() {
-            write!(f, "{}", self.message)
-        } else {
-            write!(f, "{}: {}", self.location, self.message)
-        }
-    }
-}
-
-/// Scale space as read from the file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScaleSeen {
-    /// Linear scales.
-    Linear,
-    /// Log-space scales (exp applied).
-    Log,
-    /// Primitives of both kinds.
-    Mixed,
-}
-
-impl ScaleSeen {
-    /// `"linear"`, `"log"` or `"mixed"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ScaleSeen::Linear => "linear",
-            ScaleSeen::Log => "log",
-            ScaleSeen::Mixed => "mixed",
-        }
-    }
-    pub(crate) fn merge(a: Option<Self>, b: Self) -> Self {
-        match a {
-            None => b,
-            Some(a) if a == b => a,
-            Some(_) => ScaleSeen::Mixed,
-        }
-    }
-}
-
-/// What the loader learnt besides the splats.
+/// A loaded file: the splats, the cameras it defines, and what the loader noticed.
 #[derive(Debug, Clone)]
-pub struct LoadReport {
-    /// Detected format.
-    pub format: Format,
-    /// Scale space seen (`None` when there were no splats to look at).
-    pub scale_space: Option<ScaleSeen>,
-    /// Quaternions that were not unit length (within 1e-3) and were normalised.
-    pub non_unit_quaternions: usize,
-    /// Non-fatal findings.
-    pub warnings: Vec<Warning>,
-    /// Container version, quantization and lossy steps (packed formats only).
-    pub details: Option<Details>,
-}
-
-impl LoadReport {
-    pub(crate) fn new(format: Format) -> Self {
-        LoadReport {
-            format,
-            scale_space: None,
-            non_unit_quaternions: 0,
-            warnings: Vec::new(),
-            details: None,
-        }
-    }
-    /// The warnings for people: identical messages merged into one line naming the first
-    /// location and how many more there are, in first-seen order.
-    pub fn summarized_warnings(&self) -> Vec<String> {
-        let mut groups: Vec<(&Warning, usize)> = Vec::new();
-        let mut index: std::collections::HashMap<&str, usize> = Default::default();
-        for w in &self.warnings {
-            match index.get(w.message.as_str()) {
-                Some(&g) => groups[g].1 += 1,
-                None => {
-                    index.insert(&w.message, groups.len());
-                    groups.push((w, 1));
-                }
-            }
-        }
-        groups
-            .into_iter()
-            .map(|(w, n)| match n {
-                1 => w.to_string(),
-                n => format!("{w} (and {} more like it)", n - 1),
-            })
-            .collect()
-    }
-
-    pub(crate) fn warn(&mut self, location: impl Into<String>, message: impl Into<String>) {
-        self.warnings.push(Warning {
-            location: location.into(),
-            message: message.into(),
-        });
-    }
-}
-
-/// A loaded scene.
-#[derive(Debug, Clone)]
-pub struct Loaded {
+pub struct Scene {
     /// The splats, global space.
     pub cloud: SplatCloud,
-    /// Format, scale space, warnings.
+    /// The perspective camera nodes of the glTF scene, in traversal order (depth first), with
+    /// their global transforms (orthographic cameras are skipped: splat rendering with them is
+    /// undefined per the RC). Empty for formats without cameras (PLY).
+    pub cameras: Vec<GltfPerspective>,
+    /// Format, scale space, findings.
     pub report: LoadReport,
 }
 
@@ -273,7 +148,7 @@ pub enum LoadError {
 }
 
 /// Loads a file of any supported format.
-pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Loaded, LoadError> {
+pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, LoadError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
         path: path.to_owned(),
@@ -282,41 +157,95 @@ pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Loaded, L
     load_bytes(&bytes, Some(path), opts)
 }
 
-/// Detects the format from the content (magic bytes, header, zip directory, JSON keys), then
-/// the extension, then `.splat` plausibility.
-pub fn detect_format(bytes: &[u8], path: Option<&Path>) -> Option<Format> {
-    detect::detect(bytes, path)
-}
-
-/// Loads from memory. `path` names the file in errors and resolves external glTF buffers
-/// (without it, only GLB and data-URI buffers can be read).
+/// Loads from memory. `path` names the file in errors, helps detect the format, and resolves
+/// external glTF buffers (without it, only GLB and data-URI buffers can be read).
 pub fn load_bytes(
     bytes: &[u8],
     path: Option<&Path>,
     opts: &LoadOptions,
-) -> Result<Loaded, LoadError> {
+) -> Result<Scene, LoadError> {
     let shown = path.map_or_else(|| PathBuf::from("<memory>"), Path::to_owned);
-    let format = detect_format(bytes, path);
-    let mut loaded = match format {
-        Some(Format::Ply) => ply::load(bytes).map_err(|source| LoadError::Ply {
-            path: shown,
-            source,
-        }),
-        Some(f @ (Format::Gltf | Format::Glb)) => {
-            gltf::load(bytes, f, path, opts).map_err(|source| LoadError::Gltf {
-                path: shown,
-                source,
-            })
-        }
-        Some(f @ (Format::Spz | Format::Splat | Format::Ksplat | Format::Sog)) => {
-            packed::load(f, bytes, path, shown)
-        }
-        None => Err(LoadError::UnknownFormat { path: shown }),
-    }?;
-    if let Some(w) = format.and_then(|f| detect::extension_mismatch(f, path)) {
-        loaded.report.warn("", w);
+    let Some(format) = detect_format(bytes, path) else {
+        return Err(LoadError::UnknownFormat { path: shown });
+    };
+    let mut report = report_for(format, path);
+    let (cloud, cameras) = read(format, bytes, path, opts, &mut report).map_err(|e| e.at(shown))?;
+    Ok(Scene {
+        cloud,
+        cameras,
+        report,
+    })
+}
+
+/// A fresh report for a file detected as `format`, with the warning for an extension that
+/// names another format ([`load_bytes`] and [`validate`] start from it).
+pub(crate) fn report_for(format: Format, path: Option<&Path>) -> LoadReport {
+    let mut report = LoadReport::new(format);
+    if let Some(w) = format::extension_mismatch(format, path) {
+        report.findings.push(Finding::warning("", w));
     }
-    Ok(loaded)
+    report
+}
+
+/// Why a reader stopped, before the file name is attached (see [`LoadError`]).
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum ReadError {
+    #[error(transparent)]
+    Ply(#[from] ply::PlyError),
+    #[error(transparent)]
+    Gltf(#[from] gltf::GltfError),
+    #[error(transparent)]
+    Spz(#[from] spz::SpzError),
+    #[error(transparent)]
+    Splat(#[from] splat::SplatError),
+    #[error(transparent)]
+    Ksplat(#[from] ksplat::KsplatError),
+    #[error(transparent)]
+    Sog(#[from] sog::SogError),
+}
+
+impl ReadError {
+    fn at(self, path: PathBuf) -> LoadError {
+        match self {
+            ReadError::Ply(source) => LoadError::Ply { path, source },
+            ReadError::Gltf(source) => LoadError::Gltf { path, source },
+            ReadError::Spz(source) => LoadError::Spz { path, source },
+            ReadError::Splat(source) => LoadError::Splat { path, source },
+            ReadError::Ksplat(source) => LoadError::Ksplat { path, source },
+            ReadError::Sog(source) => LoadError::Sog { path, source },
+        }
+    }
+    /// Whether the file's framing could not be read at all (`validate`'s "unreadable").
+    fn unreadable(&self) -> bool {
+        match self {
+            ReadError::Ply(e) => matches!(e, ply::PlyError::Header { .. }),
+            ReadError::Gltf(e) => matches!(e, gltf::GltfError::Container(_)),
+            // The packed formats have no structure to report findings on once they fail.
+            _ => true,
+        }
+    }
+}
+
+/// The readers, one arm per format. Each fills `report` (findings, scale space, non-unit
+/// quaternions) and returns the cloud and the cameras the file defines.
+///
+/// A new format is a [`Format`] variant (with its magic bytes and extensions), a reader here,
+/// and a [`ReadError`] / [`LoadError`] variant for the reader's error type.
+pub(crate) fn read(
+    format: Format,
+    bytes: &[u8],
+    path: Option<&Path>,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<(SplatCloud, Vec<GltfPerspective>), ReadError> {
+    Ok(match format {
+        Format::Ply => (ply::read(bytes, report)?, Vec::new()),
+        Format::Gltf | Format::Glb => gltf::read(bytes, format, path, opts, report)?,
+        Format::Spz => (spz::read(bytes, opts.spz_axes, report)?, Vec::new()),
+        Format::Splat => (splat::read(bytes, report)?, Vec::new()),
+        Format::Ksplat => (ksplat::read(bytes, report)?, Vec::new()),
+        Format::Sog => (sog::read(bytes, path, report)?, Vec::new()),
+    })
 }
 
 /// Normalises a quaternion `[x, y, z, w]`; returns it and whether it was off unit length by

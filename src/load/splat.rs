@@ -3,9 +3,9 @@
 //! in the order w, x, y, z, each `(b − 128)/128`. Little endian, PLY axes, no SH.
 
 use super::codec::{self, build_cloud, finish_cloud};
-use super::details::Details;
-use super::finding::Finding;
+use super::{Details, Finding, LoadReport, ScaleSeen};
 use crate::cloud::SplatCloud;
+use crate::sh::dc_from_color;
 
 /// Bytes per record.
 pub const RECORD: usize = 32;
@@ -44,11 +44,8 @@ pub(crate) fn looks_like(bytes: &[u8]) -> bool {
     })
 }
 
-/// Reads a `.splat` file from memory.
-pub(crate) fn read(
-    bytes: &[u8],
-    findings: &mut Vec<Finding>,
-) -> Result<(SplatCloud, Details), SplatError> {
+/// Reads a `.splat` file from memory into `report` (findings, details, linear scales).
+pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, SplatError> {
     if !bytes.len().is_multiple_of(RECORD) {
         return Err(SplatError::Truncated {
             len: bytes.len(),
@@ -57,12 +54,11 @@ pub(crate) fn read(
         });
     }
     let n = bytes.len() / RECORD;
-    let c0 = crate::sh::SH_C0 as f32;
     let cloud = build_cloud::<std::convert::Infallible>(n, 0, |i, s| {
         let r = &bytes[i * RECORD..(i + 1) * RECORD];
         *s.position = std::array::from_fn(|a| codec::f32_at(r, 4 * a));
         *s.scale = std::array::from_fn(|a| codec::f32_at(r, 12 + 4 * a));
-        s.sh[0] = std::array::from_fn(|c| (r[24 + c] as f32 / 255.0 - 0.5) / c0);
+        s.sh[0] = std::array::from_fn(|c| dc_from_color(r[24 + c] as f64 / 255.0));
         *s.opacity = r[27] as f32 / 255.0;
         let q: [f32; 4] = std::array::from_fn(|a| (r[28 + a] as f32 - 128.0) / 128.0);
         *s.rotation = [q[1], q[2], q[3], q[0]];
@@ -71,7 +67,7 @@ pub(crate) fn read(
     let Ok(mut cloud) = cloud;
     let (dropped, first) = finish_cloud(&mut cloud);
     if let Some(i) = first {
-        findings.push(
+        report.findings.push(
             Finding::warning(
                 "records",
                 format!(
@@ -93,5 +89,7 @@ pub(crate) fn read(
     d.lossy("no SH beyond the DC colour");
     d.lossy("DC colour clamped to the [0, 1] display range in steps of 1/255");
     d.lossy("rotations in steps of 1/128 per component; opacity in steps of 1/255");
-    Ok((cloud, d))
+    report.details = Some(d);
+    report.scale_space = Some(ScaleSeen::Linear);
+    Ok(cloud)
 }

@@ -1,9 +1,11 @@
 //! Writers: a [`SplatCloud`] as INRIA PLY ([`to_inria_ply`]), Niantic SPZ ([`to_spz`]),
-//! antimatter15 `.splat` ([`to_splat`]), or as glTF 2.0 with `KHR_gaussian_splatting` (RC), as `.glb` or
-//! `.gltf` with an embedded data-URI buffer. Every component type the RC allows can be chosen
-//! per attribute, with optional padding (byteStride) and a sparse OPACITY accessor, so the
-//! tests can round-trip every decoding path of the loader. The output passes
-//! `splatgl validate`.
+//! antimatter15 `.splat` ([`to_splat`]), or as glTF 2.0 with `KHR_gaussian_splatting` (RC), as
+//! `.glb` ([`to_glb`]) or `.gltf` with an embedded data-URI buffer ([`to_gltf`]). The output
+//! passes `splatgl validate`.
+//!
+//! The glTF writer can also store every component type the RC allows per attribute, pad
+//! elements (byteStride) and write OPACITY as a sparse accessor, so the tests can round-trip
+//! every decoding path of the loader; those options are hidden from these docs.
 
 mod ply;
 pub use ply::to_inria_ply;
@@ -16,7 +18,8 @@ use crate::cloud::{ColorSpace, Kernel, Projection, SortingMethod, SplatCloud};
 use base64::Engine;
 use serde_json::{Value, json};
 
-/// A stored component type (with normalization).
+/// A stored component type (with normalization). For the loader's tests.
+#[doc(hidden)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Comp {
     /// float
@@ -93,22 +96,28 @@ impl Comp {
     }
 }
 
-/// Writer options.
+/// Writer options. The default writes float accessors under one node without a matrix.
 #[derive(Debug, Clone)]
 pub struct GltfWriteOptions {
     /// POSITION component type (non-float types need `KHR_mesh_quantization`, added
     /// automatically). No dequantization node matrix is written: with normalized types the
     /// positions must already lie in [−1, 1] (signed) or [0, 1] (unsigned).
+    #[doc(hidden)]
     pub position: Comp,
     /// ROTATION: F32, I8N or I16N per the RC.
+    #[doc(hidden)]
     pub rotation: Comp,
     /// SCALE: F32, U8, U8N, U16 or U16N per the RC.
+    #[doc(hidden)]
     pub scale: Comp,
     /// OPACITY: F32, U8N or U16N per the RC.
+    #[doc(hidden)]
     pub opacity: Comp,
     /// Extra bytes after each element (gives every view an explicit `byteStride`).
+    #[doc(hidden)]
     pub padding: usize,
     /// Write OPACITY as a sparse accessor without a bufferView (zeros + overrides).
+    #[doc(hidden)]
     pub sparse_opacity: bool,
     /// Column-major 4×4 matrix of the node holding the mesh (`None`: no matrix).
     pub node_matrix: Option<[f64; 16]>,
@@ -200,7 +209,9 @@ impl Builder {
     }
 }
 
-/// Builds the glTF JSON and the binary buffer (the buffer's `uri` is left unset).
+/// Builds the glTF JSON and the binary buffer (the buffer's `uri` is left unset), for tests
+/// that edit the document before writing it.
+#[doc(hidden)]
 pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
     let n = cloud.len();
     let mut b = Builder {
@@ -269,9 +280,9 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
             if ch == 3 {
                 return cloud.opacities[i];
             }
-            let v = (cloud.sh[i * k][ch] as f64 * crate::sh::SH_C0 + 0.5).clamp(0.0, 1.0);
+            let v = crate::sh::color_from_dc(cloud.sh[i * k][ch]).clamp(0.0, 1.0);
             (if srgb {
-                crate::color::srgb_decode(v)
+                crate::profile::srgb_decode(v)
             } else {
                 v
             }) as f32

@@ -3,7 +3,8 @@
 use crate::cloud::SplatCloud;
 
 /// Writes a cloud as INRIA binary little-endian PLY (log scale, logit opacity, w-first
-/// quaternion, channel-major `f_rest`) — the inverse of [`crate::load::ply::load`], used by tests and benches.
+/// quaternion, channel-major `f_rest`) — the inverse of the
+/// [PLY loader](crate::load::ply), used by tests and benches.
 pub fn to_inria_ply(cloud: &SplatCloud) -> Vec<u8> {
     let k = cloud.coeffs_per_splat();
     let mut out = Vec::new();

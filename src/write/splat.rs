@@ -13,14 +13,13 @@ fn byte(v: f32) -> u8 {
 /// Encodes `cloud` as `.splat`. Colours outside the [0, 1] display range are clamped, the
 /// quaternion is normalised with w ≥ 0 (a zero one is written as identity).
 pub fn to_splat(cloud: &SplatCloud) -> Vec<u8> {
-    let c0 = crate::sh::SH_C0 as f32;
     let mut out = Vec::with_capacity(cloud.len() * crate::load::splat::RECORD);
     for i in 0..cloud.len() {
         for v in cloud.positions[i].iter().chain(&cloud.scales[i]) {
             out.extend_from_slice(&v.to_le_bytes());
         }
         for c in cloud.sh_of(i)[0] {
-            out.push(byte((0.5 + c0 * c) * 255.0));
+            out.push(byte((crate::sh::color_from_dc(c) * 255.0) as f32));
         }
         out.push(byte(cloud.opacities[i] * 255.0));
         let [x, y, z, w] = match crate::load::normalize_quat(cloud.rotations[i]) {

@@ -258,7 +258,6 @@ pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> 
             }
         }
     }
-    let c0 = splatgl::sh::SH_C0 as f32;
     for i in 0..n {
         let [x, y, z, w] = c.rotations[i];
         if level == 0 {
@@ -282,7 +281,7 @@ pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> 
         }
         for ch in 0..3 {
             out.push(
-                ((0.5 + c0 * c.sh_of(i)[0][ch]) * 255.0)
+                (splatgl::sh::color_from_dc(c.sh_of(i)[0][ch]) as f32 * 255.0)
                     .clamp(0.0, 255.0)
                     .floor() as u8,
             );
@@ -304,5 +303,28 @@ pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> 
             }
         }
     }
+    out
+}
+
+/// An SPZ file read from memory with its numbers taken to be in `axes`.
+pub fn read_spz(bytes: &[u8], axes: splatgl::load::spz::SpzAxes) -> SplatCloud {
+    let opts = splatgl::load::LoadOptions {
+        spz_axes: axes,
+        ..Default::default()
+    };
+    splatgl::load::load_bytes(bytes, None, &opts)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .cloud
+}
+
+/// `c` with its SH cut to degree `degree` (what a writer that keeps fewer bands stores).
+pub fn truncate_sh(c: &SplatCloud, degree: u8) -> SplatCloud {
+    let mut out = SplatCloud::with_capacity(degree, c.len());
+    let k = splatgl::cloud::sh_coeff_count(degree);
+    for i in 0..c.len() {
+        let (p, s, q, o) = (c.positions[i], c.scales[i], c.rotations[i], c.opacities[i]);
+        out.push(p, s, q, o, &c.sh_of(i)[..k]);
+    }
+    out.meta = c.meta.clone();
     out
 }

@@ -7,24 +7,27 @@
 //! - positions by the full matrix;
 //! - covariance per the RC, Σ = M C Cᵀ Mᵀ, stored back as scale + rotation. For a similarity M
 //!   this is closed form (rotation composed, scale multiplied); otherwise Σ is eigen-decomposed
-//!   in f64, which represents every Σ exactly up to rounding (see [`crate::covariance`]);
+//!   in f64, which represents every Σ exactly up to rounding (`src/covariance.rs`);
 //! - SH rotated by the orthogonal factor of M's polar decomposition (real Wigner-D, see
 //!   [`crate::sh::ShRotation`]).
 //!
 //! All RC rules are checked on the way and reported as [`Finding`]s; `splatgl validate` shows
 //! them all, the loader stops at the first one that makes the data unusable.
 
-pub mod accessor;
-pub mod container;
-pub mod primitive;
+mod accessor;
+mod container;
+mod meta;
+mod primitive;
+mod rules;
 mod transform;
 
-use super::finding::{Finding, Severity};
-use super::{Format, LoadOptions, LoadReport, Loaded, ScaleSeen};
+use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen};
+use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
-use container::EXT;
+use container::{EXT, Parsed};
 use glam::DMat4;
 use serde_json::Value;
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -42,70 +45,100 @@ pub enum GltfError {
     NoSplats,
 }
 
-/// Everything learnt from one pass over a document.
+/// Everything learnt from one pass over a document besides its findings.
 #[derive(Debug)]
-pub struct Walk {
+pub(crate) struct Walk {
     /// The merged cloud (`None` if a blocking finding stopped the pass, or no splats).
     pub cloud: Option<SplatCloud>,
-    /// Every finding, in document order.
-    pub findings: Vec<Finding>,
-    /// Scale space seen.
-    pub scale_seen: Option<ScaleSeen>,
-    /// Non-unit quaternions normalised.
-    pub non_unit: usize,
+    /// The scene's perspective cameras (empty if a blocking finding stopped the pass).
+    pub cameras: Vec<GltfPerspective>,
     /// Number of splat primitives in the document (instantiated or not).
     pub splat_primitives: usize,
 }
 
-/// Reads and checks a whole document. Only an unreadable container is an `Err`.
-pub fn walk(
+/// Loads a glTF or GLB document from memory (`path` resolves external buffers): the walk,
+/// stopped by its first blocking finding.
+pub(crate) fn read(
     bytes: &[u8],
     format: Format,
     path: Option<&Path>,
     opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<(SplatCloud, Vec<GltfPerspective>), GltfError> {
+    let w = walk(bytes, format, path, opts, report)?;
+    if let Some(f) = report.findings.iter().find(|f| f.blocks_loading) {
+        return Err(GltfError::Invalid(f.clone()));
+    }
+    let cloud = w.cloud.ok_or(GltfError::NoSplats)?;
+    Ok((cloud, w.cameras))
+}
+
+/// Reads and checks a whole document; every finding goes to `report`, with the scale space
+/// and non-unit quaternions seen. Only an unreadable container is an `Err`.
+pub(crate) fn walk(
+    bytes: &[u8],
+    format: Format,
+    path: Option<&Path>,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
 ) -> Result<Walk, GltfError> {
-    let mut findings = Vec::new();
-    let parsed = container::parse(bytes, format, path, &mut findings)?;
+    let parsed = container::parse(bytes, format, path, &mut report.findings)?;
     let mut w = Walk {
         cloud: None,
-        findings,
-        scale_seen: None,
-        non_unit: 0,
-        splat_primitives: 0,
+        cameras: Vec::new(),
+        splat_primitives: count_splat_primitives(&parsed.json),
     };
-    w.splat_primitives = count_splat_primitives(&parsed.json);
     let Some(doc) = &parsed.doc else {
         return Ok(w);
     };
-    let json = &parsed.json;
-    uses_extension_check(json, &mut w.findings);
-
+    uses_extension_check(&parsed.json, &mut report.findings);
     // Everything decoded or instantiated is charged to one budget of f32 values, bounded by the
     // input: 16M values (64 MiB) plus 4 values per input byte (file and external buffers).
     let input: u64 = parsed.input_len as u64 + parsed.external_bytes;
-    let budget = std::cell::Cell::new((16u64 << 20) + 4 * input);
+    let budget = Cell::new((16u64 << 20) + 4 * input);
+    let Some(decoded) = decode_primitives(&parsed, doc, opts, &budget, &mut report.findings) else {
+        return Ok(w);
+    };
+    let nodes = scene_nodes(doc, &parsed.json, &mut report.findings);
+    w.cameras = cameras(&nodes, &parsed.json, &mut report.findings);
+    w.cloud = instantiate(&nodes, &parsed.json, &decoded, &budget, input, report);
+    Ok(w)
+}
 
-    // Pass 1: every splat primitive of every mesh, decoded and checked once.
-    let mut decoded: HashMap<(usize, usize), primitive::LocalSplats> = HashMap::new();
-    let no_values: &[Value] = &[];
-    let meshes = json
-        .get("meshes")
+/// Splat primitives decoded in their mesh's local space, by (mesh, primitive) index.
+type Decoded = HashMap<(usize, usize), primitive::LocalSplats>;
+
+fn array<'v>(v: &'v Value, key: &str) -> &'v [Value] {
+    v.get(key)
         .and_then(Value::as_array)
-        .map_or(no_values, Vec::as_slice);
+        .map_or(&[], Vec::as_slice)
+}
+
+/// Pass 1: every splat primitive of every mesh, decoded and checked once. `None` after a
+/// blocking finding.
+fn decode_primitives(
+    parsed: &Parsed,
+    doc: &gltf::Document,
+    opts: &LoadOptions,
+    budget: &Cell<u64>,
+    findings: &mut Vec<Finding>,
+) -> Option<Decoded> {
+    let json = &parsed.json;
+    let used: Vec<&str> = array(json, "extensionsUsed")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    let mut decoded = Decoded::new();
     let mut blocked = false;
-    for (mi, mesh) in meshes.iter().enumerate() {
-        let prims = mesh
-            .get("primitives")
-            .and_then(Value::as_array)
-            .map_or(no_values, Vec::as_slice);
-        for (pi, prim) in prims.iter().enumerate() {
+    for (mi, mesh) in array(json, "meshes").iter().enumerate() {
+        for (pi, prim) in array(mesh, "primitives").iter().enumerate() {
             let ppath = format!("meshes[{mi}].primitives[{pi}]");
             let exts = prim.get("extensions").and_then(Value::as_object);
             if let Some(legacy) = exts.and_then(|e| {
                 e.keys()
                     .find(|k| k.as_str() != EXT && k.contains("gaussian_splats"))
             }) {
-                w.findings.push(Finding::fatal(
+                findings.push(Finding::fatal(
                     format!("{ppath}.extensions.{legacy}"),
                     format!("legacy draft extension {legacy:?} is not supported (re-export with KHR_gaussian_splatting)"),
                 ));
@@ -116,21 +149,16 @@ pub fn walk(
                 continue;
             };
             let Some(ext) = ext.as_object() else {
-                w.findings.push(Finding::fatal(
+                findings.push(Finding::fatal(
                     format!("{ppath}.extensions.{EXT}"),
                     "must be an object",
                 ));
                 blocked = true;
                 continue;
             };
-            let before = w.findings.len();
-            let used: Vec<&str> = json
-                .get("extensionsUsed")
-                .and_then(Value::as_array)
-                .map(|a| a.iter().filter_map(Value::as_str).collect())
-                .unwrap_or_default();
-            let meta = primitive::read_meta(ext, &ppath, &used, &mut w.findings);
-            if w.findings[before..].iter().any(|f| f.blocks_loading) {
+            let before = findings.len();
+            let meta = meta::read(ext, &ppath, &used, findings);
+            if findings[before..].iter().any(|f| f.blocks_loading) {
                 blocked = true;
                 continue;
             }
@@ -139,13 +167,10 @@ pub fn walk(
                 buffers: &parsed.buffers,
                 path: ppath,
                 scale_space: opts.scale_space,
-                budget: &budget,
-                quantization: json
-                    .get("extensionsUsed")
-                    .and_then(Value::as_array)
-                    .is_some_and(|a| a.iter().any(|v| v == "KHR_mesh_quantization")),
+                budget,
+                quantization: used.contains(&"KHR_mesh_quantization"),
             };
-            match primitive::read(&ctx, prim, &meta, &mut w.findings) {
+            match primitive::read(&ctx, prim, &meta, findings) {
                 Some(ls) => {
                     decoded.insert((mi, pi), ls);
                 }
@@ -153,64 +178,68 @@ pub fn walk(
             }
         }
     }
-    if blocked {
-        return Ok(w);
-    }
+    (!blocked).then_some(decoded)
+}
 
-    // Pass 2: instantiate through the scene's node hierarchy.
+/// Pass 2: the decoded primitives instantiated through the scene's node hierarchy and merged
+/// into one global cloud. `None` without instances, or after a blocking finding.
+fn instantiate(
+    nodes: &[(gltf::Node, DMat4)],
+    json: &Value,
+    decoded: &Decoded,
+    budget: &Cell<u64>,
+    input: u64,
+    report: &mut LoadReport,
+) -> Option<SplatCloud> {
+    let meshes = array(json, "meshes");
     let mut cloud: Option<SplatCloud> = None;
-    let mut instances = Vec::new();
-    scene_meshes(doc, json, &mut w.findings, &mut instances);
-    for (node, mesh, m) in instances {
+    for (node, m) in nodes {
+        let Some(mesh) = node.mesh().map(|m| m.index()) else {
+            continue;
+        };
+        let node = node.index();
         let Some(mesh_json) = meshes.get(mesh) else {
             continue;
         };
-        let n_prims = mesh_json
-            .get("primitives")
-            .and_then(Value::as_array)
-            .map_or(0, Vec::len);
-        for pi in 0..n_prims {
+        for pi in 0..array(mesh_json, "primitives").len() {
             let Some(ls) = decoded.get(&(mesh, pi)) else {
                 continue;
             };
             let per_splat = 11 + 3 * ls.cloud.coeffs_per_splat() as u64;
             let values = ls.cloud.len() as u64 * per_splat;
             if values > budget.get() {
-                w.findings.push(Finding::fatal(
+                report.findings.push(Finding::fatal(
                     format!("nodes[{node}]"),
                     format!(
                         "instancing meshes[{mesh}] here would exceed the output this {input}-byte input can justify (16M + 4 values per input byte)"
                     ),
                 ));
-                return Ok(w);
+                return None;
             }
             budget.set(budget.get() - values);
-            let Some(global) = transform::apply(&ls.cloud, m, node, &mut w.findings) else {
-                return Ok(w);
+            let global = transform::apply(&ls.cloud, *m, node, &mut report.findings)?;
+            report.scale_space = Some(ScaleSeen::merge(report.scale_space, ls.scale_seen));
+            report.non_unit_quaternions += ls.non_unit;
+            let Some(c) = &mut cloud else {
+                cloud = Some(global);
+                continue;
             };
-            w.scale_seen = Some(ScaleSeen::merge(w.scale_seen, ls.scale_seen));
-            w.non_unit += ls.non_unit;
-            match &mut cloud {
-                None => cloud = Some(global),
-                Some(c) => {
-                    if c.meta != global.meta {
-                        w.findings.push(Finding::warning(
-                            format!("meshes[{mesh}].primitives[{pi}]"),
-                            "extension properties differ from the first splat primitive's; the first primitive's are used",
-                        ));
-                    }
-                    if c.append(global) {
-                        w.findings.push(Finding::warning(
-                            format!("meshes[{mesh}].primitives[{pi}]"),
-                            "primitives have different SH degrees; lower degrees are zero-padded (colours unchanged)",
-                        ));
-                    }
-                }
+            let ppath = format!("meshes[{mesh}].primitives[{pi}]");
+            if c.meta != global.meta {
+                report.findings.push(Finding::warning(
+                    &ppath,
+                    "extension properties differ from the first splat primitive's; the first primitive's are used",
+                ));
+            }
+            if c.append(global) {
+                report.findings.push(Finding::warning(
+                    ppath,
+                    "primitives have different SH degrees; lower degrees are zero-padded (colours unchanged)",
+                ));
             }
         }
     }
-    w.cloud = cloud;
-    Ok(w)
+    cloud
 }
 
 fn count_splat_primitives(json: &Value) -> usize {
@@ -236,20 +265,6 @@ fn uses_extension_check(json: &Value, findings: &mut Vec<Finding>) {
             "extensionsUsed",
             format!("{EXT} is used by primitives but not listed in extensionsUsed"),
         ));
-    }
-}
-
-/// (node index, mesh index, global matrix) for every mesh instance in the scene.
-fn scene_meshes(
-    doc: &gltf::Document,
-    json: &Value,
-    findings: &mut Vec<Finding>,
-    out: &mut Vec<(usize, usize, DMat4)>,
-) {
-    for (node, m) in scene_nodes(doc, json, findings) {
-        if let Some(mesh) = node.mesh() {
-            out.push((node.index(), mesh.index(), m));
-        }
     }
 }
 
@@ -308,37 +323,29 @@ fn scene_nodes<'d>(
     out
 }
 
-/// The perspective camera nodes of the scene, in scene traversal order (depth first), with
-/// their global transforms. Orthographic cameras are skipped (splat rendering with them is
-/// undefined per the RC).
-pub fn cameras(
-    bytes: &[u8],
-    format: Format,
-    path: Option<&Path>,
-) -> Result<Vec<crate::camera::GltfPerspective>, GltfError> {
-    let mut findings = Vec::new();
-    let parsed = container::parse(bytes, format, path, &mut findings)?;
-    let Some(doc) = &parsed.doc else {
-        let f = findings.into_iter().find(|f| f.blocks_loading);
-        return Err(f.map_or(GltfError::NoSplats, GltfError::Invalid));
-    };
-    if let Some(f) = findings.iter().find(|f| f.blocks_loading) {
-        return Err(GltfError::Invalid(f.clone()));
-    }
+/// The perspective camera nodes among `nodes`, with their global transforms. Orthographic
+/// cameras are skipped (splat rendering with them is undefined per the RC); a camera without
+/// the object its `type` names is reported and skipped.
+fn cameras(
+    nodes: &[(gltf::Node, DMat4)],
+    json: &Value,
+    findings: &mut Vec<Finding>,
+) -> Vec<GltfPerspective> {
     let mut out = Vec::new();
-    for (node, m) in scene_nodes(doc, &parsed.json, &mut findings) {
+    for (node, m) in nodes {
         let Some(cam) = node.camera() else { continue };
         // The gltf crate unwraps the object named by `type`; make sure it is there.
-        let cj = &parsed.json["cameras"][cam.index()];
+        let cj = &json["cameras"][cam.index()];
         let ty = cj.get("type").and_then(Value::as_str).unwrap_or("");
         if cj.get(ty).is_none_or(|o| !o.is_object()) {
-            return Err(GltfError::Invalid(Finding::fatal(
+            findings.push(Finding::error(
                 format!("cameras[{}]", cam.index()),
-                format!("type {ty:?} but no {ty:?} object"),
-            )));
+                format!("type {ty:?} but no {ty:?} object; camera skipped"),
+            ));
+            continue;
         }
         if let gltf::camera::Projection::Perspective(p) = cam.projection() {
-            out.push(crate::camera::GltfPerspective {
+            out.push(GltfPerspective {
                 yfov: p.yfov(),
                 aspect_ratio: p.aspect_ratio(),
                 znear: p.znear(),
@@ -347,37 +354,5 @@ pub fn cameras(
             });
         }
     }
-    Ok(out)
-}
-
-/// Loads a glTF or GLB file from memory (`path` resolves external buffers).
-pub fn load(
-    bytes: &[u8],
-    format: Format,
-    path: Option<&Path>,
-    opts: &LoadOptions,
-) -> Result<Loaded, GltfError> {
-    let w = walk(bytes, format, path, opts)?;
-    if let Some(f) = w.findings.iter().find(|f| f.blocks_loading) {
-        return Err(GltfError::Invalid(f.clone()));
-    }
-    let cloud = w.cloud.ok_or(GltfError::NoSplats)?;
-    let mut report = LoadReport::new(format);
-    report.scale_space = w.scale_seen;
-    report.non_unit_quaternions = w.non_unit;
-    for f in w.findings {
-        let msg = match f.severity {
-            Severity::Error => format!(
-                "invalid per KHR_gaussian_splatting RC / glTF 2.0: {}",
-                f.message
-            ),
-            Severity::Warning => f.message,
-        };
-        let loc = match f.index {
-            Some(i) => format!("{} [index {i}]", f.path),
-            None => f.path,
-        };
-        report.warn(loc, msg);
-    }
-    Ok(Loaded { cloud, report })
+    out
 }

@@ -127,9 +127,87 @@ fn sh_byte(v: u8) -> f32 {
     (n - 0.5) * 8.0
 }
 
-/// Decodes a compressed PLY whose header is `h` and body `body`.
-/// Returns the cloud and the number of non-unit quaternions (always 0: they are rebuilt unit).
-pub(super) fn decode(h: &Header, body: &[u8]) -> Result<(SplatCloud, usize), PlyError> {
+/// Offsets of the fields of the `chunk` and `vertex` rows.
+struct Fields {
+    /// `min_x, min_y, min_z, max_x, max_y, max_z`.
+    bounds: [usize; 6],
+    /// `min_scale_x..max_scale_z` (log scale).
+    scales: [usize; 6],
+    /// `min_r..max_b`, where present.
+    colours: [Option<usize>; 6],
+    /// `packed_position, packed_rotation, packed_scale, packed_color`.
+    packed: [usize; 4],
+}
+
+impl Fields {
+    fn find(chunks: &Columns, verts: &Columns) -> Result<Self, PlyError> {
+        let f = |name: &str| chunks.find("chunk", name, Scalar::F32);
+        let six = |infix: &str, axes: [&str; 3]| -> [String; 6] {
+            std::array::from_fn(|i| {
+                let side = if i < 3 { "min" } else { "max" };
+                format!("{side}_{infix}{}", axes[i % 3])
+            })
+        };
+        let (xyz, rgb) = (["x", "y", "z"], ["r", "g", "b"]);
+        let mut bounds = [0; 6];
+        let mut scales = [0; 6];
+        for (o, n) in bounds.iter_mut().zip(six("", xyz)) {
+            *o = f(&n)?;
+        }
+        for (o, n) in scales.iter_mut().zip(six("scale_", xyz)) {
+            *o = f(&n)?;
+        }
+        let colours = six("", rgb).map(|c| f(&c).ok());
+        let u = |name: &str| verts.find("vertex", name, Scalar::U32);
+        let packed = [
+            u("packed_position")?,
+            u("packed_rotation")?,
+            u("packed_scale")?,
+            u("packed_color")?,
+        ];
+        Ok(Fields {
+            bounds,
+            scales,
+            colours,
+            packed,
+        })
+    }
+}
+
+/// The optional `sh` element: its columns, the offset of each `f_rest_j`, and the degree.
+fn sh_element<'a>(
+    h: &Header,
+    body: &'a [u8],
+    ranges: &[(usize, usize)],
+    n: usize,
+) -> Result<Option<(Columns<'a>, Vec<usize>, u8)>, PlyError> {
+    let Some(si) = h.elements.iter().position(|e| e.name == "sh") else {
+        return Ok(None);
+    };
+    let el = &h.elements[si];
+    if el.count as usize != n {
+        return Err(PlyError::Unsupported(format!(
+            "compressed PLY: element 'sh' has {} rows, 'vertex' {n}",
+            el.count
+        )));
+    }
+    let cols = Columns::new(el, body, ranges[si]);
+    let k = el.props.len();
+    let degree = match k {
+        9 => 1,
+        24 => 2,
+        45 => 3,
+        count => return Err(PlyError::BadShCount { count }),
+    };
+    let offs = (0..k)
+        .map(|j| cols.find("sh", &format!("f_rest_{j}"), Scalar::U8))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Some((cols, offs, degree)))
+}
+
+/// Decodes a compressed PLY whose header is `h` and body `body`. Quaternions are rebuilt unit
+/// from their smallest three components, so none is reported as non-unit.
+pub(super) fn decode(h: &Header, body: &[u8]) -> Result<SplatCloud, PlyError> {
     if h.encoding != Encoding::Le {
         return Err(PlyError::Unsupported(
             "compressed PLY must be binary_little_endian".into(),
@@ -155,116 +233,78 @@ pub(super) fn decode(h: &Header, body: &[u8]) -> Result<(SplatCloud, usize), Ply
     }
     let chunks = Columns::new(chunk_el, body, ranges[ci]);
     let verts = Columns::new(vertex_el, body, ranges[vi]);
-    let f = |name: &str| chunks.find("chunk", name, Scalar::F32);
-    let bounds = [
-        f("min_x")?,
-        f("min_y")?,
-        f("min_z")?,
-        f("max_x")?,
-        f("max_y")?,
-        f("max_z")?,
-    ];
-    let scales = [
-        f("min_scale_x")?,
-        f("min_scale_y")?,
-        f("min_scale_z")?,
-        f("max_scale_x")?,
-        f("max_scale_y")?,
-        f("max_scale_z")?,
-    ];
-    let colours = ["min_r", "min_g", "min_b", "max_r", "max_g", "max_b"]
-        .map(|c| chunks.find("chunk", c, Scalar::F32).ok());
-    let u = |name: &str| verts.find("vertex", name, Scalar::U32);
-    let (pp, pr, ps, pc) = (
-        u("packed_position")?,
-        u("packed_rotation")?,
-        u("packed_scale")?,
-        u("packed_color")?,
-    );
-
-    // Optional SH element: uchar f_rest_0..K (channel-major).
-    let sh = match find("sh") {
-        None => None,
-        Some(si) => {
-            let el = &h.elements[si];
-            if el.count as usize != n {
-                return Err(PlyError::Unsupported(format!(
-                    "compressed PLY: element 'sh' has {} rows, 'vertex' {n}",
-                    el.count
-                )));
-            }
-            let cols = Columns::new(el, body, ranges[si]);
-            let k = el.props.len();
-            let degree = match k {
-                9 => 1,
-                24 => 2,
-                45 => 3,
-                count => return Err(PlyError::BadShCount { count }),
-            };
-            let offs = (0..k)
-                .map(|j| cols.find("sh", &format!("f_rest_{j}"), Scalar::U8))
-                .collect::<Result<Vec<_>, _>>()?;
-            Some((cols, offs, degree))
-        }
-    };
+    let fields = Fields::find(&chunks, &verts)?;
+    let sh = sh_element(h, body, &ranges, n)?;
     let degree = sh.as_ref().map_or(0, |s| s.2);
-    let kk = sh_coeff_count(degree);
     let mut cloud = SplatCloud::with_capacity(degree, n);
-    let mut coeffs = vec![[0.0f32; 3]; kk];
-    let chunk_val = |c: usize, off: usize| chunks.f32_at(c, off);
+    let mut coeffs = vec![[0.0f32; 3]; sh_coeff_count(degree)];
     for i in 0..n {
-        let c = i / CHUNK;
-        let p = unpack_111011(verts.u32_at(i, pp));
-        let pos: [f32; 3] = std::array::from_fn(|a| {
-            lerp(chunk_val(c, bounds[a]), chunk_val(c, bounds[a + 3]), p[a])
-        });
-        let s = unpack_111011(verts.u32_at(i, ps));
-        let scale: [f32; 3] = std::array::from_fn(|a| {
-            lerp(chunk_val(c, scales[a]), chunk_val(c, scales[a + 3]), s[a]).exp()
-        });
-        let [w, x, y, z] = unpack_rotation(verts.u32_at(i, pr));
-        let Some((rot, _)) = super::super::normalize_quat([x, y, z, w]) else {
-            return Err(PlyError::Value {
-                index: i,
-                property: "packed_rotation".into(),
-                message: "decodes to a zero quaternion".into(),
-            });
-        };
-        let col = verts.u32_at(i, pc);
-        let rgba = [
-            unorm(col >> 24, 8),
-            unorm(col >> 16, 8),
-            unorm(col >> 8, 8),
-            unorm(col, 8),
-        ];
-        for ch in 0..3 {
-            let v = match (colours[ch], colours[ch + 3]) {
-                (Some(lo), Some(hi)) => lerp(chunk_val(c, lo), chunk_val(c, hi), rgba[ch]),
-                _ => rgba[ch],
-            };
-            coeffs[0][ch] = ((v as f64 - 0.5) / crate::sh::SH_C0) as f32;
-        }
         if let Some((cols, offs, _)) = &sh {
             let per = offs.len() / 3;
             for (j, &o) in offs.iter().enumerate() {
                 coeffs[1 + j % per][j / per] = sh_byte(cols.data[i * cols.row + o]);
             }
         }
-        let finite = pos
-            .iter()
-            .chain(&scale)
-            .chain(coeffs[0].iter())
-            .all(|v| v.is_finite());
-        if !finite {
-            return Err(PlyError::Value {
-                index: i,
-                property: "chunk ranges".into(),
-                message: "decode to a non-finite position, scale or colour".into(),
-            });
-        }
-        cloud.push(pos, scale, rot, rgba[3], &coeffs);
+        push_splat(&chunks, &verts, &fields, i, &mut coeffs, &mut cloud)?;
     }
-    Ok((cloud, 0))
+    Ok(cloud)
+}
+
+/// Decodes splat `i` and appends it to `cloud` with `coeffs`, whose DC term it sets (the
+/// higher ones are the caller's).
+fn push_splat(
+    chunks: &Columns,
+    verts: &Columns,
+    fields: &Fields,
+    i: usize,
+    coeffs: &mut [[f32; 3]],
+    cloud: &mut SplatCloud,
+) -> Result<(), PlyError> {
+    let c = i / CHUNK;
+    let chunk_val = |off: usize| chunks.f32_at(c, off);
+    let range =
+        |offs: &[usize; 6], a: usize, t: f32| lerp(chunk_val(offs[a]), chunk_val(offs[a + 3]), t);
+    let [pp, pr, ps, pc] = fields.packed;
+    let p = unpack_111011(verts.u32_at(i, pp));
+    let pos: [f32; 3] = std::array::from_fn(|a| range(&fields.bounds, a, p[a]));
+    let s = unpack_111011(verts.u32_at(i, ps));
+    let scale: [f32; 3] = std::array::from_fn(|a| range(&fields.scales, a, s[a]).exp());
+    let [w, x, y, z] = unpack_rotation(verts.u32_at(i, pr));
+    let Some((rot, _)) = super::super::normalize_quat([x, y, z, w]) else {
+        return Err(PlyError::Value {
+            index: i,
+            property: "packed_rotation".into(),
+            message: "decodes to a zero quaternion".into(),
+        });
+    };
+    let col = verts.u32_at(i, pc);
+    let rgba = [
+        unorm(col >> 24, 8),
+        unorm(col >> 16, 8),
+        unorm(col >> 8, 8),
+        unorm(col, 8),
+    ];
+    for ch in 0..3 {
+        let v = match (fields.colours[ch], fields.colours[ch + 3]) {
+            (Some(lo), Some(hi)) => lerp(chunk_val(lo), chunk_val(hi), rgba[ch]),
+            _ => rgba[ch],
+        };
+        coeffs[0][ch] = crate::sh::dc_from_color(v as f64);
+    }
+    let finite = pos
+        .iter()
+        .chain(&scale)
+        .chain(coeffs[0].iter())
+        .all(|v| v.is_finite());
+    if !finite {
+        return Err(PlyError::Value {
+            index: i,
+            property: "chunk ranges".into(),
+            message: "decode to a non-finite position, scale or colour".into(),
+        });
+    }
+    cloud.push(pos, scale, rot, rgba[3], coeffs);
+    Ok(())
 }
 
 #[cfg(test)]

@@ -11,9 +11,8 @@
 //! Binary rows are decoded in parallel (rayon, blocks of rows) with property offsets resolved
 //! once from the header: no per-property lookups in the inner loop.
 
-use super::{Format, LoadReport, Loaded};
-use crate::cloud::{SplatCloud, sh_coeff_count};
-use rayon::prelude::*;
+use super::{Finding, LoadReport, ScaleSeen};
+use crate::cloud::SplatCloud;
 
 /// What is wrong with a PLY file.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -90,9 +89,12 @@ pub enum PlyError {
     },
 }
 
+mod ascii;
+mod binary;
 mod compressed;
 mod header;
-use header::{Element, Encoding, Header, Property, Scalar, parse_header};
+use binary::{decode_binary, skip_binary};
+use header::{Element, Encoding, Property, Scalar, parse_header};
 
 /// Which columns feed which output: offsets (binary) or column indices (ASCII) per field.
 struct Layout {
@@ -241,7 +243,7 @@ fn convert_row(
         }
         sh[0][k] = match l.dc_is_color {
             None => d as f32,
-            Some(div) => ((d / div - 0.5) / crate::sh::SH_C0) as f32,
+            Some(div) => crate::sh::dc_from_color(d / div),
         };
         if !sh[0][k].is_finite() {
             return Err(bad(l.dc[k], "colour coefficient overflows f32"));
@@ -281,8 +283,8 @@ fn convert_row(
     }
 }
 
-/// Parses a PLY file from memory.
-pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
+/// Reads a PLY file from memory; what it notices goes to `report`.
+pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, PlyError> {
     let header = parse_header(bytes)?;
     let vi = header
         .elements
@@ -291,20 +293,19 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
         .ok_or(PlyError::NoVertexElement)?;
     let vertex = &header.elements[vi];
     let body = &bytes[header.body..];
-    let mut report = LoadReport::new(Format::Ply);
-    report.scale_space = Some(super::ScaleSeen::Log);
+    report.scale_space = Some(ScaleSeen::Log);
     if compressed::is_compressed(vertex) {
-        let (cloud, _) = compressed::decode(&header, body)?;
-        report.warn(
+        let cloud = compressed::decode(&header, body)?;
+        report.findings.push(Finding::warning(
             "",
             "PlayCanvas compressed PLY: quantised positions, scales, rotations and colours",
-        );
-        return Ok(Loaded { cloud, report });
+        ));
+        return Ok(cloud);
     }
     let l = layout(vertex)?;
 
     let (cloud, non_unit) = match header.encoding {
-        Encoding::Ascii => load_ascii(&header, vi, &l, body)?,
+        Encoding::Ascii => ascii::decode(&header, vi, &l, body)?,
         enc => {
             let start = skip_binary(&header.elements[..vi], body, enc == Encoding::Be)?;
             let rows = &body[start..];
@@ -327,13 +328,13 @@ pub fn load(bytes: &[u8]) -> Result<Loaded, PlyError> {
         }
     };
     if non_unit > 0 {
-        report.warn(
+        report.findings.push(Finding::warning(
             "vertex.rot_0..3",
             format!("{non_unit} quaternions were not unit length and were normalised"),
-        );
+        ));
     }
     report.non_unit_quaternions = non_unit;
-    Ok(Loaded { cloud, report })
+    Ok(cloud)
 }
 
 /// (bytes, row size) of an element of fixed-size rows, checked against the `available` bytes
@@ -350,210 +351,4 @@ fn fixed_rows_len(el: &Element, available: usize) -> Result<(usize, usize), PlyE
         });
     }
     Ok((needed as usize, row))
-}
-
-/// Byte offset just past the elements before `vertex` (binary).
-fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<usize, PlyError> {
-    let mut pos = 0usize;
-    for el in before {
-        let ends = |rows_read: u64| PlyError::EndsEarly {
-            element: el.name.clone(),
-            count: el.count,
-            rows_read,
-        };
-        if el.props.is_empty() {
-            if el.count > 0 {
-                return Err(PlyError::Unsupported(format!(
-                    "element '{}' has rows but no properties",
-                    el.name
-                )));
-            }
-            continue;
-        }
-        if el.props.iter().all(|p| p.list.is_none()) {
-            pos += fixed_rows_len(el, body.len() - pos)?.0;
-            continue;
-        }
-        // Rows with lists: walk them (each row takes at least one byte, so the count is
-        // bounded by the data before the walk starts).
-        if el.count > (body.len() - pos) as u64 {
-            return Err(PlyError::Truncated {
-                element: el.name.clone(),
-                count: el.count,
-                needed: el.count,
-                available: (body.len() - pos) as u64,
-            });
-        }
-        for r in 0..el.count {
-            for p in &el.props {
-                let n = match p.list {
-                    Some(ct) => {
-                        if pos + ct.size() > body.len() {
-                            return Err(ends(r));
-                        }
-                        let n = ct.read(&body[pos..], be);
-                        pos += ct.size();
-                        if !(0.0..=u32::MAX as f64).contains(&n) {
-                            return Err(PlyError::Unsupported(format!(
-                                "element '{}': negative list length",
-                                el.name
-                            )));
-                        }
-                        n as usize
-                    }
-                    None => 1,
-                };
-                let len = n.saturating_mul(p.ty.size());
-                if len > body.len() - pos {
-                    return Err(ends(r));
-                }
-                pos += len;
-            }
-        }
-    }
-    Ok(pos)
-}
-
-const BLOCK: usize = 4096;
-
-fn decode_binary(
-    l: &Layout,
-    props: &[Property],
-    rows: &[u8],
-    be: bool,
-) -> Result<(SplatCloud, usize), PlyError> {
-    let n = rows.len().checked_div(l.stride).unwrap_or(0);
-    let k = sh_coeff_count(l.sh_degree);
-    let all_f32_le = !be && l.cols.iter().all(|&(_, t)| t == Scalar::F32);
-    let mut cloud = SplatCloud::new(l.sh_degree);
-    cloud.positions = vec![[0.0; 3]; n];
-    cloud.scales = vec![[0.0; 3]; n];
-    cloud.rotations = vec![[0.0; 4]; n];
-    cloud.opacities = vec![0.0; n];
-    cloud.sh = vec![[0.0; 3]; n * k];
-    let results: Vec<Result<usize, PlyError>> = cloud
-        .positions
-        .par_chunks_mut(BLOCK)
-        .zip(cloud.scales.par_chunks_mut(BLOCK))
-        .zip(cloud.rotations.par_chunks_mut(BLOCK))
-        .zip(cloud.opacities.par_chunks_mut(BLOCK))
-        .zip(cloud.sh.par_chunks_mut(BLOCK * k))
-        .zip(rows.par_chunks(BLOCK * l.stride))
-        .enumerate()
-        .map(|(b, (((((p, s), r), o), sh), raw))| {
-            let mut non_unit = 0;
-            for i in 0..p.len() {
-                let row = &raw[i * l.stride..(i + 1) * l.stride];
-                let out = (&mut p[i], &mut s[i], &mut r[i], &mut o[i]);
-                let sh = &mut sh[i * k..(i + 1) * k];
-                // The common case (every column f32, little endian) gets its own
-                // monomorphised copy of `convert_row` without the per-value type dispatch.
-                let off = if all_f32_le {
-                    let get = |c: usize| {
-                        let off = l.cols[c].0;
-                        f32::from_le_bytes([row[off], row[off + 1], row[off + 2], row[off + 3]])
-                            as f64
-                    };
-                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
-                } else {
-                    let get = |c: usize| {
-                        let (off, ty) = l.cols[c];
-                        ty.read(&row[off..], be)
-                    };
-                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
-                };
-                non_unit += off as usize;
-            }
-            Ok(non_unit)
-        })
-        .collect();
-    let mut non_unit = 0;
-    for r in results {
-        non_unit += r?;
-    }
-    Ok((cloud, non_unit))
-}
-
-fn load_ascii(
-    header: &Header,
-    vi: usize,
-    l: &Layout,
-    body: &[u8],
-) -> Result<(SplatCloud, usize), PlyError> {
-    let vertex = &header.elements[vi];
-    let text = std::str::from_utf8(body).map_err(|e| PlyError::Ascii {
-        line: header.lines + 1,
-        message: format!("body is not text ({e})"),
-    })?;
-    let mut lines = text.lines().enumerate();
-    for el in &header.elements[..vi] {
-        for r in 0..el.count {
-            if lines.next().is_none() {
-                return Err(PlyError::EndsEarly {
-                    element: el.name.clone(),
-                    count: el.count,
-                    rows_read: r,
-                });
-            }
-        }
-    }
-    let ncols = vertex.props.len();
-    // Each value needs at least one digit and one separator.
-    let min_bytes = vertex.count.saturating_mul(2 * ncols as u64);
-    if min_bytes > body.len() as u64 {
-        return Err(PlyError::Truncated {
-            element: "vertex".into(),
-            count: vertex.count,
-            needed: min_bytes,
-            available: body.len() as u64,
-        });
-    }
-    let n = vertex.count as usize;
-    let k = sh_coeff_count(l.sh_degree);
-    let mut cloud = SplatCloud::with_capacity(l.sh_degree, n);
-    let mut vals = vec![0.0f64; ncols];
-    let mut sh = vec![[0.0f32; 3]; k];
-    let mut non_unit = 0;
-    for i in 0..n {
-        let (ln, line) = lines.next().ok_or_else(|| PlyError::EndsEarly {
-            element: "vertex".into(),
-            count: vertex.count,
-            rows_read: i as u64,
-        })?;
-        let line_no = header.lines + ln + 1;
-        let mut it = line.split_ascii_whitespace();
-        for (c, v) in vals.iter_mut().enumerate() {
-            let tok = it.next().ok_or_else(|| PlyError::Ascii {
-                line: line_no,
-                message: format!("expected {ncols} values, found {c}"),
-            })?;
-            // Parse at the declared precision so ASCII equals the binary encoding exactly.
-            let parsed = match vertex.props[c].ty {
-                Scalar::F32 => tok.parse::<f32>().map(f64::from).ok(),
-                _ => tok.parse::<f64>().ok(),
-            };
-            *v = parsed.ok_or_else(|| PlyError::Ascii {
-                line: line_no,
-                message: format!(
-                    "value {tok:?} of property '{}' is not a number",
-                    vertex.props[c].name
-                ),
-            })?;
-        }
-        let (mut p, mut s, mut r, mut o) = ([0.0; 3], [0.0; 3], [0.0; 4], 0.0);
-        let off = convert_row(
-            l,
-            &vertex.props,
-            i,
-            |c| vals[c],
-            &mut p,
-            &mut s,
-            &mut r,
-            &mut o,
-            &mut sh,
-        )?;
-        non_unit += off as usize;
-        cloud.push(p, s, r, o, &sh);
-    }
-    Ok((cloud, non_unit))
 }

@@ -12,8 +12,7 @@
 use super::{Meta, Quant, SogError};
 use crate::cloud::SplatCloud;
 use crate::load::codec::build_cloud;
-use crate::load::details::Details;
-use crate::load::finding::Finding;
+use crate::load::{Details, Finding};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 

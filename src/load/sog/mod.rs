@@ -7,8 +7,7 @@ mod decode;
 pub mod zip;
 
 use super::codec::budget_for;
-use super::details::Details;
-use super::finding::Finding;
+use super::{Details, Finding, Format, LoadReport, ScaleSeen, Scene};
 use crate::cloud::SplatCloud;
 use serde_json::Value;
 use std::path::Path;
@@ -226,8 +225,25 @@ pub(crate) fn is_bundle(bytes: &[u8]) -> bool {
     bytes.starts_with(b"PK\x03\x04") && zip::Archive::new(bytes).is_ok_and(|a| a.has("meta.json"))
 }
 
+/// Reads a SOG from memory into `report`: a bundle (zip), or a meta.json whose textures are
+/// read beside `path`.
+pub(crate) fn read(
+    bytes: &[u8],
+    path: Option<&Path>,
+    report: &mut LoadReport,
+) -> Result<SplatCloud, SogError> {
+    let (cloud, details) = if is_meta_json(bytes) {
+        read_dir(bytes, path, &mut report.findings)
+    } else {
+        read_bundle(bytes, &mut report.findings)
+    }?;
+    report.details = Some(details);
+    report.scale_space = Some(ScaleSeen::Log);
+    Ok(cloud)
+}
+
 /// Reads a bundled `.sog` (zip) from memory.
-pub(crate) fn read_bundle(
+fn read_bundle(
     bytes: &[u8],
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SogError> {
@@ -243,9 +259,25 @@ pub(crate) fn read_bundle(
     Ok((cloud, d))
 }
 
-/// Reads an unbundled SOG: `meta` is the meta.json text, and `load` returns the bytes of a
-/// texture it names. The budget counts meta.json and every texture as input.
+/// Reads an unbundled SOG from wherever its textures are (memory, an archive, the network):
+/// `meta` is the meta.json text, and `load` returns the bytes of a texture it names. The
+/// budget counts meta.json and every texture as input.
 pub fn read_unbundled(
+    meta: &[u8],
+    load: &mut dyn FnMut(&str) -> Result<Vec<u8>, SogError>,
+) -> Result<Scene, SogError> {
+    let mut report = LoadReport::new(Format::Sog);
+    let (cloud, details) = unbundled(meta, load, &mut report.findings)?;
+    report.details = Some(details);
+    report.scale_space = Some(ScaleSeen::Log);
+    Ok(Scene {
+        cloud,
+        cameras: Vec::new(),
+        report,
+    })
+}
+
+fn unbundled(
     meta: &[u8],
     load: &mut dyn FnMut(&str) -> Result<Vec<u8>, SogError>,
     findings: &mut Vec<Finding>,
@@ -262,7 +294,7 @@ pub fn read_unbundled(
 }
 
 /// Reads the textures of an unbundled SOG beside `path` (plain names only; regular files).
-pub(crate) fn read_dir(
+fn read_dir(
     meta: &[u8],
     path: Option<&Path>,
     findings: &mut Vec<Finding>,
@@ -292,5 +324,5 @@ pub(crate) fn read_dir(
             }),
         }
     };
-    read_unbundled(meta, &mut load, findings)
+    unbundled(meta, &mut load, findings)
 }

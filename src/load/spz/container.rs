@@ -3,8 +3,8 @@
 //! Sizes claimed by a header are checked against the budget before anything is allocated.
 
 use super::{ATTRIBUTES, FLAG_EXTENSIONS, Header, MAGIC, MAX_VERSION, SpzError, header, sizes};
+use crate::load::Finding;
 use crate::load::codec::{self, InflateError, cloud_bytes};
-use crate::load::finding::Finding;
 use rayon::prelude::*;
 use std::io::Read;
 

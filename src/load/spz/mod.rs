@@ -15,8 +15,7 @@
 //! are (what `splat-transform` 3.x writes).
 
 use super::codec::{self, InflateError, budget_for, build_cloud, finish_cloud, sh_flip_signs};
-use super::details::Details;
-use super::finding::Finding;
+use super::{Details, Finding, LoadReport, ScaleSeen};
 use crate::cloud::{MAX_SH_DEGREE, SplatCloud};
 
 mod container;
@@ -41,8 +40,20 @@ pub enum SpzAxes {
     /// Niantic's convention: RUB, converted to splatgl's PLY frame (RDF).
     #[default]
     Rub,
-    /// No conversion: the numbers are already in the PLY frame.
+    /// No conversion: the numbers are already in the PLY frame (what `splat-transform` 3.x
+    /// writes and expects).
     Raw,
+}
+
+impl std::str::FromStr for SpzAxes {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rub" => Ok(SpzAxes::Rub),
+            "raw" => Ok(SpzAxes::Raw),
+            _ => Err(format!("expected rub or raw, found {s:?}")),
+        }
+    }
 }
 
 /// What is wrong with an SPZ file.
@@ -151,16 +162,21 @@ pub(crate) fn header(b: &[u8]) -> Header {
     }
 }
 
-/// Reads an SPZ file in Niantic's axes. See [`read_with`].
+/// Reads an SPZ file into `report` (findings, container details, log scale space).
 pub(crate) fn read(
     bytes: &[u8],
-    findings: &mut Vec<Finding>,
-) -> Result<(SplatCloud, Details), SpzError> {
-    read_with(bytes, SpzAxes::Rub, findings)
+    axes: SpzAxes,
+    report: &mut LoadReport,
+) -> Result<SplatCloud, SpzError> {
+    let (cloud, details) = decode_bytes(bytes, axes, &mut report.findings)?;
+    report.details = Some(details);
+    report.scale_space = Some(ScaleSeen::Log);
+    Ok(cloud)
 }
 
-/// Reads an SPZ file (gzip v1–v3, uncompressed legacy, or v4 zstd streams) from memory.
-pub fn read_with(
+/// Decodes an SPZ payload (gzip v1–v3, uncompressed legacy, or v4 zstd streams): the cloud and
+/// the container's details. The glTF SPZ compression extensions call this on a bufferView.
+pub(crate) fn decode_bytes(
     bytes: &[u8],
     axes: SpzAxes,
     findings: &mut Vec<Finding>,

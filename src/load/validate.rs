@@ -1,11 +1,11 @@
 //! `splatgl validate`: every MUST of `KHR_gaussian_splatting` (RC) for glTF input, glTF 2.0
-//! structural errors, and loadability for PLY input, as a list of [`Finding`]s.
+//! structural errors, and loadability for other input, as a list of [`Finding`]s.
 //!
-//! The checks are the loader's own (one pass, [`crate::load::gltf::walk`]), so what
-//! `validate` accepts is exactly what `load` reads.
+//! The checks are the loader's own: the same readers, the same findings in the same
+//! [`super::LoadReport`], so what `validate` accepts is exactly what `load` reads. For glTF the
+//! findings go on past the first blocking one (the walk reports every problem it can reach).
 
-pub use crate::load::finding::{Finding, Severity};
-use crate::load::{Format, LoadOptions, detect_format, gltf, ply};
+use super::{Finding, Format, LoadOptions, Severity, detect_format, gltf};
 use std::path::Path;
 
 /// Overall verdict; the process exit status of `splatgl validate`.
@@ -96,67 +96,48 @@ pub fn validate_path(path: &Path, opts: &LoadOptions) -> Report {
 
 /// Validates bytes (`path` resolves external glTF buffers and picks the format by extension).
 pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> Report {
-    let format = detect_format(bytes, path);
-    let mut report = Report {
-        format,
-        findings: Vec::new(),
-        readable: true,
-        splat_count: None,
-    };
-    match format {
-        None => {
-            report.readable = false;
-            report.findings.push(Finding::fatal(
+    let Some(format) = detect_format(bytes, path) else {
+        return Report {
+            format: None,
+            findings: vec![Finding::fatal(
                 "",
                 "unknown file format (expected glTF, GLB, PLY, SPZ, .splat, .ksplat or SOG)",
-            ));
-        }
-        Some(Format::Ply) => match ply::load(bytes) {
-            Ok(l) => {
-                report.splat_count = Some(l.cloud.len());
-                for w in l.report.warnings {
-                    report
-                        .findings
-                        .push(Finding::warning(w.location, w.message));
-                }
-            }
+            )],
+            readable: false,
+            splat_count: None,
+        };
+    };
+    let mut load = super::report_for(format, path);
+    let mut readable = true;
+    let mut splat_count = None;
+    match format {
+        Format::Gltf | Format::Glb => match gltf::walk(bytes, format, path, opts, &mut load) {
             Err(e) => {
-                report.readable = !matches!(e, ply::PlyError::Header { .. });
-                report.findings.push(Finding::fatal("", e.to_string()));
-            }
-        },
-        // Packed formats (SPZ, .splat, .ksplat, SOG): what the loader says.
-        Some(Format::Spz | Format::Splat | Format::Ksplat | Format::Sog) => {
-            match crate::load::load_bytes(bytes, path, opts) {
-                Ok(l) => {
-                    report.splat_count = Some(l.cloud.len());
-                    for w in l.report.warnings {
-                        let finding = Finding::warning(w.location, w.message);
-                        report.findings.push(finding);
-                    }
-                }
-                Err(e) => {
-                    report.readable = false;
-                    report.findings.push(Finding::fatal("", e.to_string()));
-                }
-            }
-        }
-        Some(f) => match gltf::walk(bytes, f, path, opts) {
-            Err(e) => {
-                report.readable = false;
-                report.findings.push(Finding::fatal("", e.to_string()));
+                readable = false;
+                load.findings.push(Finding::fatal("", e.to_string()));
             }
             Ok(w) => {
-                report.findings = w.findings;
                 if w.splat_primitives == 0 {
-                    report.findings.push(Finding::fatal(
+                    load.findings.push(Finding::fatal(
                         "meshes",
                         "no primitive uses KHR_gaussian_splatting",
                     ));
                 }
-                report.splat_count = w.cloud.as_ref().map(|c| c.len());
+                splat_count = w.cloud.as_ref().map(|c| c.len());
+            }
+        },
+        _ => match super::read(format, bytes, path, opts, &mut load) {
+            Ok((cloud, _)) => splat_count = Some(cloud.len()),
+            Err(e) => {
+                readable = !e.unreadable();
+                load.findings.push(Finding::fatal("", e.to_string()));
             }
         },
     }
-    report
+    Report {
+        format: Some(format),
+        findings: load.findings,
+        readable,
+        splat_count,
+    }
 }
