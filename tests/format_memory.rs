@@ -70,14 +70,9 @@ fn hostile_packed_files_stay_within_the_budget() {
     e.write_all(&raw).unwrap();
     cases.push(("lying.spz", e.finish().unwrap(), "100000000 points"));
     // SPZ v4 claiming u32::MAX points.
-    let mut v4 = splatgl::write::to_spz(
-        &random_cloud(10, 0, 5.0, 1),
-        &splatgl::write::SpzWriteOptions {
-            version: 4,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mut v4 =
+        splatgl::write::to_spz(&random_cloud(10, 0, 5.0, 1), splatgl::write::SpzVersion::V4)
+            .unwrap();
     v4[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
     cases.push(("count.spz", v4, "budget"));
     // A zip member claiming 4 GiB.

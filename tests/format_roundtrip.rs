@@ -1,13 +1,16 @@
-//! Writers (SPZ v2/v3/v4, `.splat`) and the test encoders (`.ksplat` levels 0-2, SOG bundled
-//! and unbundled) round-trip a random cloud within each format's documented quantization
-//! error (docs/formats.md). Each bound is derived from the format's step sizes.
+//! Writers (SPZ v2/v3/v4, `.splat`, `.glb` with SPZ compression) and the test encoders
+//! (`.ksplat` levels 0-2, SOG bundled and unbundled) round-trip a random cloud within each
+//! format's documented quantization error (docs/formats.md). Each bound is derived from the
+//! format's step sizes.
 
 mod common;
-use common::packed::read_spz;
+use common::packed::{glb_chunks, glb_of, read_spz};
 use common::{packed, random_cloud};
 use splatgl::SplatCloud;
+use splatgl::load::spz::SpzAxes;
+use splatgl::load::validate::{Status, validate_bytes};
 use splatgl::load::{LoadOptions, Scene, load_bytes, load_path};
-use splatgl::write::{SpzWriteOptions, to_splat, to_spz};
+use splatgl::write::{SpzVersion, SpzWriteOptions, to_splat, to_spz, to_spz_with};
 use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::Path;
 
@@ -109,11 +112,11 @@ fn spz_writer_round_trips_every_version() {
     let cloud = random_cloud(2000, 3, 5.0, 7);
     for version in 2..=4 {
         let o = SpzWriteOptions {
-            version,
+            version: SpzVersion::try_from(version).unwrap(),
             antialiased: version == 4,
             ..Default::default()
         };
-        let bytes = to_spz(&cloud, &o).unwrap();
+        let bytes = to_spz_with(&cloud, &o).unwrap();
         let l = load(&bytes, "x.spz");
         let d = l.report.details.unwrap();
         assert_eq!(d.version, version.to_string());
@@ -136,11 +139,11 @@ fn spz_writer_round_trips_every_version() {
 fn spz_axes_flip_is_its_own_inverse_and_raw_keeps_numbers() {
     let cloud = random_cloud(300, 3, 5.0, 3);
     let raw = SpzWriteOptions {
-        version: 3,
-        axes: splatgl::load::spz::SpzAxes::Raw,
+        version: SpzVersion::V3,
+        axes: SpzAxes::Raw,
         ..Default::default()
     };
-    let bytes = to_spz(&cloud, &raw).unwrap();
+    let bytes = to_spz_with(&cloud, &raw).unwrap();
     let c = read_spz(&bytes, raw.axes);
     check("SPZ v3 raw axes", &cloud, &c, &spz_bounds(3));
     // Read in Niantic's axes, the raw file is the cloud turned by 180° about x.
@@ -158,25 +161,25 @@ fn spz_axes_flip_is_its_own_inverse_and_raw_keeps_numbers() {
 fn spz_writer_rejects_what_it_cannot_store() {
     let mut c = random_cloud(3, 0, 5.0, 1);
     c.positions[2][1] = 3000.0;
-    let e = to_spz(&c, &SpzWriteOptions::default())
-        .unwrap_err()
-        .to_string();
+    let e = to_spz(&c, SpzVersion::V2).unwrap_err().to_string();
     assert!(e.contains("splat 2") && e.contains("3000"), "{e}");
     c.positions[2][1] = f32::NAN;
-    let e = to_spz(&c, &SpzWriteOptions::default())
-        .unwrap_err()
-        .to_string();
+    let e = to_spz(&c, SpzVersion::V2).unwrap_err().to_string();
     assert!(e.contains("splat 2: non-finite position"), "{e}");
-    let o = SpzWriteOptions {
-        version: 5,
-        ..Default::default()
-    };
     assert!(
-        to_spz(&random_cloud(3, 0, 5.0, 1), &o)
+        SpzVersion::try_from(5)
             .unwrap_err()
             .to_string()
             .contains("version 5")
     );
+    let o = SpzWriteOptions {
+        version: SpzVersion::V3,
+        ..Default::default()
+    };
+    let e = splatgl::write::to_glb_spz_with(&random_cloud(3, 0, 5.0, 1), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("pins SPZ version 2"), "{e}");
 }
 
 /// `.splat`: f32 positions and scales are exact; DC ±0.5/255/Y₀₀ (inside the display
@@ -210,8 +213,8 @@ fn ksplat_every_level_round_trips_with_buckets() {
         let bytes = packed::ksplat(&cloud, level, 256, 25.0);
         let l = load(&bytes, "x.ksplat");
         assert_eq!(
-            l.report.details.as_ref().unwrap().container,
-            format!("compression level {level}")
+            l.report.details.as_ref().unwrap().compression,
+            format!("none (compression level {level})")
         );
         let f16 = if level == 0 { 1e-6 } else { 1.0 / 2048.0 };
         let sh = match level {
@@ -266,8 +269,8 @@ fn sog_bundled_and_unbundled_round_trip() {
     let bounds = sog_bounds(&cloud);
     let l = load(&packed::sog_bundle(&cloud), "x.sog");
     assert_eq!(
-        l.report.details.as_ref().unwrap().container,
-        "zip (bundled)"
+        l.report.details.as_ref().unwrap().compression,
+        "WebP lossless, in a zip"
     );
     check("SOG bundled", &cloud, &l.cloud, &bounds);
 
@@ -336,4 +339,83 @@ fn ksplat_sections_of_different_degrees_merge() {
         [[0.0; 3]; 5],
         "padded coefficients are zero"
     );
+}
+
+/// `.glb` with `KHR_gaussian_splatting_compression_spz_2`: loads back within SPZ v2's bounds
+/// with its metadata, validates without a single finding, stores the payload in SPZ's RUB
+/// (read as a plain SPZ file without conversion, it is the cloud with x and z negated), and
+/// its node transform applies as for uncompressed primitives.
+#[test]
+fn glb_spz_round_trips_within_spz_v2_and_validates_clean() {
+    let mut cloud = random_cloud(800, 3, 5.0, 17);
+    cloud.meta.color_space =
+        splatgl::cloud::Known::Known(splatgl::cloud::ColorSpace::LinRec709Display);
+    let glb = splatgl::write::to_glb_spz(&cloud).unwrap();
+    let l = load(&glb, "x.glb");
+    let d = l.report.details.as_ref().unwrap();
+    assert_eq!(
+        (d.container, d.version.as_str(), d.gltf_extension),
+        ("spz", "2", Some("KHR_gaussian_splatting_compression_spz_2"))
+    );
+    assert!(l.report.findings.is_empty(), "{:?}", l.report.findings);
+    assert_eq!(l.cloud.meta, cloud.meta);
+    check("glb SPZ v2", &cloud, &l.cloud, &spz_bounds(2));
+    let v = validate_bytes(&glb, Some(Path::new("x.glb")), &LoadOptions::default());
+    assert_eq!(v.status(), Status::Valid);
+    assert!(v.findings.is_empty(), "{:?}", v.findings);
+
+    let (mut doc, bin) = glb_chunks(&glb);
+    let stored = read_spz(
+        &bin[..doc["bufferViews"][0]["byteLength"].as_u64().unwrap() as usize],
+        SpzAxes::Raw,
+    );
+    let mut luf = cloud.clone();
+    for p in &mut luf.positions {
+        *p = [-p[0], p[1], -p[2]];
+    }
+    for i in 0..stored.len() {
+        for k in 0..3 {
+            let e = (stored.positions[i][k] - luf.positions[i][k]).abs();
+            assert!(
+                e <= 1.0 / 8192.0 + 1e-6,
+                "splat {i} axis {k}: stored {:?}",
+                stored.positions[i]
+            );
+        }
+    }
+
+    doc["nodes"][0]["translation"] = serde_json::json!([1.0, -2.0, 0.5]);
+    let moved = load(&glb_of(&doc, &bin), "moved.glb").cloud;
+    let shift = [1.0f32, -2.0, 0.5];
+    for (i, (m, p)) in moved.positions.iter().zip(&l.cloud.positions).enumerate() {
+        let d = (0..3)
+            .map(|k| (m[k] - p[k] - shift[k]).abs())
+            .fold(0.0, f32::max);
+        assert!(d < 1e-5, "splat {i}: {m:?} vs {p:?} + {shift:?}");
+    }
+}
+
+/// A writer that skips the LUF → RUB conversion leaves POSITION's min/max equal to the raw
+/// payload: the loader says so and names `--spz-axes raw`, which reads the file as meant.
+#[test]
+fn glb_spz_without_the_axis_conversion_is_detected_and_readable_raw() {
+    let cloud = random_cloud(300, 1, 5.0, 23);
+    let o = SpzWriteOptions {
+        axes: SpzAxes::Raw,
+        ..Default::default()
+    };
+    let glb = splatgl::write::to_glb_spz_with(&cloud, &o).unwrap();
+    let l = load(&glb, "raw.glb");
+    let w = l.report.warning_lines();
+    assert!(w.iter().any(|m| m.contains("--spz-axes raw")), "{w:?}");
+    let raw = LoadOptions {
+        spz_axes: SpzAxes::Raw,
+        ..Default::default()
+    };
+    let r = load_bytes(&glb, Some(Path::new("raw.glb")), &raw).unwrap();
+    assert!(r.report.findings.is_empty(), "{:?}", r.report.findings);
+    check("glb SPZ v2 raw axes", &cloud, &r.cloud, &spz_bounds(2));
+    // Written correctly, there is no such warning.
+    let ok = load(&splatgl::write::to_glb_spz(&cloud).unwrap(), "ok.glb");
+    assert!(ok.report.findings.is_empty(), "{:?}", ok.report.findings);
 }

@@ -34,8 +34,8 @@ fn real_spz_files_report_their_container() {
     if let Some(l) = real_ok("playcanvas_biker_v4.spz", 152_746, 0, Format::Spz) {
         let d = l.report.details.unwrap();
         assert_eq!(
-            (d.version.as_str(), d.container.as_str()),
-            ("4", "zstd streams")
+            (d.container, d.version.as_str(), d.compression.as_str()),
+            ("spz", "4", "zstd (one stream per attribute)")
         );
         assert!(!d.antialiased);
         assert!(
@@ -48,14 +48,14 @@ fn real_spz_files_report_their_container() {
         ("raw", "2", "none"),
         ("v2", "2", "gzip"),
         ("v3", "3", "gzip"),
-        ("v4", "4", "zstd streams"),
+        ("v4", "4", "zstd (one stream per attribute)"),
     ] {
         let name = format!("splat_transform_minimal-{name}.spz");
         if let Some(l) = real_ok(&name, 4, 0, Format::Spz) {
             let d = l.report.details.unwrap();
             assert_eq!(
-                (d.version.as_str(), d.container.as_str()),
-                (version, container),
+                (d.container, d.version.as_str(), d.compression.as_str()),
+                ("spz", version, container),
                 "{name}"
             );
         }
@@ -204,10 +204,10 @@ fn biker_compressed_ply_and_spz_v4_are_the_same_scene() {
 
 fn spz_of(c: &SplatCloud, version: u32) -> Vec<u8> {
     let o = splatgl::write::SpzWriteOptions {
-        version,
+        version: splatgl::write::SpzVersion::try_from(version).unwrap(),
         ..Default::default()
     };
-    splatgl::write::to_spz(c, &o).unwrap()
+    splatgl::write::to_spz_with(c, &o).unwrap()
 }
 
 #[test]

@@ -14,7 +14,7 @@ use splatgl::image::Image;
 use splatgl::load::validate::{Status, validate_bytes};
 use splatgl::load::{LoadOptions, ScaleSpace, load_bytes};
 use splatgl::write::{Comp, GltfWriteOptions, build, to_glb};
-use splatgl::write::{SpzWriteOptions, to_splat, to_spz};
+use splatgl::write::{SpzWriteOptions, to_splat, to_spz_with};
 use std::io::{Read, Write};
 use std::path::Path;
 
@@ -673,10 +673,10 @@ fn gzip(b: &[u8]) -> Vec<u8> {
 
 fn spz_of(c: &splatgl::SplatCloud, version: u32) -> Vec<u8> {
     let o = SpzWriteOptions {
-        version,
+        version: splatgl::write::SpzVersion::try_from(version).unwrap(),
         ..Default::default()
     };
-    to_spz(c, &o).unwrap()
+    to_spz_with(c, &o).unwrap()
 }
 
 fn spz(version: u32, degree: u8) -> Vec<u8> {
@@ -917,6 +917,103 @@ fn unbundled_sog_rejects_paths_outside_its_folder() {
         .to_string();
     assert!(e.contains("needs its path"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------- glTF with SPZ compression ----------
+
+/// A `.glb` with `KHR_gaussian_splatting_compression_spz_2` (8 splats, SH 1) whose JSON and
+/// BIN `edit` changes.
+fn glb_spz_with(edit: impl FnOnce(&mut Value, &mut Vec<u8>)) -> Vec<u8> {
+    let glb = splatgl::write::to_glb_spz(&random_cloud(8, 1, 5.0, 3)).unwrap();
+    let (mut doc, mut bin) = packed::glb_chunks(&glb);
+    edit(&mut doc, &mut bin);
+    packed::glb_of(&doc, &bin)
+}
+
+const SPZ_EXT: &str = "/meshes/0/primitives/0/extensions/KHR_gaussian_splatting/extensions/KHR_gaussian_splatting_compression_spz_2";
+
+#[test]
+fn malformed_spz_compressed_gltf_gives_precise_errors() {
+    let ext_path =
+        "extensions.KHR_gaussian_splatting.extensions.KHR_gaussian_splatting_compression_spz_2";
+    expect(
+        &glb_spz_with(|d, _| d.pointer_mut(SPZ_EXT).unwrap()["bufferView"] = json!("zero")),
+        "a.glb",
+        &[ext_path, "'bufferView' is missing or not an index"],
+    );
+    expect(
+        &glb_spz_with(|d, _| d.pointer_mut(SPZ_EXT).unwrap()["bufferView"] = json!(7)),
+        "a.glb",
+        &["bufferViews[7] does not exist"],
+    );
+    // A view running past its buffer.
+    expect(
+        &glb_spz_with(|d, _| d["bufferViews"][0]["byteLength"] = json!(1 << 20)),
+        "a.glb",
+        &["exceeds buffers[0]"],
+    );
+    // A truncated gzip member.
+    expect(
+        &glb_spz_with(|d, b| {
+            let half = b.len() / 2;
+            b.truncate(half);
+            d["buffers"][0]["byteLength"] = json!(half);
+            d["bufferViews"][0]["byteLength"] = json!(half);
+        }),
+        "a.glb",
+        &["bufferViews[0]: SPZ: gzip"],
+    );
+    // A gzip bomb: a header claiming 10⁷ points, then zeros.
+    expect(
+        &glb_spz_with(|d, b| {
+            let mut raw = gunzip(b);
+            raw[8..12].copy_from_slice(&10_000_000u32.to_le_bytes());
+            raw.resize(raw.len() + (32 << 20), 0);
+            *b = gzip(&raw);
+            d["buffers"][0]["byteLength"] = json!(b.len());
+            d["bufferViews"][0]["byteLength"] = json!(b.len());
+        }),
+        "a.glb",
+        &["SPZ:", "budget"],
+    );
+}
+
+/// What the loader works around is still an error for `validate`: placeholder counts that
+/// differ from the payload's, an SPZ version the extension does not pin.
+#[test]
+fn spz_compressed_gltf_spec_violations_are_validation_errors() {
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (
+            glb_spz_with(|d, _| d["accessors"][2]["count"] = json!(9)),
+            "placeholder accessor count 9, but the SPZ payload holds 8 points",
+        ),
+        (
+            glb_spz_with(|d, b| {
+                *b = to_spz_with(
+                    &random_cloud(8, 1, 5.0, 3),
+                    &SpzWriteOptions {
+                        version: splatgl::write::SpzVersion::V3,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                d["buffers"][0]["byteLength"] = json!(b.len());
+                d["bufferViews"][0]["byteLength"] = json!(b.len());
+            }),
+            "pins SPZ version 2, the payload is version 3",
+        ),
+    ];
+    for (glb, needle) in cases {
+        let scene = load_bytes(&glb, None, &LoadOptions::default()).unwrap();
+        assert_eq!(scene.cloud.len(), 8);
+        let r = validate_bytes(&glb, None, &LoadOptions::default());
+        assert_eq!(r.status(), Status::Invalid, "{needle}");
+        assert!(
+            r.findings.iter().any(|f| f.message.contains(needle)),
+            "{needle}: {:#?}",
+            r.findings
+        );
+    }
 }
 
 // ---------- Images (PNG, PFM) read by `compare` ----------

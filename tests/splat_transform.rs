@@ -23,7 +23,7 @@ use common::random_cloud;
 use splatgl::SplatCloud;
 use splatgl::load::spz::SpzAxes;
 use splatgl::load::{LoadOptions, load_bytes};
-use splatgl::write::{SpzWriteOptions, to_inria_ply, to_splat, to_spz};
+use splatgl::write::{SpzVersion, SpzWriteOptions, to_inria_ply, to_splat, to_spz_with};
 use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -285,11 +285,11 @@ fn splat_transform_and_splatgl_agree_on_every_format() {
     for version in 2..=4u32 {
         for axes in [SpzAxes::Raw, SpzAxes::Rub] {
             let o = SpzWriteOptions {
-                version,
+                version: SpzVersion::try_from(version).unwrap(),
                 axes,
                 ..Default::default()
             };
-            std::fs::write(f("ours.spz"), to_spz(&cloud, &o).unwrap()).unwrap();
+            std::fs::write(f("ours.spz"), to_spz_with(&cloud, &o).unwrap()).unwrap();
             convert(&st, &f("ours.spz"), &f("back_spz.ply"), &[]);
             let back = load(&f("back_spz.ply"));
             let (name, expect) = match axes {

@@ -309,11 +309,9 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
 }
 
 fn describe(bytes: &[u8], level: u16, degree: u8) -> Details {
-    let mut d = Details {
-        version: format!("{}.{}", bytes[0], bytes[1]),
-        container: format!("compression level {level}"),
-        ..Default::default()
-    };
+    // The level is the format's own name for its quantization; no entropy coding follows.
+    let mut d = Details::new("ksplat", format!("none (compression level {level})"));
+    d.version = format!("{}.{}", bytes[0], bytes[1]);
     if level == 0 {
         d.bits("position", 32, "f32");
         d.bits("scale", 32, "f32, linear");

@@ -77,10 +77,7 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
             .at(i as u64),
         );
     }
-    let mut d = Details {
-        container: "none".into(),
-        ..Default::default()
-    };
+    let mut d = Details::new("splat", "none");
     d.bits("position", 32, "f32");
     d.bits("scale", 32, "f32, linear");
     d.bits("rotation", 8, "w, x, y, z as (b − 128)/128, normalised");

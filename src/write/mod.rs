@@ -1,7 +1,8 @@
 //! Writers: a [`SplatCloud`] as INRIA PLY ([`to_inria_ply`]), Niantic SPZ ([`to_spz`]),
 //! antimatter15 `.splat` ([`to_splat`]), or as glTF 2.0 with `KHR_gaussian_splatting` (RC), as
-//! `.glb` ([`to_glb`]) or `.gltf` with an embedded data-URI buffer ([`to_gltf`]). The output
-//! passes `splatgl validate`.
+//! `.glb` ([`to_glb`]), `.gltf` with an embedded data-URI buffer ([`to_gltf`]), or `.glb` with
+//! the splats SPZ-compressed by `KHR_gaussian_splatting_compression_spz_2` ([`to_glb_spz`]).
+//! The output passes `splatgl validate`.
 //!
 //! The glTF writer can also store every component type the RC allows per attribute, pad
 //! elements (byteStride) and write OPACITY as a sparse accessor, so the tests can round-trip
@@ -9,10 +10,12 @@
 
 mod ply;
 pub use ply::to_inria_ply;
+mod glb_spz;
 mod splat;
 mod spz;
+pub use glb_spz::{to_glb_spz, to_glb_spz_with};
 pub use splat::to_splat;
-pub use spz::{SpzWriteError, SpzWriteOptions, to_spz};
+pub use spz::{SpzVersion, SpzWriteError, SpzWriteOptions, to_spz, to_spz_with};
 
 use crate::cloud::{ColorSpace, Kernel, Projection, SortingMethod, SplatCloud};
 use base64::Engine;
@@ -308,12 +311,7 @@ pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
         "meshes": [{"primitives": [{
             "attributes": attrs,
             "mode": 0,
-            "extensions": {"KHR_gaussian_splatting": {
-                "kernel": m.kernel.to_string_with(Kernel::as_str),
-                "colorSpace": m.color_space.to_string_with(ColorSpace::as_str),
-                "projection": m.projection.to_string_with(Projection::as_str),
-                "sortingMethod": m.sorting_method.to_string_with(SortingMethod::as_str),
-            }},
+            "extensions": {"KHR_gaussian_splatting": extension_object(m)},
         }]}],
         "buffers": [{"byteLength": b.bin.len()}],
         "bufferViews": b.views,
@@ -334,12 +332,31 @@ pub fn to_gltf(cloud: &SplatCloud, o: &GltfWriteOptions) -> Vec<u8> {
     serde_json::to_vec_pretty(&doc).unwrap_or_default()
 }
 
+/// The primitive's `KHR_gaussian_splatting` object for `meta`.
+fn extension_object(m: &crate::cloud::SplatMeta) -> Value {
+    json!({
+        "kernel": m.kernel.to_string_with(Kernel::as_str),
+        "colorSpace": m.color_space.to_string_with(ColorSpace::as_str),
+        "projection": m.projection.to_string_with(Projection::as_str),
+        "sortingMethod": m.sorting_method.to_string_with(SortingMethod::as_str),
+    })
+}
+
 /// A `.glb` file.
 pub fn to_glb(cloud: &SplatCloud, o: &GltfWriteOptions) -> Vec<u8> {
     let (doc, bin) = build(cloud, o);
+    glb(&doc, &bin)
+}
+
+/// GLB framing: header, JSON chunk (space-padded), BIN chunk (zero-padded).
+fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
     let mut json = serde_json::to_vec(&doc).unwrap_or_default();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
     let mut out = Vec::with_capacity(total);

@@ -1,18 +1,57 @@
 //! Niantic SPZ writer: version 2 (gzip, first-three quaternions — what
 //! `KHR_gaussian_splatting_compression_spz_2` pins), 3 (gzip, smallest-three) or 4 (zstd
 //! streams). The inverse of [`crate::load::spz`]: our PLY frame is converted to SPZ's RUB
-//! (y and z negated) unless [`SpzWriteOptions::axes`] is [`SpzAxes::Raw`].
+//! (y and z negated) unless [`SpzWriteOptions::axes`] is [`SpzAxes::Raw`]; for glTF
+//! ([`super::to_glb_spz`]) glTF's LUF is converted instead (x and z negated).
 
 use crate::cloud::SplatCloud;
 use crate::load::codec::sh_flip_signs;
-use crate::load::spz::{COLOR_SCALE, FLAG_ANTIALIASED, MAGIC, SpzAxes};
+use crate::load::spz::{COLOR_SCALE, FLAG_ANTIALIASED, Frame, MAGIC, RUB, SpzAxes, axis_flips};
 use std::io::Write;
+
+/// The SPZ versions splatgl writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpzVersion {
+    /// Gzip, first-three quaternions (8 bits each): what `KHR_gaussian_splatting_compression_spz_2`
+    /// pins, and what most readers take.
+    #[default]
+    V2,
+    /// Gzip, smallest-three quaternions (10 bits).
+    V3,
+    /// One zstd stream per attribute, smallest-three quaternions; not gzip-wrapped.
+    V4,
+}
+
+impl SpzVersion {
+    /// The number in the header.
+    pub fn number(self) -> u32 {
+        match self {
+            SpzVersion::V2 => 2,
+            SpzVersion::V3 => 3,
+            SpzVersion::V4 => 4,
+        }
+    }
+}
+
+impl TryFrom<u32> for SpzVersion {
+    type Error = SpzWriteError;
+    fn try_from(v: u32) -> Result<Self, SpzWriteError> {
+        match v {
+            2 => Ok(SpzVersion::V2),
+            3 => Ok(SpzVersion::V3),
+            4 => Ok(SpzVersion::V4),
+            v => Err(SpzWriteError::Options(format!(
+                "version {v}, expected 2, 3 or 4"
+            ))),
+        }
+    }
+}
 
 /// How to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SpzWriteOptions {
-    /// 2, 3 or 4.
-    pub version: u32,
+    /// The version.
+    pub version: SpzVersion,
     /// Fractional bits of the 24-bit fixed-point positions (Niantic writes 12: ±2048 units in
     /// steps of 1/4096).
     pub fractional_bits: u8,
@@ -29,7 +68,7 @@ pub struct SpzWriteOptions {
 impl Default for SpzWriteOptions {
     fn default() -> Self {
         SpzWriteOptions {
-            version: 2,
+            version: SpzVersion::V2,
             fractional_bits: 12,
             sh1_bits: 5,
             sh_rest_bits: 4,
@@ -100,12 +139,6 @@ fn smallest_three(q: [f32; 4]) -> [u8; 4] {
 }
 
 fn check(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<(), SpzWriteError> {
-    if !(2..=4).contains(&o.version) {
-        return Err(SpzWriteError::Options(format!(
-            "version {}, expected 2, 3 or 4",
-            o.version
-        )));
-    }
     if o.fractional_bits > 23
         || !(1..=8).contains(&o.sh1_bits)
         || !(1..=8).contains(&o.sh_rest_bits)
@@ -151,12 +184,34 @@ fn check(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<(), SpzWriteError> {
     Ok(())
 }
 
-/// Encodes `cloud` as SPZ.
-pub fn to_spz(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8>, SpzWriteError> {
+/// Encodes `cloud` (in splatgl's PLY frame, as SPZ, PLY and the other packed formats load) as
+/// an SPZ file of `version` with Niantic's defaults: 12 fractional bits, SH kept to 5 bits
+/// (degree 1) and 4 bits (degrees 2, 3), RUB axes. See [`to_spz_with`] for the options.
+pub fn to_spz(cloud: &SplatCloud, version: SpzVersion) -> Result<Vec<u8>, SpzWriteError> {
+    to_spz_with(
+        cloud,
+        &SpzWriteOptions {
+            version,
+            ..Default::default()
+        },
+    )
+}
+
+/// Encodes `cloud` (PLY frame) as SPZ with the given options.
+pub fn to_spz_with(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8>, SpzWriteError> {
+    encode(cloud, o, Frame::Ply)
+}
+
+/// Encodes `cloud`, whose axes are those of `frame`, as SPZ (RUB unless `o.axes` is raw).
+pub(crate) fn encode(
+    cloud: &SplatCloud,
+    o: &SpzWriteOptions,
+    frame: Frame,
+) -> Result<Vec<u8>, SpzWriteError> {
     check(cloud, o)?;
     let n = cloud.len();
     let flip = match o.axes {
-        SpzAxes::Rub => [false, true, true],
+        SpzAxes::Rub => axis_flips(frame.code(), RUB),
         SpzAxes::Raw => [false; 3],
     };
     let s = flip.map(|f| if f { -1.0f32 } else { 1.0 });
@@ -183,7 +238,7 @@ pub fn to_spz(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8>, SpzWri
             None => [0.0, 0.0, 0.0, 1.0],
         };
         let q = [q[0] * qs[0], q[1] * qs[1], q[2] * qs[2], q[3]];
-        if o.version >= 3 {
+        if o.version != SpzVersion::V2 {
             blocks[4].extend_from_slice(&smallest_three(q));
         } else {
             let w = if q[3] < 0.0 { -1.0 } else { 1.0 };
@@ -200,13 +255,13 @@ pub fn to_spz(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8>, SpzWri
     }
     let mut header = Vec::with_capacity(32);
     header.extend_from_slice(MAGIC);
-    header.extend_from_slice(&o.version.to_le_bytes());
+    header.extend_from_slice(&o.version.number().to_le_bytes());
     header.extend_from_slice(&(n as u32).to_le_bytes());
     let degree = cloud.sh_degree;
     let flags = if o.antialiased { FLAG_ANTIALIASED } else { 0 };
     header.extend_from_slice(&[degree, o.fractional_bits, flags]);
     debug_assert_eq!(blocks[5].len(), n * k * 3);
-    if o.version < 4 {
+    if o.version != SpzVersion::V4 {
         header.push(0);
         let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
         let io = |r: std::io::Result<()>| r.expect("writing to a Vec cannot fail");

@@ -328,3 +328,31 @@ pub fn truncate_sh(c: &SplatCloud, degree: u8) -> SplatCloud {
     out.meta = c.meta.clone();
     out
 }
+
+/// The JSON and BIN chunks of a GLB (test input, well formed).
+pub fn glb_chunks(glb: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    let u32_at = |o: usize| u32::from_le_bytes(glb[o..o + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let doc = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    let bin = glb[bin_at + 8..bin_at + 8 + u32_at(bin_at)].to_vec();
+    (doc, bin)
+}
+
+/// A GLB from its chunks (BIN padded to 4 bytes).
+pub fn glb_of(doc: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut json = serde_json::to_vec(doc).unwrap();
+    json.resize(json.len().div_ceil(4) * 4, b' ');
+    let mut bin = bin.to_vec();
+    bin.resize(bin.len().div_ceil(4) * 4, 0);
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&((28 + json.len() + bin.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}

@@ -273,10 +273,8 @@ fn splats(
 }
 
 fn describe(m: &Meta, sh: Option<(u8, usize, usize)>) -> Details {
-    let mut d = Details {
-        version: m.version.to_string(),
-        ..Default::default()
-    };
+    let mut d = Details::new("sog", "WebP lossless");
+    d.version = m.version.to_string();
     d.bits(
         "position",
         16,

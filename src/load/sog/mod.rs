@@ -255,7 +255,7 @@ fn read_bundle(
         .map(|(_, name)| archive.read(name, &mut budget))
         .collect::<Result<Vec<_>, _>>()?;
     let (cloud, mut d) = decode::decode(&meta, &textures, budget, findings)?;
-    d.container = "zip (bundled)".into();
+    d.compression = "WebP lossless, in a zip".into();
     Ok((cloud, d))
 }
 
@@ -289,7 +289,7 @@ fn unbundled(
         .collect::<Result<Vec<_>, _>>()?;
     let input = meta.len() + textures.iter().map(Vec::len).sum::<usize>();
     let (cloud, mut d) = decode::decode(&m, &textures, budget_for(input), findings)?;
-    d.container = "meta.json + WebP files".into();
+    d.compression = "WebP lossless, meta.json + files".into();
     Ok((cloud, d))
 }
 

@@ -11,8 +11,9 @@
 //! Stored axes are RUB (x right, y up, z back; Niantic's reference packs from its PLY frame RDF
 //! into RUB). splatgl keeps PLY files in their own (RDF) frame, so by default the reader maps
 //! RUB → RDF: y and z are negated, quaternions become (x, −y, −z, w) and each SH coefficient
-//! takes the sign of its basis function's parity. [`SpzAxes::Raw`] reads the numbers as they
-//! are (what `splat-transform` 3.x writes).
+//! takes the sign of its basis function's parity. Inside glTF (the SPZ compression
+//! extensions) the payload is unpacked to glTF's LUF instead: x and z negated. [`SpzAxes::Raw`]
+//! reads the numbers as they are (what `splat-transform` 3.x writes).
 
 use super::codec::{self, InflateError, budget_for, build_cloud, finish_cloud, sh_flip_signs};
 use super::{Details, Finding, LoadReport, ScaleSeen};
@@ -43,6 +44,35 @@ pub enum SpzAxes {
     /// No conversion: the numbers are already in the PLY frame (what `splat-transform` 3.x
     /// writes and expects).
     Raw,
+}
+
+/// The frame an SPZ payload is converted to (from its stored frame, RUB unless a
+/// coordinate-system extension record says otherwise).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Frame {
+    /// splatgl's PLY frame, RDF: SPZ files, like PLY files, stay in the trainer's axes.
+    Ply,
+    /// glTF's LUF: the glTF SPZ compression extensions require unpacking to LUF.
+    Gltf,
+}
+
+/// Niantic's `CoordinateSystem` code of RUB, the frame SPZ stores.
+pub(crate) const RUB: u32 = 4;
+
+impl Frame {
+    /// Niantic's `CoordinateSystem` code (RDF = 6, LUF = 7).
+    pub(crate) fn code(self) -> u32 {
+        match self {
+            Frame::Ply => 6,
+            Frame::Gltf => 7,
+        }
+    }
+}
+
+/// Which axes (x, y, z) differ between two frames of the same family, by Niantic's codes:
+/// code − 1 is 3 bits, x right, y up, z front (RUB = 0b011, RDF = 0b101, LUF = 0b110).
+pub(crate) fn axis_flips(from: u32, to: u32) -> [bool; 3] {
+    std::array::from_fn(|a| ((from - 1) >> a) & 1 != ((to - 1) >> a) & 1)
 }
 
 impl std::str::FromStr for SpzAxes {
@@ -168,42 +198,44 @@ pub(crate) fn read(
     axes: SpzAxes,
     report: &mut LoadReport,
 ) -> Result<SplatCloud, SpzError> {
-    let (cloud, details) = decode_bytes(bytes, axes, &mut report.findings)?;
+    let (cloud, details) = decode_bytes(bytes, axes, Frame::Ply, &mut report.findings)?;
     report.details = Some(details);
     report.scale_space = Some(ScaleSeen::Log);
     Ok(cloud)
 }
 
 /// Decodes an SPZ payload (gzip v1–v3, uncompressed legacy, or v4 zstd streams): the cloud and
-/// the container's details. The glTF SPZ compression extensions call this on a bufferView.
+/// the container's details, in `frame` (unless `axes` is [`SpzAxes::Raw`]). The glTF SPZ
+/// compression extensions call this on a bufferView.
 pub(crate) fn decode_bytes(
     bytes: &[u8],
     axes: SpzAxes,
+    frame: Frame,
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SpzError> {
     let limit = budget_for(bytes.len());
-    let mut d = Details::default();
+    let mut d = Details::new("spz", "");
     let inner;
     let (h, blocks, ext) = if bytes.starts_with(&[0x1f, 0x8b]) {
         let trailing;
         (inner, trailing) = container::gunzip_legacy(bytes, limit)?;
-        d.container = "gzip".into();
+        d.compression = "gzip".into();
         container::legacy(&inner, "a gzip member", trailing, limit, findings)?
     } else if bytes.starts_with(MAGIC) && bytes.len() >= 8 && codec::u32_at(bytes, 4) >= 4 {
-        d.container = "zstd streams".into();
+        d.compression = "zstd (one stream per attribute)".into();
         container::v4(bytes, limit)?
     } else if bytes.starts_with(MAGIC) {
         findings.push(Finding::warning(
             "container",
             "legacy SPZ without its gzip wrapping (read as is)",
         ));
-        d.container = "none".into();
+        d.compression = "none".into();
         container::legacy(bytes, "an uncompressed file", 0, limit, findings)?
     } else {
         let found = bytes.iter().take(4).map(|b| format!("{b:02x}")).collect();
         return Err(SpzError::BadMagic { found });
     };
-    let flips = flips(axes, ext, findings)?;
+    let flips = flips(axes, frame, ext, findings)?;
     d.version = h.version.to_string();
     d.antialiased = h.flags & FLAG_ANTIALIASED != 0;
     describe(&h, &mut d);
@@ -211,10 +243,15 @@ pub(crate) fn decode_bytes(
     Ok((cloud, d))
 }
 
-/// Axis flips (x, y, z) from the stored frame to ours: Niantic's RUB unless a
+/// Axis flips (x, y, z) from the stored frame to `frame`: Niantic's RUB unless a
 /// coordinate-system extension names another frame of the same family.
-fn flips(axes: SpzAxes, ext: &[u8], f: &mut Vec<Finding>) -> Result<[bool; 3], SpzError> {
-    let mut stored = 4u32; // RUB
+fn flips(
+    axes: SpzAxes,
+    frame: Frame,
+    ext: &[u8],
+    f: &mut Vec<Finding>,
+) -> Result<[bool; 3], SpzError> {
+    let mut stored = RUB;
     let mut off = 0;
     while off < ext.len() {
         if ext.len() - off < 8 {
@@ -252,8 +289,7 @@ fn flips(axes: SpzAxes, ext: &[u8], f: &mut Vec<Finding>) -> Result<[bool; 3], S
     }
     Ok(match axes {
         SpzAxes::Raw => [false; 3],
-        // Codes − 1 are 3 bits: x right, y up, z front. RDF = 0b101.
-        SpzAxes::Rub => std::array::from_fn(|a| ((stored - 1) >> a) & 1 != ((6 - 1) >> a) & 1),
+        SpzAxes::Rub => axis_flips(stored, frame.code()),
     })
 }
 
