@@ -146,7 +146,7 @@ fn info_reports_the_container_and_validate_accepts_spz_compression() {
     );
     let (code, _, err) = splatgl(&["info", "--spz-axes", "sideways", spz.to_str().unwrap()]);
     assert_eq!(code, 2, "clap's usage error");
-    assert!(err.contains("expected rub or raw"), "{err}");
+    assert!(err.contains("expected auto, rub or raw"), "{err}");
 }
 
 /// Both backends show a `lin_rec709_display` cloud the same way: blended in linear, encoded

@@ -395,27 +395,55 @@ fn glb_spz_round_trips_within_spz_v2_and_validates_clean() {
     }
 }
 
-/// A writer that skips the LUF → RUB conversion leaves POSITION's min/max equal to the raw
-/// payload: the loader says so and names `--spz-axes raw`, which reads the file as meant.
+/// A writer that skips the LUF → RUB conversion (as CesiumJS expects) leaves POSITION's
+/// min/max equal to the payload as stored: `auto` reads it as stored and says so, `rub`
+/// converts anyway and says the bounds disagree; a file written as the text says reads
+/// without a finding under `auto` and `rub`, and with one under `raw`.
 #[test]
-fn glb_spz_without_the_axis_conversion_is_detected_and_readable_raw() {
+fn glb_spz_axes_follow_position_bounds() {
     let cloud = random_cloud(300, 1, 5.0, 23);
-    let o = SpzWriteOptions {
-        axes: SpzAxes::Raw,
+    let with = |axes| LoadOptions {
+        spz_axes: axes,
         ..Default::default()
     };
-    let glb = splatgl::write::to_glb_spz_with(&cloud, &o).unwrap();
-    let l = load(&glb, "raw.glb");
+    let read = |glb: &[u8], axes| load_bytes(glb, Some(Path::new("x.glb")), &with(axes)).unwrap();
+    let stored = splatgl::write::to_glb_spz_with(
+        &cloud,
+        &SpzWriteOptions {
+            axes: SpzAxes::Raw,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let l = read(&stored, SpzAxes::Auto);
     let w = l.report.warning_lines();
-    assert!(w.iter().any(|m| m.contains("--spz-axes raw")), "{w:?}");
-    let raw = LoadOptions {
-        spz_axes: SpzAxes::Raw,
-        ..Default::default()
-    };
-    let r = load_bytes(&glb, Some(Path::new("raw.glb")), &raw).unwrap();
+    assert!(w.iter().any(|m| m.contains("read as stored")), "{w:?}");
+    check(
+        "glb SPZ v2 as stored, auto",
+        &cloud,
+        &l.cloud,
+        &spz_bounds(2),
+    );
+    let r = read(&stored, SpzAxes::Raw);
     assert!(r.report.findings.is_empty(), "{:?}", r.report.findings);
-    check("glb SPZ v2 raw axes", &cloud, &r.cloud, &spz_bounds(2));
-    // Written correctly, there is no such warning.
-    let ok = load(&splatgl::write::to_glb_spz(&cloud).unwrap(), "ok.glb");
-    assert!(ok.report.findings.is_empty(), "{:?}", ok.report.findings);
+    assert_eq!(r.cloud, l.cloud);
+    let c = read(&stored, SpzAxes::Rub);
+    let w = c.report.warning_lines();
+    assert!(
+        w.iter().any(|m| m.contains("--spz-axes auto or raw")),
+        "{w:?}"
+    );
+    assert!((c.cloud.positions[0][0] + l.cloud.positions[0][0]).abs() < 1e-6);
+
+    let converted = splatgl::write::to_glb_spz(&cloud).unwrap();
+    for axes in [SpzAxes::Auto, SpzAxes::Rub] {
+        let l = read(&converted, axes);
+        assert!(l.report.findings.is_empty(), "{:?}", l.report.findings);
+        check("glb SPZ v2 converted", &cloud, &l.cloud, &spz_bounds(2));
+    }
+    let w = read(&converted, SpzAxes::Raw).report.warning_lines();
+    assert!(
+        w.iter().any(|m| m.contains("--spz-axes auto or rub")),
+        "{w:?}"
+    );
 }

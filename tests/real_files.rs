@@ -160,25 +160,61 @@ fn spz_compressed_gltf_files_load() {
             d.gltf_extension,
             Some("KHR_gaussian_splatting_compression_spz_2")
         );
-        // The payload stores (1, 2, 3) and so do POSITION's min/max: its writer skipped the
-        // RUB → LUF conversion the extension requires. Converted, the point is (−1, 2, −3) in
-        // mesh space; the node matrix (column-major [1,0,0,0, 0,0,−1,0, 0,1,0,0, 0,0,0,1])
-        // maps (x, y, z) to (x, z, −y).
-        assert_eq!(l.cloud.positions[0], [-1.0, -3.0, -2.0]);
-        assert!(has_warning(&l, "--spz-axes raw"));
-        let raw = splatgl::load::LoadOptions {
-            spz_axes: splatgl::load::spz::SpzAxes::Raw,
+        // The payload stores (1, 2, 3), and so do POSITION's min/max: its writer put glTF-axis
+        // numbers in it, without the RUB → LUF conversion the extension's text requires, and
+        // cesium-native's own test expects (1, 2, 3) back. Read as stored (auto follows the
+        // bounds); the node matrix (column-major [1,0,0,0, 0,0,−1,0, 0,1,0,0, 0,0,0,1]) maps
+        // (x, y, z) to (x, z, −y).
+        assert_eq!(l.cloud.positions[0], [1.0, 3.0, -2.0]);
+        assert!(has_warning(&l, "read as stored"));
+        let rub = splatgl::load::LoadOptions {
+            spz_axes: splatgl::load::spz::SpzAxes::Rub,
             ..Default::default()
         };
-        let r = load_path(real("cesium_native_spz2_basic.glb").unwrap(), &raw).unwrap();
-        assert_eq!(r.cloud.positions[0], [1.0, 3.0, -2.0]);
-        assert!(
-            !r.report
-                .warning_lines()
-                .iter()
-                .any(|w| w.contains("--spz-axes"))
-        );
+        let r = load_path(real("cesium_native_spz2_basic.glb").unwrap(), &rub).unwrap();
+        assert_eq!(r.cloud.positions[0], [-1.0, -3.0, -2.0]);
+        assert!(has_warning(&r, "--spz-axes auto or raw"));
     }
+}
+
+/// The legacy tower, read as CesiumJS reads it (as stored), stands upright after its node's
+/// Z-up → Y-up matrix: the top quarter of its height (the antenna platform) spreads more than
+/// twice as wide around its axis as the bottom quarter (the lattice foot). Converted RUB → LUF,
+/// it would stand on its antennas.
+#[test]
+fn legacy_tower_stands_upright() {
+    let spread = |l: &splatgl::load::Scene| -> (f32, f32) {
+        let p = &l.cloud.positions;
+        let mut ys: Vec<f32> = p.iter().map(|v| v[1]).collect();
+        ys.sort_by(f32::total_cmp);
+        let (lo, hi) = (ys[ys.len() / 100], ys[ys.len() * 99 / 100]);
+        let q = (hi - lo) / 4.0;
+        let radius = |a: f32, b: f32| {
+            let sel: Vec<_> = p.iter().filter(|v| v[1] >= a && v[1] < b).collect();
+            let n = sel.len() as f32;
+            let (cx, cz) = (
+                sel.iter().map(|v| v[0]).sum::<f32>() / n,
+                sel.iter().map(|v| v[2]).sum::<f32>() / n,
+            );
+            sel.iter()
+                .map(|v| (v[0] - cx).hypot(v[2] - cz))
+                .sum::<f32>()
+                / n
+        };
+        (radius(lo, lo + q), radius(hi - q, hi))
+    };
+    let Some(l) = load_ok("sharpgltf_tower_legacy_spz_v2.glb", 73_172, 3) else {
+        return;
+    };
+    let (bottom, top) = spread(&l);
+    assert!(top > 2.0 * bottom, "bottom {bottom}, top {top}");
+    let rub = LoadOptions {
+        spz_axes: splatgl::load::spz::SpzAxes::Rub,
+        ..Default::default()
+    };
+    let r = load_path(real("sharpgltf_tower_legacy_spz_v2.glb").unwrap(), &rub).unwrap();
+    let (bottom, top) = spread(&r);
+    assert!(bottom > 2.0 * top, "converted: bottom {bottom}, top {top}");
 }
 
 /// `validate` reads the compressed file like any other: it is invalid for its missing

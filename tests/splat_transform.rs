@@ -297,7 +297,7 @@ fn splat_transform_and_splatgl_agree_on_every_format() {
                     format!("splatgl .spz v{version} raw axes → splat-transform"),
                     ply.clone(),
                 ),
-                SpzAxes::Rub => (
+                SpzAxes::Rub | SpzAxes::Auto => (
                     format!("splatgl .spz v{version} RUB → splat-transform (turned 180° about x)"),
                     flipped(&ply),
                 ),

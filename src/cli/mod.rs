@@ -57,9 +57,11 @@ pub struct LoadArgs {
     /// draft's log space), linear (RC) or log.
     #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
     pub scale_space: splatgl::load::ScaleSpace,
-    /// Axes of SPZ data (files and glTF SPZ compression): rub (Niantic's convention, converted
-    /// to splatgl's frame) or raw (no conversion: what splat-transform 3.x writes).
-    #[arg(long, default_value = "rub", value_name = "rub|raw")]
+    /// Axes of SPZ data: rub (Niantic's RUB, converted to splatgl's frame: RDF for .spz files,
+    /// glTF's LUF inside glTF), raw (no conversion: what splat-transform 3.x writes into .spz,
+    /// and CesiumJS expects inside glTF) or auto (.spz: rub; glTF: what POSITION min/max show,
+    /// else rub for KHR_gaussian_splatting_compression_spz_2 and raw for the legacy extension).
+    #[arg(long, default_value = "auto", value_name = "auto|rub|raw")]
     pub spz_axes: splatgl::load::spz::SpzAxes,
 }
 

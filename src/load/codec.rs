@@ -159,6 +159,32 @@ pub fn sh_flip_signs(flip: [bool; 3]) -> [f32; 15] {
     })
 }
 
+/// Signs of an axis flip F = diag(s): for positions (x, y, z) and for a quaternion's x, y, z
+/// (F R F is a rotation for any signs: its quaternion is (x·sy·sz, y·sx·sz, z·sx·sy, w)).
+pub fn flip_signs(flip: [bool; 3]) -> ([f32; 3], [f32; 3]) {
+    let s = flip.map(|f| if f { -1.0f32 } else { 1.0 });
+    (s, [s[1] * s[2], s[0] * s[2], s[0] * s[1]])
+}
+
+/// Negates the axes in `flip` (x, y, z) of a whole cloud — positions, quaternions and SH by
+/// parity ([`flip_signs`], [`sh_flip_signs`]), as the SPZ reader does while decoding.
+pub fn flip_axes(c: &mut SplatCloud, flip: [bool; 3]) {
+    let (ps, qs) = flip_signs(flip);
+    let shs = sh_flip_signs(flip);
+    let k = c.coeffs_per_splat();
+    c.positions
+        .par_iter_mut()
+        .for_each(|p| *p = std::array::from_fn(|a| p[a] * ps[a]));
+    c.rotations
+        .par_iter_mut()
+        .for_each(|q| *q = [q[0] * qs[0], q[1] * qs[1], q[2] * qs[2], q[3]]);
+    c.sh.par_chunks_mut(k.max(1)).for_each(|sh| {
+        for (j, t) in sh.iter_mut().enumerate().skip(1) {
+            *t = t.map(|v| v * shs[j - 1]);
+        }
+    });
+}
+
 /// One splat's slots in a cloud being filled.
 pub struct SplatMut<'a> {
     /// Mean.

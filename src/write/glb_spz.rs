@@ -1,7 +1,9 @@
 //! `.glb` with `KHR_gaussian_splatting_compression_spz_2`: the splats as one SPZ v2 (gzip)
-//! blob in a bufferView, unpacked by readers to glTF's LUF axes (the extension's rule), and
-//! placeholder accessors without bufferViews whose `count` is the SPZ point count. POSITION's
-//! `min`/`max` (a glTF MUST) hold the positions as they decode, quantization included.
+//! blob in a bufferView, packed from glTF's LUF axes to SPZ's RUB (the extension's text;
+//! CesiumJS instead reads the payload as stored, see docs/formats.md § glTF with SPZ
+//! compression), and placeholder accessors without bufferViews whose `count` is the SPZ point
+//! count. POSITION's `min`/`max` (a glTF MUST) hold the positions as they decode, quantization
+//! included, so a reader can tell which axes the payload is in.
 
 use super::spz::{SpzWriteError, SpzWriteOptions, encode};
 use super::{extension_object, glb};
@@ -21,7 +23,7 @@ pub fn to_glb_spz(cloud: &SplatCloud) -> Result<Vec<u8>, SpzWriteError> {
 
 /// [`to_glb_spz`] with `o`'s fractional bits, SH bits and antialiasing flag. `o.version` must
 /// be [`super::SpzVersion::V2`], the one the extension pins; `o.axes` raw skips the LUF → RUB
-/// conversion (what a writer that ignores the extension's axis rule produces).
+/// conversion (glTF-axis numbers in the payload, as CesiumJS reads it).
 pub fn to_glb_spz_with(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8>, SpzWriteError> {
     if o.version != super::SpzVersion::V2 {
         return Err(SpzWriteError::Options(format!(

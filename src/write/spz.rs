@@ -5,7 +5,7 @@
 //! ([`super::to_glb_spz`]) glTF's LUF is converted instead (x and z negated).
 
 use crate::cloud::SplatCloud;
-use crate::load::codec::sh_flip_signs;
+use crate::load::codec::{flip_signs, sh_flip_signs};
 use crate::load::spz::{COLOR_SCALE, FLAG_ANTIALIASED, Frame, MAGIC, RUB, SpzAxes, axis_flips};
 use std::io::Write;
 
@@ -211,11 +211,10 @@ pub(crate) fn encode(
     check(cloud, o)?;
     let n = cloud.len();
     let flip = match o.axes {
-        SpzAxes::Rub => axis_flips(frame.code(), RUB),
+        SpzAxes::Rub | SpzAxes::Auto => axis_flips(frame.code(), RUB),
         SpzAxes::Raw => [false; 3],
     };
-    let s = flip.map(|f| if f { -1.0f32 } else { 1.0 });
-    let qs = [s[1] * s[2], s[0] * s[2], s[0] * s[1]];
+    let (s, qs) = flip_signs(flip);
     let shs = sh_flip_signs(flip);
     let k = cloud.coeffs_per_splat() - 1;
     let scale = (1u32 << o.fractional_bits) as f32;

@@ -4,13 +4,15 @@
 //!
 //! Both point a `bufferView` at an SPZ blob (the current extension pins SPZ v2, gzip) and list
 //! placeholder attribute accessors whose `count` must equal the SPZ point count; the values
-//! come from the SPZ data alone. Both extensions require unpacking to glTF's LUF axes (SPZ
-//! stores RUB: x and z are negated, as `spz::UnpackOptions{LUF}` does in cesium-native), so the
-//! decoded primitive is in mesh space like any other and the node transforms apply to it.
+//! come from the SPZ data alone. Their text requires unpacking to glTF's LUF axes (SPZ stores
+//! RUB: x and z negated), while CesiumJS and the real files take the payload as stored;
+//! [`as_stored`] decides per primitive. The decoded primitive is in mesh space like any other
+//! and the node transforms apply to it.
 
 use super::accessor::view_bytes;
 use super::container::PREFIX;
 use super::primitive::{Ctx, LocalSplats, attr_path};
+use crate::load::codec::flip_axes;
 use crate::load::spz::{Frame, SpzAxes, decode_bytes};
 use crate::load::{Finding, ScaleSeen};
 use serde_json::Value;
@@ -39,9 +41,9 @@ impl Kind {
     }
 }
 
-/// Reads an SPZ-compressed primitive: the blob of `ext.bufferView` decoded (into LUF unless
-/// `--spz-axes raw`), the placeholders checked against it. `ext_path` is the extension
-/// object's JSON path. `None` after a blocking finding.
+/// Reads an SPZ-compressed primitive: the blob of `ext.bufferView` decoded, converted RUB →
+/// LUF or read as stored ([`as_stored`]), the placeholders checked against it. `ext_path` is
+/// the extension object's JSON path. `None` after a blocking finding.
 pub fn read(
     ctx: &Ctx,
     prim: &Value,
@@ -50,14 +52,6 @@ pub fn read(
     ext_path: &str,
     f: &mut Vec<Finding>,
 ) -> Option<LocalSplats> {
-    if kind == Kind::Legacy {
-        f.push(Finding::warning(
-            ext_path,
-            format!(
-                "legacy extension {LEGACY:?} (superseded by KHR_gaussian_splatting with {SPZ_2}); read, with kernel \"ellipse\" and colorSpace \"srgb_rec709_display\""
-            ),
-        ));
-    }
     let bv_path = format!("{ext_path}.bufferView");
     let Some(index) = ext.get("bufferView").and_then(Value::as_u64) else {
         f.push(Finding::fatal(
@@ -80,7 +74,8 @@ pub fn read(
             return None;
         }
     };
-    let (cloud, mut details) = match decode_bytes(bytes, ctx.spz_axes, Frame::Gltf, f) {
+    // Decoded converted (stored frame → LUF); the flips are undone if it is read as stored.
+    let (mut cloud, mut details, flips) = match decode_bytes(bytes, SpzAxes::Rub, Frame::Gltf, f) {
         Ok(d) => d,
         Err(e) => {
             f.push(Finding::fatal(
@@ -110,8 +105,22 @@ pub fn read(
     }
     ctx.budget.set(ctx.budget.get() - values);
     check_placeholders(ctx, prim, kind, cloud.len(), cloud.sh_degree, f);
-    if ctx.spz_axes == SpzAxes::Rub {
-        raw_axes_hint(ctx, prim, &cloud, f);
+    let stored = as_stored(ctx, prim, kind, &cloud, flips, f);
+    if stored {
+        flip_axes(&mut cloud, flips);
+    }
+    if kind == Kind::Legacy {
+        let axes = if stored {
+            "payload read as stored, in glTF axes, as CesiumJS reads it"
+        } else {
+            "payload converted RUB → LUF"
+        };
+        f.push(Finding::warning(
+            ext_path,
+            format!(
+                "legacy extension {LEGACY:?} (superseded by KHR_gaussian_splatting with {SPZ_2}); read, with kernel \"ellipse\" and colorSpace \"srgb_rec709_display\", {axes} (--spz-axes rub|raw to choose)"
+            ),
+        ));
     }
     Some(LocalSplats {
         cloud,
@@ -218,11 +227,22 @@ pub fn compression<'v>(prim: &'v Value, path: &str) -> Option<(Kind, &'v Value, 
     Some((Kind::Legacy, v, format!("{path}.extensions.{LEGACY}")))
 }
 
-/// A writer that skipped the LUF conversion leaves POSITION's `min`/`max` (a glTF MUST, so
-/// placeholders carry them) equal to the payload read raw: x and z negated against what was
-/// decoded. Says so, naming the option that reads such files as their writer meant.
-fn raw_axes_hint(ctx: &Ctx, prim: &Value, cloud: &crate::SplatCloud, f: &mut Vec<Finding>) {
-    let Some(b) = cloud.bounds() else { return };
+/// What POSITION's `min`/`max` (a glTF MUST, so placeholders carry them) say about the
+/// payload's axes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Shows {
+    /// They match the payload converted RUB → LUF (what the extensions' text requires).
+    Converted,
+    /// They match the payload as stored: its writer put glTF-axis numbers in it.
+    Stored,
+    /// Neither, or both (placeholder bounds such as ±1, or no flip at all).
+    Nothing,
+}
+
+fn evidence(ctx: &Ctx, prim: &Value, converted: &crate::SplatCloud, flips: [bool; 3]) -> Shows {
+    let Some(b) = converted.bounds() else {
+        return Shows::Nothing;
+    };
     let acc = prim["attributes"]["POSITION"]
         .as_u64()
         .and_then(|i| ctx.doc.accessors().nth(i as usize));
@@ -231,23 +251,65 @@ fn raw_axes_hint(ctx: &Ctx, prim: &Value, cloud: &crate::SplatCloud, f: &mut Vec
         let a = a.as_array()?;
         (a.len() == 3).then(|| std::array::from_fn(|k| a[k].as_f64().unwrap_or(f64::NAN)))
     };
-    let (Some(lo), Some(hi)) = (
-        vec3(acc.as_ref().and_then(|a| a.min())),
-        vec3(acc.and_then(|a| a.max())),
-    ) else {
-        return;
+    let lo = vec3(acc.as_ref().and_then(|a| a.min()));
+    let (Some(lo), Some(hi)) = (lo, vec3(acc.and_then(|a| a.max()))) else {
+        return Shows::Nothing;
     };
-    let (bmin, bmax) = (b.min.map(f64::from), b.max.map(f64::from));
-    // Read raw, x and z are negated: their min and max swap sign and place.
-    let raw_min = [-bmax[0], bmin[1], -bmax[2]];
-    let raw_max = [-bmin[0], bmax[1], -bmin[2]];
+    let (cmin, cmax) = (b.min.map(f64::from), b.max.map(f64::from));
+    // As stored, a flipped axis has its min and max negated and swapped.
+    let smin: [f64; 3] = std::array::from_fn(|a| if flips[a] { -cmax[a] } else { cmin[a] });
+    let smax: [f64; 3] = std::array::from_fn(|a| if flips[a] { -cmin[a] } else { cmax[a] });
     let near = |a: [f64; 3], b: [f64; 3]| {
         (0..3).all(|k| (a[k] - b[k]).abs() <= 1e-3 * (1.0 + a[k].abs().max(b[k].abs())))
     };
-    if near(lo, raw_min) && near(hi, raw_max) && !(near(lo, bmin) && near(hi, bmax)) {
-        f.push(Finding::warning(
-            attr_path(&ctx.path, "POSITION"),
-            "min/max match the SPZ payload read without the RUB → LUF conversion the extension requires: the writer probably skipped it (--spz-axes raw reads the file that way)",
-        ));
+    match (
+        near(lo, cmin) && near(hi, cmax),
+        near(lo, smin) && near(hi, smax),
+    ) {
+        (true, false) => Shows::Converted,
+        (false, true) => Shows::Stored,
+        _ => Shows::Nothing,
+    }
+}
+
+/// Whether the payload is read as stored (no RUB → LUF conversion). The extensions' text says
+/// convert; CesiumJS (their named implementation) reads as stored, and so were the real files
+/// written (docs/formats.md § glTF with SPZ compression). `--spz-axes rub|raw` decides;
+/// `auto` follows POSITION's `min`/`max` where they tell, else the text for the current
+/// extension and CesiumJS for the legacy one. A choice the bounds contradict is reported.
+fn as_stored(
+    ctx: &Ctx,
+    prim: &Value,
+    kind: Kind,
+    converted: &crate::SplatCloud,
+    flips: [bool; 3],
+    f: &mut Vec<Finding>,
+) -> bool {
+    let shows = evidence(ctx, prim, converted, flips);
+    let path = attr_path(&ctx.path, "POSITION");
+    let mut say = |m: &str| f.push(Finding::warning(&path, m));
+    match (ctx.spz_axes, shows) {
+        (SpzAxes::Rub, Shows::Stored) => {
+            say(
+                "min/max match the SPZ payload as stored, not converted RUB → LUF: its writer probably skipped the conversion (--spz-axes auto or raw reads it as stored)",
+            );
+            false
+        }
+        (SpzAxes::Raw, Shows::Converted) => {
+            say(
+                "min/max match the SPZ payload converted RUB → LUF, as the extension requires (--spz-axes auto or rub converts it)",
+            );
+            true
+        }
+        (SpzAxes::Rub, _) => false,
+        (SpzAxes::Raw, _) => true,
+        (SpzAxes::Auto, Shows::Converted) => false,
+        (SpzAxes::Auto, Shows::Stored) => {
+            say(
+                "min/max match the SPZ payload as stored, not converted RUB → LUF as the extension's text requires: read as stored, as CesiumJS reads it (--spz-axes rub converts)",
+            );
+            true
+        }
+        (SpzAxes::Auto, Shows::Nothing) => kind == Kind::Legacy,
     }
 }

@@ -35,14 +35,21 @@ pub const FLAG_EXTENSIONS: u8 = 0x2;
 /// SPZ_ADOBE_coordinate_system extension: a u32 coordinate-system code.
 const EXT_COORDINATE_SYSTEM: u32 = 0xADBE_0003;
 
-/// Which axes the stored numbers are taken to be in.
+/// Which axes the stored SPZ numbers are taken to be in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SpzAxes {
-    /// Niantic's convention: RUB, converted to splatgl's PLY frame (RDF).
+    /// SPZ files: [`SpzAxes::Rub`]. Inside glTF, per primitive: what POSITION's `min`/`max`
+    /// show (the payload converted RUB → LUF, or as stored); without that evidence, converted
+    /// for `KHR_gaussian_splatting_compression_spz_2` (its text) and as stored for the legacy
+    /// `KHR_spz_gaussian_splats_compression` (how its implementation, CesiumJS, reads it).
+    /// See docs/formats.md § glTF with SPZ compression. Writers treat it as `Rub`.
     #[default]
+    Auto,
+    /// Niantic's convention: RUB, converted to splatgl's PLY frame (RDF) for SPZ files and to
+    /// glTF's LUF inside glTF.
     Rub,
-    /// No conversion: the numbers are already in the PLY frame (what `splat-transform` 3.x
-    /// writes and expects).
+    /// No conversion: the numbers are already in the target frame (what `splat-transform` 3.x
+    /// writes into SPZ files, and CesiumJS expects inside glTF).
     Raw,
 }
 
@@ -79,9 +86,10 @@ impl std::str::FromStr for SpzAxes {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
+            "auto" => Ok(SpzAxes::Auto),
             "rub" => Ok(SpzAxes::Rub),
             "raw" => Ok(SpzAxes::Raw),
-            _ => Err(format!("expected rub or raw, found {s:?}")),
+            _ => Err(format!("expected auto, rub or raw, found {s:?}")),
         }
     }
 }
@@ -198,21 +206,22 @@ pub(crate) fn read(
     axes: SpzAxes,
     report: &mut LoadReport,
 ) -> Result<SplatCloud, SpzError> {
-    let (cloud, details) = decode_bytes(bytes, axes, Frame::Ply, &mut report.findings)?;
+    let (cloud, details, _) = decode_bytes(bytes, axes, Frame::Ply, &mut report.findings)?;
     report.details = Some(details);
     report.scale_space = Some(ScaleSeen::Log);
     Ok(cloud)
 }
 
-/// Decodes an SPZ payload (gzip v1–v3, uncompressed legacy, or v4 zstd streams): the cloud and
-/// the container's details, in `frame` (unless `axes` is [`SpzAxes::Raw`]). The glTF SPZ
-/// compression extensions call this on a bufferView.
+/// Decodes an SPZ payload (gzip v1–v3, uncompressed legacy, or v4 zstd streams): the cloud,
+/// the container's details and the axis flips applied — from the stored frame to `frame`, none
+/// when `axes` is [`SpzAxes::Raw`]. The glTF SPZ compression extensions call this on a
+/// bufferView.
 pub(crate) fn decode_bytes(
     bytes: &[u8],
     axes: SpzAxes,
     frame: Frame,
     findings: &mut Vec<Finding>,
-) -> Result<(SplatCloud, Details), SpzError> {
+) -> Result<(SplatCloud, Details, [bool; 3]), SpzError> {
     let limit = budget_for(bytes.len());
     let mut d = Details::new("spz", "");
     let inner;
@@ -240,7 +249,7 @@ pub(crate) fn decode_bytes(
     d.antialiased = h.flags & FLAG_ANTIALIASED != 0;
     describe(&h, &mut d);
     let cloud = decode(&h, &blocks, flips, findings);
-    Ok((cloud, d))
+    Ok((cloud, d, flips))
 }
 
 /// Axis flips (x, y, z) from the stored frame to `frame`: Niantic's RUB unless a
@@ -289,7 +298,7 @@ fn flips(
     }
     Ok(match axes {
         SpzAxes::Raw => [false; 3],
-        SpzAxes::Rub => axis_flips(stored, frame.code()),
+        SpzAxes::Rub | SpzAxes::Auto => axis_flips(stored, frame.code()),
     })
 }
 
@@ -355,11 +364,8 @@ fn decode(h: &Header, b: &Blocks<'_>, flip: [bool; 3], f: &mut Vec<Finding>) -> 
             "SH degree 4 read as degree 3 (the extra 9 coefficients are dropped)",
         ));
     }
-    let sign = |a: usize| if flip[a] { -1.0f32 } else { 1.0 };
-    let (sx, sy, sz) = (sign(0), sign(1), sign(2));
-    // Σ' = F R S² Rᵀ F with F = diag(sx, sy, sz), and F R F is a rotation for any signs: its
-    // quaternion is (x·sy·sz, y·sx·sz, z·sx·sy, w).
-    let qs = [sy * sz, sx * sz, sx * sy];
+    // Σ' = F R S² Rᵀ F with F = diag(sx, sy, sz).
+    let ([sx, sy, sz], qs) = codec::flip_signs(flip);
     let shs = sh_flip_signs(flip);
     let file_dim = ((h.degree as usize + 1).pow(2) - 1) * 3;
     let scale = (2.0f64).powi(-(h.fractional_bits as i32)) as f32;
