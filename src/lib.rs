@@ -11,6 +11,8 @@
 pub mod camera;
 pub mod cloud;
 pub mod compare;
+pub mod conformance;
+pub mod convert;
 pub mod covariance;
 #[cfg(feature = "gl")]
 pub mod gl;
