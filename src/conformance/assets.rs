@@ -117,6 +117,13 @@ pub(crate) fn splat(
 
 pub(crate) const ID: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
 
+/// Adds a sub-pixel white splat at `p`: where an asset's own content would catch erratum i
+/// (no dilation) only within the margin of its tolerance, the probe makes the outcome clear
+/// (it vanishes without dilation).
+pub(crate) fn subpixel_probe(c: &mut SplatCloud, p: [f32; 3]) {
+    splat(c, p, [0.002; 3], ID, 1.0, [1.0, 1.0, 1.0]);
+}
+
 /// A primitive with default (float) options.
 pub(crate) fn prim(cloud: SplatCloud) -> SplatPrimitive {
     SplatPrimitive {

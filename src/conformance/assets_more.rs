@@ -1,7 +1,9 @@
 //! The suite's assets, continued: lighting (SH), fallbacks and the per-pixel rules.
 
 use super::Erratum;
-use super::assets::{AssetSpec, CameraSpec, ID, cam, palette, prim, quat, single, splat};
+use super::assets::{
+    AssetSpec, CameraSpec, ID, cam, palette, prim, quat, single, splat, subpixel_probe,
+};
 use crate::cloud::{Known, SplatCloud};
 use crate::write::GltfWriteOptions;
 use crate::write::scene::{NodeTransform, SceneDoc, SceneNode, SplatPrimitive};
@@ -116,6 +118,7 @@ fn color0() -> AssetSpec {
         );
         c.sh[4 * k + 2] = [0.25, 0.1, -0.2];
     }
+    subpixel_probe(&mut c, [0.9, 0.75, 0.0]);
     let p = SplatPrimitive {
         cloud: c,
         options: GltfWriteOptions {
@@ -236,6 +239,7 @@ fn near_plane() -> AssetSpec {
         0.9,
         [1.0, 0.0, 0.0],
     );
+    subpixel_probe(&mut c, [1.0, 0.8, 0.0]);
     AssetSpec::new(
         "near_plane_crossing",
         "a splat whose mean is 0.35 in front of the camera but whose 3σ extent crosses the near plane (znear 0.2) is drawn whole; one whose mean is nearer than znear is not drawn",
@@ -441,6 +445,7 @@ fn jacobian_clamp() -> AssetSpec {
         let q = glam::Quat::from_rotation_z(0.3 * k as f32).to_array();
         splat(&mut c, [x, 0.2, 0.0], s, q, 0.8, [0.9, 0.8, 0.3]);
     }
+    subpixel_probe(&mut c, [0.6, -0.5, 0.0]);
     AssetSpec::new(
         "jacobian_clamp_offscreen",
         "large splats whose means lie far outside the view (|x/z| > 1.3·tan(half fov)) reach into the image; J uses x/z clamped to ±1.3·tan",

@@ -33,6 +33,9 @@ pub struct CameraEntry {
     pub reference_png: String,
     /// Our reference, float PFM, relative to the suite folder (what the runner compares to).
     pub reference_pfm: String,
+    /// Per-pixel error bound (grey PFM, relative to the suite folder): a pixel whose error
+    /// exceeds its bound fails the camera.
+    pub bound_pfm: String,
     /// Pass thresholds.
     pub tolerance: Tolerance,
 }
@@ -97,6 +100,7 @@ impl Manifest {
                             "cameras_json_index": c.gltf_camera,
                             "width": c.width, "height": c.height, "image": c.image,
                             "reference_png": c.reference_png, "reference_pfm": c.reference_pfm,
+                            "bound_pfm": c.bound_pfm,
                             "tolerance": {
                                 "max_abs": c.tolerance.max_abs, "min_psnr": c.tolerance.min_psnr,
                                 "terms": terms_json(&c.tolerance.terms),
@@ -151,6 +155,7 @@ impl Manifest {
                     image: s(&c, "image")?,
                     reference_png: s(&c, "reference_png")?,
                     reference_pfm: s(&c, "reference_pfm")?,
+                    bound_pfm: s(&c, "bound_pfm")?,
                     tolerance: Tolerance {
                         max_abs: f(t, "max_abs")?,
                         min_psnr: f(t, "min_psnr")?,

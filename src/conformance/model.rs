@@ -40,7 +40,7 @@ struct Layer {
 pub struct Terms {
     /// 8-bit output quantization, 0.5/255.
     pub output: f64,
-    /// 8-bit framebuffer rounding per blend, 0.5/255 per contributing splat.
+    /// 8-bit framebuffer rounding, 2 × 0.5/255 per contributing splat (source and result).
     pub blend: f64,
     /// Pixel centres within rounding of a splat's 3σ cut (in for one renderer, out for another).
     pub cutoff: f64,
@@ -280,7 +280,9 @@ pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
                 }
                 a = wgt + a * (1.0 - alpha);
             }
-            t.blend = q * layers_here as f64;
+            // UNORM8 blending rounds the fragment output (c·α, α) to 8 bits and the result
+            // again: two half-steps per blended splat.
+            t.blend = 2.0 * q * layers_here as f64;
             t.float = 1e-5 * (layers_here + 1) as f64;
             let disp = c.map(|v| if linear { srgb_encode(v) } else { v }.clamp(0.0, 1.0));
             if linear {

@@ -1,7 +1,7 @@
 //! Comparing a set of images with the suite's references, per the manifest's tolerances, and
 //! naming the likely cause of known failure patterns.
 
-use super::generate::{clamped, fails};
+use super::generate::{clamped, fails, measure};
 use super::manifest::{AssetEntry, CameraEntry, Manifest};
 use super::{Erratum, model, render};
 use crate::compare::{Comparison, compare};
@@ -83,20 +83,27 @@ fn flipped(img: &Image, vertical: bool) -> Image {
 
 /// The likely cause of a failing camera: a flipped image, an erratum whose model the image
 /// matches, else the asset's `failure_means`.
-fn cause(dir: &Path, m: &Manifest, ai: usize, ci: usize, actual: &Image, want: &Image) -> String {
+fn cause(
+    dir: &Path,
+    m: &Manifest,
+    (ai, ci): (usize, usize),
+    actual: &Image,
+    want: &Image,
+    bound: &[f64],
+) -> String {
     let a = &m.assets[ai];
     let t = &a.cameras[ci].tolerance;
-    if !fails(&flipped(actual, true), want, t) {
+    if !fails(&flipped(actual, true), want, bound, t) {
         return "the image is upside down (rows not flipped after a GL read-back, or y up vs down)"
             .into();
     }
-    if !fails(&flipped(actual, false), want, t) {
+    if !fails(&flipped(actual, false), want, bound, t) {
         return "the image is mirrored left-right (handedness or x axis flipped)".into();
     }
     if let Ok((scene, cams)) = render::load_asset(dir, m, ai) {
         for e in Erratum::ALL {
             let model = model::render(&scene.cloud, &cams[ci], &[e]).image;
-            if !fails(actual, &model, t) {
+            if !fails(actual, &model, bound, t) {
                 return format!(
                     "matches review-draft erratum {}: {}",
                     e.letter(),
@@ -106,6 +113,15 @@ fn cause(dir: &Path, m: &Manifest, ai: usize, ci: usize, actual: &Image, want: &
         }
     }
     a.failure_means.clone()
+}
+
+fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(bound)
+        .filter(|((p, q), bd)| (0..3).any(|k| !((p[k] - q[k]).abs() as f64 <= **bd)))
+        .count()
 }
 
 /// Compares the images `get(camera)` returns (`None`: missing; `Err`: unreadable) with the
@@ -122,6 +138,15 @@ pub fn run(
         for (ci, c) in a.cameras.iter().enumerate() {
             let want = Image::read(dir.join(&c.reference_pfm)).map_err(|e| e.to_string())?;
             let want = clamped(&want);
+            let bound: Vec<f64> = Image::read(dir.join(&c.bound_pfm))
+                .map_err(|e| e.to_string())?
+                .pixels
+                .iter()
+                .map(|p| p[0] as f64)
+                .collect();
+            if bound.len() != want.pixels.len() {
+                return Err(format!("{}: wrong size", c.bound_pfm));
+            }
             let got = get(c);
             let (comparison, pass, cause_text, actual) = match got {
                 None => {
@@ -139,10 +164,18 @@ pub fn run(
                 }
                 Some(Ok(img)) => {
                     let img = clamped(&img);
+                    let (_, ratio) = measure(&img, &want, &bound);
                     let cmp = compare(&img, &want, 1.0 / 255.0).map_err(|e| e.to_string())?;
                     let t = &c.tolerance;
-                    let pass = cmp.max_abs as f64 <= t.max_abs && cmp.psnr >= t.min_psnr;
-                    let why = (!pass).then(|| cause(dir, m, ai, ci, &img, &want));
+                    let pass =
+                        ratio <= 1.0 && cmp.max_abs as f64 <= t.max_abs && cmp.psnr >= t.min_psnr;
+                    let why = (!pass).then(|| {
+                        let over = format!(
+                            "{} pixels over their bound (worst {ratio:.2}×); ",
+                            over_bound(&img, &want, &bound)
+                        );
+                        over + &cause(dir, m, (ai, ci), &img, &want, &bound)
+                    });
                     (Some(cmp), pass, why, Some(img))
                 }
             };
