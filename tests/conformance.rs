@@ -174,3 +174,254 @@ fn erratum_proof_gl_fails_exactly_the_assets_that_catch_it() {
     }
     eprintln!("{}", table.join("\n"));
 }
+
+/// The Khronos glTF-Validator (filtered only for the extension it predates) and
+/// `splatgl validate` on every asset: RC-valid ones pass, the legacy one is flagged.
+#[test]
+fn every_asset_passes_the_khronos_validator_and_splatgl_validate() {
+    let (d, m) = suite();
+    let pkg = Path::new(env!("CARGO_MANIFEST_DIR")).join(".npm-tools/node_modules/gltf-validator");
+    let khronos = pkg.exists() && Command::new("node").arg("--version").output().is_ok();
+    if !khronos {
+        eprintln!(
+            "SKIPPED glTF-Validator: {} or node missing (.ci/run installs them)",
+            pkg.display()
+        );
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gltf_validate.mjs");
+    for a in &m.assets {
+        let file = d.join(&a.file);
+        let (code, text) = splatgl(&["validate", s(&file)]);
+        assert_eq!(code, if a.rc_valid { 0 } else { 1 }, "{}: {text}", a.name);
+        if khronos {
+            let out = Command::new("node")
+                .arg(&script)
+                .arg(&file)
+                .output()
+                .unwrap();
+            let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_eq!(
+                r["issues"]["numErrors"], 0,
+                "{}: {:#}",
+                a.name, r["issues"]["messages"]
+            );
+            assert_eq!(out.status.code(), Some(0));
+            assert!(r["issues"]["filteredPredatingExtension"].as_u64().unwrap() > 0);
+        }
+    }
+}
+
+#[test]
+fn cameras_json_describes_the_same_views_as_the_camera_nodes() {
+    let (d, m) = suite();
+    for (i, a) in m.assets.iter().enumerate() {
+        let (_, cams) = render::load_asset(d, m, i).unwrap();
+        let list = splatgl::camera::load_cameras_json(d.join(&a.cameras_json)).unwrap();
+        for (c, e) in cams.iter().zip(&list) {
+            let j = splatgl::camera::Camera::from_3dgs(e).unwrap();
+            // A point 2 in front of the glTF camera, off the axis.
+            let p = c
+                .world_to_camera
+                .inverse()
+                .transform_point3(glam::Vec3::new(0.3, -0.2, 2.0));
+            let (u1, _) = c.project(p).unwrap();
+            let (u2, _) = j.project(p).unwrap();
+            assert!((u1 - u2).length() < 1e-3, "{}: {u1} vs {u2}", a.name);
+        }
+    }
+}
+
+/// The runner: exit codes, images given as PNG in the reference layout, and causes.
+#[test]
+fn runner_exit_codes_layouts_and_likely_causes() {
+    let (d, m) = suite();
+    let (code, text) = splatgl(&["conformance", "run", s(d), "--images", "/nonexistent"]);
+    assert_eq!(code, 2, "{text}");
+    let empty = tmp("empty");
+    let (code, _) = splatgl(&["conformance", "run", s(&empty), "--backend", "reference"]);
+    assert_eq!(code, 2, "no manifest");
+    // Our own 8-bit references, laid out as reference/ is: every asset passes.
+    let (code, text) = splatgl(&[
+        "conformance",
+        "run",
+        s(d),
+        "--images",
+        s(&d.join("reference")),
+        "-o",
+        s(&tmp("png")),
+    ]);
+    assert_eq!(code, 0, "{text}");
+    // A copy with one image flipped, one missing and the legacy (optional) asset absent.
+    let other = tmp("other");
+    for a in &m.assets {
+        for c in &a.cameras {
+            if a.optional || (a.name == "sh_degree_1" && c.name == "back") {
+                continue;
+            }
+            let mut img = Image::read(d.join(&c.reference_png)).unwrap();
+            if a.name == "orientation_cube_corners" && c.name == "front" {
+                let w = img.width as usize;
+                let rows: Vec<_> = img.pixels.chunks(w).rev().flatten().copied().collect();
+                img.pixels = rows;
+            }
+            let p = other.join(format!("{}.png", c.image));
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            img.write_png(&p, Default::default(), false).unwrap();
+        }
+    }
+    let out = tmp("other-report");
+    let (code, text) = splatgl(&[
+        "conformance",
+        "run",
+        s(d),
+        "--images",
+        s(&other),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code, 1, "{text}");
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let optional = m.assets.iter().filter(|a| a.optional).count();
+    assert_eq!(r["failed"], 2);
+    assert_eq!(r["skipped"], optional);
+    assert_eq!(r["passed"], m.assets.len() - 2 - optional);
+    let find = |name: &str| {
+        r["assets"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|a| a["name"] == name)
+            .unwrap()
+            .clone()
+    };
+    let cube = find("orientation_cube_corners");
+    assert!(
+        cube["cameras"][0]["cause"]
+            .as_str()
+            .unwrap()
+            .contains("upside down"),
+        "{cube:#}"
+    );
+    let sh1 = find("sh_degree_1");
+    assert!(
+        sh1["cameras"][1]["cause"]
+            .as_str()
+            .unwrap()
+            .contains("no image"),
+        "{sh1:#}"
+    );
+    assert!(sh1["psnr"].is_null());
+}
+
+/// A renderer that sorts by view depth fails the sort asset; one that ignores colorSpace
+/// fails one of the colour-space assets (the assets are sensitive to what they check).
+#[test]
+fn sort_and_color_space_assets_fail_renderers_that_get_them_wrong() {
+    let (d, m) = suite();
+    let idx = |n: &str| m.assets.iter().position(|a| a.name == n).unwrap();
+    let check =
+        |name: &str, render: &dyn Fn(&splatgl::SplatCloud, &splatgl::camera::Camera) -> Image| {
+            let i = idx(name);
+            let (scene, cams) = render::load_asset(d, m, i).unwrap();
+            let imgs: Vec<Image> = cams.iter().map(|c| render(&scene.cloud, c)).collect();
+            let mut k = 0;
+            let r = runner::run(d, m, |c| {
+                (c.image.starts_with(&format!("{name}/"))).then(|| {
+                    k += 1;
+                    Ok(imgs[k - 1].clone())
+                })
+            })
+            .unwrap();
+            assert!(!r[i].pass(), "{name} should fail");
+        };
+    use splatgl::reference::{RenderOptions, SortMode, render_display};
+    check("sort_distance_not_depth", &|cl, c| {
+        let o = RenderOptions {
+            sort: SortMode::ViewDepth,
+            ..Default::default()
+        };
+        render_display(cl, c, &o, cl.meta.color_space.effective()).0
+    });
+    check("color_space_linear", &|cl, c| {
+        render_display(
+            cl,
+            c,
+            &RenderOptions::default(),
+            splatgl::cloud::ColorSpace::SrgbRec709Display,
+        )
+        .0
+    });
+}
+
+/// The HTML report opens in headless Chromium: the title and one table row per camera.
+#[test]
+fn html_report_renders_in_headless_chromium() {
+    let (d, m) = suite();
+    let out = tmp("html");
+    let (code, text) = splatgl(&[
+        "conformance",
+        "run",
+        s(d),
+        "--backend",
+        "reference",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{text}");
+    let Some(chromium) = ["chromium", "chromium-browser"]
+        .into_iter()
+        .find(|b| Command::new(b).arg("--version").output().is_ok())
+    else {
+        eprintln!("SKIPPED: chromium is not installed (.ci/run installs it)");
+        return;
+    };
+    let page = format!("file://{}", out.join("report.html").display());
+    let profile = tmp("chromium-profile");
+    let args = |extra: &[String]| {
+        let mut v: Vec<String> = [
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+        ]
+        .map(String::from)
+        .to_vec();
+        v.push(format!("--user-data-dir={}", profile.display()));
+        v.extend_from_slice(extra);
+        v.push(page.clone());
+        v
+    };
+    let dom = Command::new(chromium)
+        .args(args(&["--dump-dom".into()]))
+        .output()
+        .unwrap();
+    let html = String::from_utf8_lossy(&dom.stdout);
+    assert!(
+        html.contains("<title>KHR_gaussian_splatting conformance report</title>"),
+        "{html:.300}"
+    );
+    let cams: usize = m.assets.iter().map(|a| a.cameras.len()).sum();
+    assert_eq!(html.matches("<tr class=\"result").count(), cams);
+    let shot = out.join("shot.png");
+    let st = Command::new(chromium)
+        .args(args(&[
+            format!("--screenshot={}", shot.display()),
+            "--window-size=1200,900".into(),
+        ]))
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let img = Image::read(&shot).unwrap();
+    assert_eq!((img.width, img.height), (1200, 900));
+    // Not blank: the page drew text and thumbnails.
+    let first = img.pixels[0];
+    assert!(img.pixels.iter().any(|p| p != &first));
+}
