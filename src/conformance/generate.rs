@@ -160,13 +160,8 @@ fn add_probe(doc: &mut crate::write::scene::SceneDoc, spec: &AssetSpec) {
     doc.roots.push(n);
 }
 
-fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
-    let design = |message: String| GenerateError::Design {
-        asset: spec.name.to_owned(),
-        message,
-    };
-    let mut doc = spec.doc.clone();
-    add_probe(&mut doc, spec);
+/// The asset's cameras as perspective camera nodes (roots, after the content).
+fn add_cameras(doc: &mut crate::write::scene::SceneDoc, spec: &AssetSpec) {
     for c in &spec.cameras {
         let cam = doc.add_camera(PerspectiveCamera {
             yfov: c.yfov_deg.to_radians(),
@@ -187,6 +182,16 @@ fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
         });
         doc.roots.push(n);
     }
+}
+
+fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
+    let design = |message: String| GenerateError::Design {
+        asset: spec.name.to_owned(),
+        message,
+    };
+    let mut doc = spec.doc.clone();
+    add_probe(&mut doc, spec);
+    add_cameras(&mut doc, spec);
     let ext = if spec.json { "gltf" } else { "glb" };
     let file = format!("assets/{}.{ext}", spec.name);
     let bytes = if spec.json {

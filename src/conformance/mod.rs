@@ -10,7 +10,9 @@
 //! → [`runner`] (compares images, explains failures) → [`report`] (HTML + JSON).
 
 pub mod assets;
-mod assets_more;
+mod assets_light;
+mod assets_pixel;
+mod assets_scene;
 mod generate;
 pub mod manifest;
 pub mod model;

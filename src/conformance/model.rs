@@ -275,8 +275,8 @@ pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
                     .map(|v| (v - 1.0).max(0.0))
                     .fold(0.0, f64::max);
                 let wgt = if g { alpha * alpha } else { alpha };
-                for ch in 0..3 {
-                    c[ch] = l.color[ch] * wgt + c[ch] * (1.0 - alpha);
+                for (v, lc) in c.iter_mut().zip(l.color) {
+                    *v = lc * wgt + *v * (1.0 - alpha);
                 }
                 a = wgt + a * (1.0 - alpha);
             }

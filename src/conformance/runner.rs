@@ -120,7 +120,12 @@ fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
         .iter()
         .zip(&b.pixels)
         .zip(bound)
-        .filter(|((p, q), bd)| (0..3).any(|k| !((p[k] - q[k]).abs() as f64 <= **bd)))
+        .filter(|((p, q), bd)| {
+            (0..3).any(|k| {
+                let e = (p[k] - q[k]).abs() as f64;
+                e.is_nan() || e > **bd
+            })
+        })
         .count()
 }
 

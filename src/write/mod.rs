@@ -312,7 +312,7 @@ pub(crate) fn gltf_bytes(mut doc: Value, bin: &[u8]) -> Vec<u8> {
 /// `.glb` bytes of a document whose buffer 0 is `bin`.
 pub(crate) fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
     let mut json = serde_json::to_vec(doc).unwrap_or_default();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
