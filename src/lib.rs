@@ -14,6 +14,8 @@
 pub mod camera;
 pub mod cloud;
 pub mod compare;
+pub mod conformance;
+pub mod convert;
 // Covariance algebra behind the loader's node transforms: public for the node-transform tests,
 // not part of the documented API (`SplatCloud::covariance` is the user-facing form).
 #[doc(hidden)]

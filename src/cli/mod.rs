@@ -4,6 +4,8 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod compare;
+mod conformance;
+mod convert;
 mod info;
 mod render;
 mod validate;
@@ -36,6 +38,12 @@ enum Command {
     /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
     /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
     Compare(compare::Args),
+    /// Convert a splat file to glTF (.glb/.gltf, KHR_gaussian_splatting RC) or INRIA PLY.
+    /// Exit status: 0, or 2 on any error.
+    Convert(convert::Args),
+    /// The KHR_gaussian_splatting conformance suite: generate it, or run it on images.
+    #[command(subcommand)]
+    Conformance(conformance::Command),
 }
 
 /// The arguments of `info` and `validate`: one file, read with the loader options.
@@ -83,5 +91,7 @@ pub fn run() -> ExitCode {
         Command::Validate(a) => validate::run(a),
         Command::Render(a) => render::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Convert(a) => convert::run(a),
+        Command::Conformance(c) => conformance::run(c),
     }
 }

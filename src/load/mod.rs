@@ -248,7 +248,12 @@ pub(crate) fn read(
     })
 }
 
-/// Normalises a quaternion `[x, y, z, w]`; returns it and whether it was off unit length by
+/// A quaternion whose norm is 1 within this (4 f32 ulps at 1) is kept as stored: renormalising
+/// an already normalised f32 quaternion can flip last bits, so a file written from a loaded
+/// cloud would not load back bit for bit. Renderers normalise again anyway.
+pub(crate) const UNIT_NORM_ROUNDING: f64 = 4.0 * f32::EPSILON as f64;
+
+/// Normalises a quaternion `[x, y, z, w]` (kept as is when unit to f32 rounding); returns it and whether it was off unit length by
 /// more than 1e-3. A zero or non-finite quaternion is an error (`None`).
 pub(crate) fn normalize_quat(q: [f32; 4]) -> Option<([f32; 4], bool)> {
     let n2: f64 = q.iter().map(|&v| (v as f64) * (v as f64)).sum();
@@ -257,5 +262,8 @@ pub(crate) fn normalize_quat(q: [f32; 4]) -> Option<([f32; 4], bool)> {
     }
     let n = n2.sqrt();
     let off = (n - 1.0).abs() > 1e-3;
+    if (n - 1.0).abs() <= UNIT_NORM_ROUNDING {
+        return Some((q, off)); // unit to f32 rounding: dividing would only flip last bits
+    }
     Some((q.map(|v| (v as f64 / n) as f32), off))
 }

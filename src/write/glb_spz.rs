@@ -6,7 +6,7 @@
 //! included, so a reader can tell which axes the payload is in.
 
 use super::spz::{SpzWriteError, SpzWriteOptions, encode};
-use super::{extension_object, glb};
+use super::{extension_object, glb_bytes};
 use crate::cloud::SplatCloud;
 use crate::load::spz::Frame;
 use serde_json::{Value, json};
@@ -72,7 +72,7 @@ pub fn to_glb_spz_with(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8
         "bufferViews": [{"buffer": 0, "byteLength": spz.len()}],
         "accessors": accessors,
     });
-    Ok(glb(&doc, &spz))
+    Ok(glb_bytes(&doc, &spz))
 }
 
 /// Bounds of the positions as a reader decodes them: rounded to steps of 2^-bits (the axis

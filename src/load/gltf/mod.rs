@@ -22,6 +22,11 @@ mod rules;
 mod spz;
 mod transform;
 
+/// Applies a node's global matrix to a local-space cloud exactly as the loader does
+/// (positions, Σ = M C Cᵀ Mᵀ, SH rotated by the polar factor); findings name `nodes[node]`;
+/// `None` after a blocking finding.
+pub use transform::apply as apply_node_transform;
+
 use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen};
 use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;

@@ -234,7 +234,11 @@ fn assemble(
             non_unit += 1;
             first_non_unit.get_or_insert(i);
         }
-        let q = q.map(|v| (v as f64 / norm) as f32);
+        let q = if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
+            q // unit to f32 rounding: kept bit for bit
+        } else {
+            q.map(|v| (v as f64 / norm) as f32)
+        };
         let s: [f32; 3] = a.scale.get(i);
         let s = if log {
             s.map(f32::exp)
