@@ -23,6 +23,10 @@ pub enum OutputFormat {
     Gltf,
     /// INRIA 3DGS binary PLY.
     Ply,
+    /// Niantic SPZ ([`ConvertOptions::spz_version`]; v2 by default).
+    Spz,
+    /// antimatter15 `.splat` (32 bytes per splat, SH degree 0).
+    Splat,
 }
 
 /// Output formats by file extension (lower case).
@@ -30,6 +34,8 @@ pub const OUTPUTS: &[(&str, OutputFormat)] = &[
     ("glb", OutputFormat::Glb),
     ("gltf", OutputFormat::Gltf),
     ("ply", OutputFormat::Ply),
+    ("spz", OutputFormat::Spz),
+    ("splat", OutputFormat::Splat),
 ];
 
 impl OutputFormat {
@@ -165,6 +171,11 @@ pub struct ConvertOptions {
     pub rotate_deg: [f64; 3],
     /// Relabel the colour space (no colour values change).
     pub color_space: Option<ColorSpace>,
+    /// SPZ version of `.spz` outputs.
+    pub spz_version: write::SpzVersion,
+    /// `.glb` output: SPZ v2 in `KHR_gaussian_splatting_compression_spz_2` instead of
+    /// accessors (then `quantize` does not apply).
+    pub spz_compress: bool,
 }
 
 impl ConvertOptions {
@@ -232,11 +243,34 @@ pub fn relabel(cloud: &mut SplatCloud, o: &ConvertOptions) {
 }
 
 /// The file bytes of `cloud` in `format`, and notes for the user (e.g. clamped values).
-pub fn encode(cloud: &SplatCloud, format: OutputFormat, q: &Quantize) -> (Vec<u8>, Vec<String>) {
+/// Fails only where the format cannot hold the cloud (SPZ's 24-bit fixed-point positions).
+pub fn encode(
+    cloud: &SplatCloud,
+    format: OutputFormat,
+    o: &ConvertOptions,
+) -> Result<(Vec<u8>, Vec<String>), String> {
     let mut notes = Vec::new();
-    if format == OutputFormat::Ply {
-        return (write::to_inria_ply(cloud), notes);
+    let spz_err = |e: write::SpzWriteError| format!("cannot write SPZ: {e}");
+    match format {
+        OutputFormat::Ply => return Ok((write::to_inria_ply(cloud), notes)),
+        OutputFormat::Spz => {
+            return Ok((write::to_spz(cloud, o.spz_version).map_err(spz_err)?, notes));
+        }
+        OutputFormat::Splat => {
+            if cloud.sh_degree > 0 {
+                notes.push(format!(
+                    ".splat holds colour only: SH degrees 1..={} dropped",
+                    cloud.sh_degree
+                ));
+            }
+            return Ok((write::to_splat(cloud), notes));
+        }
+        OutputFormat::Glb if o.spz_compress => {
+            return Ok((write::to_glb_spz(cloud).map_err(spz_err)?, notes));
+        }
+        OutputFormat::Glb | OutputFormat::Gltf => {}
     }
+    let q = &o.quantize;
     let d = dequantize_node(cloud, q.position, q.scale);
     if d.clamped_scales > 0 {
         notes.push(format!(
@@ -245,7 +279,7 @@ pub fn encode(cloud: &SplatCloud, format: OutputFormat, q: &Quantize) -> (Vec<u8
             q.scale.name()
         ));
     }
-    let o = GltfWriteOptions {
+    let w = GltfWriteOptions {
         position: q.position,
         rotation: q.rotation,
         scale: q.scale,
@@ -255,8 +289,8 @@ pub fn encode(cloud: &SplatCloud, format: OutputFormat, q: &Quantize) -> (Vec<u8
         ..Default::default()
     };
     let bytes = match format {
-        OutputFormat::Glb => write::to_glb(&d.cloud, &o),
-        _ => write::to_gltf(&d.cloud, &o),
+        OutputFormat::Glb => write::to_glb(&d.cloud, &w),
+        _ => write::to_gltf(&d.cloud, &w),
     };
-    (bytes, notes)
+    Ok((bytes, notes))
 }

@@ -224,3 +224,58 @@ fn max_diff_extent(c: &SplatCloud) -> f64 {
         .map(|j| (b.max[j] - b.min[j]) as f64)
         .fold(0.0, f64::max)
 }
+
+#[test]
+fn spz_splat_and_spz_compressed_glb_outputs_load_back_within_their_quantization() {
+    let d = dir("packed");
+    let (input, src) = source(&d);
+    // SPZ stores positions in 24-bit fixed point with 12 fractional bits (error ≤ 2^-13);
+    // .splat stores them as f32 (exact). docs/formats.md has every bound.
+    let half_step = 2f64.powi(-13) * 1.0001;
+    for (name, extra, pos_bound) in [
+        ("v2.spz", &[][..], half_step),
+        ("v3.spz", &["--spz-version", "3"][..], half_step),
+        ("v4.spz", &["--spz-version", "4"][..], half_step),
+        ("c.splat", &[][..], 0.0),
+        ("spz.glb", &["--spz-compress"][..], half_step),
+    ] {
+        let out = d.join(name);
+        let mut args = vec!["convert", s(&input), s(&out)];
+        args.extend_from_slice(extra);
+        let (code, text) = splatgl(&args);
+        assert_eq!(code, 0, "{name}: {text}");
+        if name.ends_with(".splat") {
+            assert!(text.contains("SH degrees 1..=3 dropped"), "{text}");
+        }
+        if name.ends_with(".glb") {
+            khronos_validate(&out); // asserts 0 errors (when installed)
+        }
+        let back = load(&out);
+        assert_eq!(back.len(), src.len(), "{name}");
+        let err = max_diff(&back.positions, &src.positions);
+        assert!(
+            err <= pos_bound,
+            "{name}: position error {err} > {pos_bound}"
+        );
+    }
+}
+
+#[test]
+fn spz_options_that_do_not_apply_are_errors() {
+    let d = dir("packed-opts");
+    let (input, _) = source(&d);
+    for (out, flag, want) in [
+        ("a.glb", "--spz-version", "applies to .spz outputs only"),
+        ("b.ply", "--spz-compress", "applies to .glb outputs only"),
+    ] {
+        let out = d.join(out);
+        let mut args = vec!["convert", s(&input), s(&out), flag];
+        if flag == "--spz-version" {
+            args.push("3");
+        }
+        let (code, text) = splatgl(&args);
+        assert_eq!(code, 2, "{text}");
+        assert!(text.contains(want), "{text}");
+        assert!(!out.exists());
+    }
+}

@@ -14,7 +14,8 @@ use std::time::Instant;
 pub struct Args {
     /// Input file (any format splatgl reads).
     pub input: PathBuf,
-    /// Output file: .glb, .gltf (KHR_gaussian_splatting RC) or .ply (INRIA 3DGS).
+    /// Output file: .glb, .gltf (KHR_gaussian_splatting RC), .ply (INRIA 3DGS), .spz (Niantic)
+    /// or .splat (antimatter15).
     pub output: PathBuf,
     /// Store an attribute as an integer type (glTF outputs), ATTR=TYPE, comma-separated or
     /// repeated: position=i8|i8n|u8|u8n|i16|i16n|u16|u16n (KHR_mesh_quantization with a
@@ -57,6 +58,14 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     pub up: Up,
+    /// SPZ version of a .spz output: 2 (gzip; what KHR_gaussian_splatting_compression_spz_2
+    /// pins and most readers take), 3 (gzip, smallest-three quaternions) or 4 (zstd).
+    #[arg(long, value_name = "2|3|4", value_parser = clap::value_parser!(u32).range(2..=4))]
+    pub spz_version: Option<u32>,
+    /// .glb output compressed as SPZ v2 in KHR_gaussian_splatting_compression_spz_2 (lossy:
+    /// see docs/formats.md) instead of plain accessors.
+    #[arg(long)]
+    pub spz_compress: bool,
     /// Set colorSpace (a relabel for inputs that carry none, e.g. PLY; colours are unchanged).
     #[arg(long, value_name = "srgb_rec709_display|lin_rec709_display", value_parser = parse_color_space)]
     pub color_space: Option<ColorSpace>,
@@ -127,6 +136,12 @@ fn options(a: &Args) -> Result<ConvertOptions, String> {
         up: a.up,
         rotate_deg,
         color_space: a.color_space,
+        spz_version: match a.spz_version {
+            Some(v) => splatgl::write::SpzVersion::try_from(v)
+                .map_err(|e| format!("--spz-version: {e}"))?,
+            None => splatgl::write::SpzVersion::V2,
+        },
+        spz_compress: a.spz_compress,
     })
 }
 
@@ -170,8 +185,14 @@ fn go(a: &Args) -> Result<(), String> {
         )
     })?;
     let o = options(a)?;
-    if o.quantize.any() && !format.is_gltf() {
-        return Err("--quantize applies to .glb/.gltf outputs only".into());
+    if o.quantize.any() && (!format.is_gltf() || o.spz_compress) {
+        return Err("--quantize applies to uncompressed .glb/.gltf outputs only".into());
+    }
+    if o.spz_compress && format != OutputFormat::Glb {
+        return Err("--spz-compress applies to .glb outputs only".into());
+    }
+    if a.spz_version.is_some() && format != OutputFormat::Spz {
+        return Err("--spz-version applies to .spz outputs only".into());
     }
     if !a.force && a.output.exists() {
         return Err(format!(
@@ -196,7 +217,7 @@ fn go(a: &Args) -> Result<(), String> {
     convert::relabel(&mut cloud, &o);
     let cloud = rotate(cloud, &o, &p)?;
     p.stage("encoding");
-    let (bytes, notes) = convert::encode(&cloud, format, &o.quantize);
+    let (bytes, notes) = convert::encode(&cloud, format, &o)?;
     for n in notes {
         eprintln!("note: {n}");
     }
