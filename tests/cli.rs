@@ -75,6 +75,80 @@ fn info_json_keys() {
     assert!(err.contains("nonexistent.glb"), "{err}");
 }
 
+/// `info` on quantized containers: the container keys (`container`, `container_version`,
+/// `compression`, `gltf_extension`, `quantization`, `lossy`, `antialiased`) in `--json`, null
+/// for plain files, and the same facts as text; `validate` takes the SPZ-compressed `.glb` as
+/// valid, and `--spz-axes` is accepted by both.
+#[test]
+fn info_reports_the_container_and_validate_accepts_spz_compression() {
+    let cloud = common::random_cloud(20, 1, 5.0, 4);
+    let o = splatgl::write::SpzWriteOptions {
+        version: splatgl::write::SpzVersion::V3,
+        antialiased: true,
+        ..Default::default()
+    };
+    let spz = tmp("c.spz", &splatgl::write::to_spz_with(&cloud, &o).unwrap());
+    let glb = tmp("c_spz.glb", &splatgl::write::to_glb_spz(&cloud).unwrap());
+    let ply = tmp("plain.ply", &splatgl::write::to_inria_ply(&cloud));
+    let json = |p: &std::path::Path| -> serde_json::Value {
+        let (code, out, err) = splatgl(&["info", "--json", p.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let v = json(&spz);
+    assert_eq!(v["format"], "spz");
+    assert_eq!(v["container"], "spz");
+    assert_eq!(v["container_version"], "3");
+    assert_eq!(v["compression"], "gzip");
+    assert_eq!(v["gltf_extension"], serde_json::Value::Null);
+    assert_eq!(v["antialiased"], true);
+    let q = v["quantization"].as_array().unwrap();
+    let bits = |a: &str| {
+        q.iter()
+            .find(|e| e["attribute"] == a)
+            .map(|e| e["bits"].clone())
+    };
+    assert_eq!(bits("position"), Some(serde_json::json!(24)));
+    assert_eq!(bits("rotation"), Some(serde_json::json!(10)));
+    assert_eq!(bits("sh"), Some(serde_json::json!(8)));
+    assert!(!v["lossy"].as_array().unwrap().is_empty());
+    let v = json(&glb);
+    assert_eq!(v["format"], "glb");
+    assert_eq!(v["container_version"], "2");
+    assert_eq!(
+        v["gltf_extension"],
+        "KHR_gaussian_splatting_compression_spz_2"
+    );
+    assert_eq!(v["antialiased"], false);
+    let v = json(&ply);
+    for key in [
+        "container",
+        "container_version",
+        "quantization",
+        "lossy",
+        "antialiased",
+    ] {
+        assert_eq!(v[key], serde_json::Value::Null, "{key} of a plain PLY");
+    }
+    let (code, out, _) = splatgl(&["info", spz.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    assert!(out.contains("container:      spz v3, gzip"), "{out}");
+    assert!(out.contains("antialiased:    yes"), "{out}");
+    assert!(out.contains("position  24 bits"), "{out}");
+    let (code, out, _) = splatgl(&["validate", "--spz-axes", "raw", glb.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+    let (code, out, _) = splatgl(&["validate", "--json", glb.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (v["status"].as_str(), v["splat_count"].as_u64()),
+        (Some("valid"), Some(20))
+    );
+    let (code, _, err) = splatgl(&["info", "--spz-axes", "sideways", spz.to_str().unwrap()]);
+    assert_eq!(code, 2, "clap's usage error");
+    assert!(err.contains("expected auto, rub or raw"), "{err}");
+}
+
 /// Both backends show a `lin_rec709_display` cloud the same way: blended in linear, encoded
 /// to sRGB once at the end, over a background given in display values.
 #[test]

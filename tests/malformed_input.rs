@@ -1,26 +1,32 @@
 //! Malformed and hostile input files, each ending in its specific error or a correct load
 //! (never a panic, a stack overflow, an endless read or an allocation far beyond the input
 //! size): lying headers, truncation, wrong types, partial SH, out-of-range values, NaN, bad
-//! JSON, missing buffers, bad indices, deep or cyclic node graphs, instance bombs; PNG and PFM
-//! images that `compare` reads.
+//! JSON, missing buffers, bad indices, deep or cyclic node graphs, instance bombs; SPZ (truncated
+//! or bomb gzip, lying counts, bad versions and magic), `.splat`, `.ksplat` and SOG (zips with
+//! missing members, WebP of the wrong size, paths out of the folder); PNG and PFM images that
+//! `compare` reads. Peak memory of hostile packed files: tests/format_memory.rs.
 
 mod common;
 use base64::Engine;
-use common::random_cloud;
+use common::{packed, random_cloud};
 use serde_json::{Value, json};
 use splatgl::image::Image;
 use splatgl::load::validate::{Status, validate_bytes};
 use splatgl::load::{LoadOptions, ScaleSpace, load_bytes};
 use splatgl::write::{Comp, GltfWriteOptions, build, to_glb};
+use splatgl::write::{SpzWriteOptions, to_splat, to_spz_with};
+use std::io::{Read, Write};
 use std::path::Path;
 
+#[track_caller]
 fn err_of(bytes: &[u8], name: &str) -> String {
     match load_bytes(bytes, Some(Path::new(name)), &LoadOptions::default()) {
-        Ok(_) => panic!("{name}: expected an error"),
+        Ok(l) => panic!("{name}: expected an error, loaded {} splats", l.cloud.len()),
         Err(e) => e.to_string(),
     }
 }
 
+#[track_caller]
 fn expect(bytes: &[u8], name: &str, needles: &[&str]) {
     let e = err_of(bytes, name);
     for n in needles {
@@ -419,6 +425,7 @@ fn spec_violations_the_loader_survives_are_validation_errors() {
         Some(Path::new("v.gltf")),
         &LoadOptions {
             scale_space: ScaleSpace::Linear,
+            ..Default::default()
         },
     )
     .unwrap_err()
@@ -646,6 +653,367 @@ fn sparse_all_zero_opacity_writes_a_valid_file() {
     let glb = to_glb(&c, &o);
     let v = validate_bytes(&glb, Some(Path::new("s.glb")), &LoadOptions::default());
     assert_eq!(v.status(), Status::Valid, "{:#?}", v.findings);
+}
+
+// ---------- SPZ, .splat, .ksplat, SOG: errors name the block, member, section or texture ----------
+
+fn gunzip(b: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    flate2::read::GzDecoder::new(b)
+        .read_to_end(&mut out)
+        .unwrap();
+    out
+}
+
+fn gzip(b: &[u8]) -> Vec<u8> {
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    e.write_all(b).unwrap();
+    e.finish().unwrap()
+}
+
+fn spz_of(c: &splatgl::SplatCloud, version: u32) -> Vec<u8> {
+    let o = SpzWriteOptions {
+        version: splatgl::write::SpzVersion::try_from(version).unwrap(),
+        ..Default::default()
+    };
+    to_spz_with(c, &o).unwrap()
+}
+
+fn spz(version: u32, degree: u8) -> Vec<u8> {
+    spz_of(&random_cloud(40, degree, 5.0, 2), version)
+}
+
+#[test]
+fn spz_corpus() {
+    let v2 = spz(2, 1);
+    let inner = gunzip(&v2);
+    let with = |f: &dyn Fn(&mut Vec<u8>)| {
+        let mut b = inner.clone();
+        f(&mut b);
+        gzip(&b)
+    };
+    expect(&v2[..v2.len() - 20], "a.spz", &["SPZ: gzip:"]);
+    expect(
+        b"hello world, not a splat",
+        "a.spz",
+        &["not SPZ", "found 68656c6c"],
+    );
+    expect(&with(&|b| b[4] = 7), "a.spz", &["version 7", "gzip member"]);
+    expect(&with(&|b| b[4] = 0), "a.spz", &["version 0"]);
+    expect(&with(&|b| b[12] = 5), "a.spz", &["SH degree 5"]);
+    expect(
+        &with(&|b| b[8..12].copy_from_slice(&1000u32.to_le_bytes())),
+        "a.spz",
+        &[
+            "claims 1000 points",
+            "positions needs 28016 bytes, only 1136 present",
+        ],
+    );
+    expect(
+        &with(&|b| b[8..12].copy_from_slice(&1_000_000u32.to_le_bytes())),
+        "a.spz",
+        &["claims 1000000 points", "over the budget"],
+    );
+    expect(
+        &with(&|b| b.truncate(b.len() - 5)),
+        "a.spz",
+        &["claims 40 points", "sh needs"],
+    );
+    // A gzip bomb: 64 MiB of zeros after a valid header, far over 16 MiB + 64 × ~65 KB.
+    let mut bomb = inner[..16].to_vec();
+    bomb.resize(64 << 20, 0);
+    let bomb = gzip(&bomb);
+    expect(&bomb, "a.spz", &["gzip", "budget"]);
+
+    let v4 = spz(4, 1);
+    let toc = u32::from_le_bytes(v4[16..20].try_into().unwrap()) as usize;
+    let mut b = v4.clone();
+    b[4] = 9;
+    expect(&b, "a.spz", &["version 9"]);
+    let mut b = v4.clone();
+    b[15] = 3;
+    expect(&b, "a.spz", &["3 streams, expected 6"]);
+    let mut b = v4.clone();
+    b[toc + 8] ^= 1; // stream 0 uncompressed size
+    expect(&b, "a.spz", &["stream 0 (positions) holds", "expected 360"]);
+    let mut b = v4.clone();
+    b[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+    expect(&b, "a.spz", &["4294967295 points", "budget"]);
+    let mut b = v4.clone();
+    b.truncate(b.len() - 3);
+    expect(&b, "a.spz", &["sh needs"]);
+    let mut b = v4.clone();
+    b[toc + 6 * 16] ^= 0xff; // the first stream's zstd magic
+    expect(&b, "a.spz", &["stream 0 (positions): zstd frame header"]);
+    let mut b = v4.clone();
+    b.extend_from_slice(b"junk");
+    expect(&b, "a.spz", &["streams end at byte", "the file at"]);
+}
+
+#[test]
+fn splat_and_ksplat_corpus() {
+    let s = to_splat(&random_cloud(5, 0, 5.0, 1));
+    expect(
+        &s[..s.len() - 7],
+        "a.splat",
+        &["length 153", "record 4 is truncated (25 of 32"],
+    );
+    // A NaN position is dropped and counted, not loaded and not an error.
+    let mut b = s.clone();
+    b[32..36].copy_from_slice(&f32::NAN.to_le_bytes());
+    let l = load_bytes(&b, Some(Path::new("a.splat")), &LoadOptions::default()).unwrap();
+    assert_eq!(l.cloud.len(), 4);
+    assert!(
+        l.report
+            .warning_lines()
+            .iter()
+            .any(|w| w.contains("1 splats dropped"))
+    );
+
+    let k = packed::ksplat(&random_cloud(300, 1, 5.0, 3), 1, 128, 25.0);
+    expect(
+        &k[..5000],
+        "a.ksplat",
+        &["section headers needs", "the file has 5000"],
+    );
+    expect(&k[..k.len() - 1], "a.ksplat", &["section 0 data needs"]);
+    let poke = |at: usize, v: &[u8]| {
+        let mut b = k.clone();
+        b[at..at + v.len()].copy_from_slice(v);
+        b
+    };
+    expect(&poke(0, &[1]), "a.ksplat", &["version 1.1"]);
+    expect(&poke(20, &[3, 0]), "a.ksplat", &["compression level 3"]);
+    expect(
+        &poke(4096, &301u32.to_le_bytes()),
+        "a.ksplat",
+        &["301 splats but room for 300"],
+    );
+    expect(&poke(4096 + 40, &[4, 0]), "a.ksplat", &["SH degree 4"]);
+    expect(
+        &poke(4096 + 32, &[1, 0, 0, 0]),
+        "a.ksplat",
+        &["buckets hold", "the section 300"],
+    );
+    let l = load_bytes(
+        &poke(16, &[7, 0, 0, 0]),
+        Some(Path::new("a.ksplat")),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        l.report
+            .warning_lines()
+            .iter()
+            .any(|w| w.contains("states 7 splats"))
+    );
+}
+
+/// The files of a SOG bundle: (name, bytes).
+type Files = Vec<(String, Vec<u8>)>;
+
+fn sog_members(edit: &dyn Fn(&mut Files)) -> Vec<u8> {
+    let mut files = packed::sog_files(&random_cloud(50, 1, 5.0, 4));
+    edit(&mut files);
+    let m: Vec<(&str, &[u8])> = files
+        .iter()
+        .map(|(n, b)| (n.as_str(), b.as_slice()))
+        .collect();
+    packed::zip_stored(&m)
+}
+
+#[test]
+fn sog_corpus() {
+    let good = sog_members(&|_| {});
+    expect(
+        &sog_members(&|f| f.retain(|(n, _)| n != "quats.webp")),
+        "a.sog",
+        &["SOG: 'quats.webp' is missing"],
+    );
+    expect(
+        &sog_members(&|f| f.retain(|(n, _)| n != "meta.json")),
+        "a.sog",
+        &["'meta.json' is missing"],
+    );
+    expect(
+        &sog_members(&|f| f[3].1 = packed::webp(&[0; 4 * 12], 4, 3)),
+        "a.sog",
+        &[
+            "texture 'scales.webp' (scales)",
+            "4×3 = 12 texels, fewer than the 50 splats",
+        ],
+    );
+    expect(
+        &sog_members(&|f| f[0].1 = b"RIFF....WEBPnope".to_vec()),
+        "a.sog",
+        &["'means_l.webp' (means_l)", "not a WebP image"],
+    );
+    let meta = |f: &mut Files, from: &str, to: &str| {
+        let m = f.last_mut().unwrap();
+        m.1 = String::from_utf8(m.1.clone())
+            .unwrap()
+            .replace(from, to)
+            .into_bytes();
+    };
+    expect(
+        &sog_members(&|f| meta(f, "\"version\":2", "\"version\":3")),
+        "a.sog",
+        &["meta.json: version: 3"],
+    );
+    expect(
+        &sog_members(&|f| meta(f, "\"bands\":1", "\"bands\":7")),
+        "a.sog",
+        &["shN.bands: 7, expected 1-3"],
+    );
+    expect(
+        &sog_members(&|f| meta(f, "\"count\":50", "\"count\":5000")),
+        "a.sog",
+        &["fewer than the 5000 splats"],
+    );
+    // Zip-level damage: truncated, a corrupt member, a member claiming a huge size.
+    expect(
+        &good[..good.len() - 30],
+        "a.sog",
+        &["zip: no end-of-central-directory record"],
+    );
+    let mut b = good.clone();
+    b[50] ^= 0xff; // inside means_l.webp's data (after the 30-byte header and its name)
+    expect(&b, "a.sog", &["'means_l.webp'", "CRC-32"]);
+    let cd = u32::from_le_bytes(good[good.len() - 6..good.len() - 2].try_into().unwrap()) as usize;
+    let mut b = good.clone();
+    b[cd + 24..cd + 28].copy_from_slice(&u32::MAX.to_le_bytes()); // first member's size
+    expect(&b, "a.sog", &["'means_l.webp'", "over the", "budget"]);
+    expect(
+        b"PK\x03\x04 not really a zip at all",
+        "a.sog",
+        &["SOG: zip:"],
+    );
+}
+
+#[test]
+fn unbundled_sog_rejects_paths_outside_its_folder() {
+    let dir = std::env::temp_dir().join(format!("splatgl-sogbad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let files = packed::sog_files(&random_cloud(20, 0, 5.0, 4));
+    for (n, b) in &files {
+        std::fs::write(dir.join(n), b).unwrap();
+    }
+    let meta = String::from_utf8(files.last().unwrap().1.clone()).unwrap();
+    let bad = meta.replace("\"quats.webp\"", "\"../quats.webp\"");
+    let p = dir.join("meta.json");
+    expect(
+        bad.as_bytes(),
+        p.to_str().unwrap(),
+        &["'../quats.webp': not a plain relative file name"],
+    );
+    let gone = meta.replace("\"quats.webp\"", "\"nothere.webp\"");
+    expect(
+        gone.as_bytes(),
+        p.to_str().unwrap(),
+        &["'nothere.webp' is missing"],
+    );
+    let e = load_bytes(meta.as_bytes(), None, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("needs its path"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------- glTF with SPZ compression ----------
+
+/// A `.glb` with `KHR_gaussian_splatting_compression_spz_2` (8 splats, SH 1) whose JSON and
+/// BIN `edit` changes.
+fn glb_spz_with(edit: impl FnOnce(&mut Value, &mut Vec<u8>)) -> Vec<u8> {
+    let glb = splatgl::write::to_glb_spz(&random_cloud(8, 1, 5.0, 3)).unwrap();
+    let (mut doc, mut bin) = packed::glb_chunks(&glb);
+    edit(&mut doc, &mut bin);
+    packed::glb_of(&doc, &bin)
+}
+
+const SPZ_EXT: &str = "/meshes/0/primitives/0/extensions/KHR_gaussian_splatting/extensions/KHR_gaussian_splatting_compression_spz_2";
+
+#[test]
+fn malformed_spz_compressed_gltf_gives_precise_errors() {
+    let ext_path =
+        "extensions.KHR_gaussian_splatting.extensions.KHR_gaussian_splatting_compression_spz_2";
+    expect(
+        &glb_spz_with(|d, _| d.pointer_mut(SPZ_EXT).unwrap()["bufferView"] = json!("zero")),
+        "a.glb",
+        &[ext_path, "'bufferView' is missing or not an index"],
+    );
+    expect(
+        &glb_spz_with(|d, _| d.pointer_mut(SPZ_EXT).unwrap()["bufferView"] = json!(7)),
+        "a.glb",
+        &["bufferViews[7] does not exist"],
+    );
+    // A view running past its buffer.
+    expect(
+        &glb_spz_with(|d, _| d["bufferViews"][0]["byteLength"] = json!(1 << 20)),
+        "a.glb",
+        &["exceeds buffers[0]"],
+    );
+    // A truncated gzip member.
+    expect(
+        &glb_spz_with(|d, b| {
+            let half = b.len() / 2;
+            b.truncate(half);
+            d["buffers"][0]["byteLength"] = json!(half);
+            d["bufferViews"][0]["byteLength"] = json!(half);
+        }),
+        "a.glb",
+        &["bufferViews[0]: SPZ: gzip"],
+    );
+    // A gzip bomb: a header claiming 10⁷ points, then zeros.
+    expect(
+        &glb_spz_with(|d, b| {
+            let mut raw = gunzip(b);
+            raw[8..12].copy_from_slice(&10_000_000u32.to_le_bytes());
+            raw.resize(raw.len() + (32 << 20), 0);
+            *b = gzip(&raw);
+            d["buffers"][0]["byteLength"] = json!(b.len());
+            d["bufferViews"][0]["byteLength"] = json!(b.len());
+        }),
+        "a.glb",
+        &["SPZ:", "budget"],
+    );
+}
+
+/// What the loader works around is still an error for `validate`: placeholder counts that
+/// differ from the payload's, an SPZ version the extension does not pin.
+#[test]
+fn spz_compressed_gltf_spec_violations_are_validation_errors() {
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (
+            glb_spz_with(|d, _| d["accessors"][2]["count"] = json!(9)),
+            "placeholder accessor count 9, but the SPZ payload holds 8 points",
+        ),
+        (
+            glb_spz_with(|d, b| {
+                *b = to_spz_with(
+                    &random_cloud(8, 1, 5.0, 3),
+                    &SpzWriteOptions {
+                        version: splatgl::write::SpzVersion::V3,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
+                d["buffers"][0]["byteLength"] = json!(b.len());
+                d["bufferViews"][0]["byteLength"] = json!(b.len());
+            }),
+            "pins SPZ version 2, the payload is version 3",
+        ),
+    ];
+    for (glb, needle) in cases {
+        let scene = load_bytes(&glb, None, &LoadOptions::default()).unwrap();
+        assert_eq!(scene.cloud.len(), 8);
+        let r = validate_bytes(&glb, None, &LoadOptions::default());
+        assert_eq!(r.status(), Status::Invalid, "{needle}");
+        assert!(
+            r.findings.iter().any(|f| f.message.contains(needle)),
+            "{needle}: {:#?}",
+            r.findings
+        );
+    }
 }
 
 // ---------- Images (PNG, PFM) read by `compare` ----------

@@ -44,7 +44,8 @@ pub enum SortArg {
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (.ply, .gltf, .glb). Without it: the bundled default scene.
+    /// Scene file (.ply, .gltf, .glb, .spz, .splat, .ksplat, .sog, SOG meta.json). Without it:
+    /// the bundled default scene.
     pub scene: Option<PathBuf>,
     /// 3DGS cameras.json to take the view from (see --view).
     #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
@@ -63,7 +64,8 @@ pub struct Args {
     /// Use the N-th glTF camera node of the scene.
     ///
     /// Without any camera option the view frames the scene: glTF from +Z with +Y up, PLY
-    /// (COLMAP axes) from +Z with −Y up; the default scene has its own camera.
+    /// (COLMAP axes, also SPZ, .splat, .ksplat and SOG) from +Z with −Y up; the default scene
+    /// has its own camera.
     #[arg(long, value_name = "N")]
     pub gltf_camera: Option<usize>,
     /// Image width (default 640, or the cameras.json view's, scaled).
@@ -200,7 +202,8 @@ fn camera(
     if a.scene.is_none() {
         return Ok(splatgl::scene::default_camera(w, h));
     }
-    let framed = if format == Some(Format::Ply) {
+    // Every format but glTF is in PLY axes (SPZ is converted to them).
+    let framed = if !matches!(format, Some(Format::Gltf | Format::Glb)) {
         // INRIA/COLMAP axes: −Y up. Look from +Z, slightly from above (−Y).
         let fwd = Vec3::new(0.0, 0.35, -1.0);
         Camera::frame_points_along(&cloud.positions, fwd, -Vec3::Y, fov, w, h)

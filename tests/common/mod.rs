@@ -1,6 +1,6 @@
 //! Shared test helpers: the seeded generator and random clouds (from `splatgl::scene`), the
 //! real-data folder, cameras and single-colour SH. The GL helpers (headless renderer, scores,
-//! error bounds) are in [`gl`].
+//! error bounds) are in [`gl`]; test-side encoders of the packed formats in [`packed`].
 #![allow(dead_code, unused_imports)]
 
 use glam::Vec3;
@@ -11,6 +11,7 @@ pub use splatgl::scene::{Rng, random_cloud};
 
 #[cfg(feature = "gl")]
 pub mod gl;
+pub mod packed;
 
 /// The shared real-data folder (`../shared/data/real`, beside the checkout).
 fn real_dir() -> PathBuf {

@@ -5,8 +5,8 @@ use super::accessor::{Decoded, decode};
 use super::container::PREFIX;
 use super::rules;
 use crate::cloud::{ColorSpace, SplatCloud, SplatMeta};
-use crate::load::Finding;
-use crate::load::{ScaleSeen, ScaleSpace};
+use crate::load::spz::SpzAxes;
+use crate::load::{Details, Finding, ScaleSeen, ScaleSpace};
 use gltf::accessor::DataType;
 use serde_json::{Map, Value};
 
@@ -19,6 +19,8 @@ pub struct LocalSplats {
     pub scale_seen: ScaleSeen,
     /// Quaternions that were not unit within tolerance.
     pub non_unit: usize,
+    /// Container facts of a compressed primitive (SPZ), `None` for plain accessors.
+    pub details: Option<Details>,
 }
 
 /// Context for reading one primitive.
@@ -29,8 +31,10 @@ pub struct Ctx<'a> {
     pub buffers: &'a [Vec<u8>],
     /// `meshes[m].primitives[p]`.
     pub path: String,
-    /// Options.
+    /// How SCALE values are read.
     pub scale_space: ScaleSpace,
+    /// Axes of SPZ payloads (compressed primitives).
+    pub spz_axes: SpzAxes,
     /// Whether `KHR_mesh_quantization` is in `extensionsUsed` (quantized POSITION allowed).
     pub quantization: bool,
     /// Values the document may still decode (see [`decode`]).
@@ -49,6 +53,11 @@ pub fn read(
     f: &mut Vec<Finding>,
 ) -> Option<LocalSplats> {
     check_primitive(&ctx.path, prim, f);
+    if let Some((kind, ext, ext_path)) = super::spz::compression(prim, &ctx.path) {
+        let mut ls = super::spz::read(ctx, prim, kind, ext, &ext_path, f)?;
+        ls.cloud.meta = meta.clone();
+        return Some(ls);
+    }
     let attrs = fetch(ctx, prim, f)?;
     rules::check_types_and_counts(ctx, &attrs, f)?;
     let degree = rules::sh_degree(&ctx.path, &attrs.higher, f);
@@ -225,7 +234,11 @@ fn assemble(
             non_unit += 1;
             first_non_unit.get_or_insert(i);
         }
-        let q = q.map(|v| (v as f64 / norm) as f32);
+        let q = if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
+            q // unit to f32 rounding: kept bit for bit
+        } else {
+            q.map(|v| (v as f64 / norm) as f32)
+        };
         let s: [f32; 3] = a.scale.get(i);
         let s = if log {
             s.map(f32::exp)
@@ -268,6 +281,7 @@ fn assemble(
         cloud,
         scale_seen,
         non_unit,
+        details: None,
     })
 }
 

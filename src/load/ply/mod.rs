@@ -296,6 +296,7 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
     report.scale_space = Some(ScaleSeen::Log);
     if compressed::is_compressed(vertex) {
         let cloud = compressed::decode(&header, body)?;
+        report.details = Some(compressed::details(cloud.sh_degree));
         report.findings.push(Finding::warning(
             "",
             "PlayCanvas compressed PLY: quantised positions, scales, rotations and colours",
