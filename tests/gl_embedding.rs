@@ -548,6 +548,12 @@ fn render_scene(gl: &glow::Context, cam: &Camera, bg: [f32; 3], draw: &mut dyn F
     image
 }
 
+/// `cloud` under `model`, placed by the glTF loader's node-transform code.
+fn place(cloud: &SplatCloud, model: Mat4) -> SplatCloud {
+    splatgl::load::gltf::apply_node_transform(cloud, model.as_dmat4(), 0, &mut Vec::new())
+        .expect("finite")
+}
+
 #[test]
 fn interleaved_clouds_render_like_the_merged_cloud_through_the_reference() {
     let Some(ctx) = or_skip(HeadlessContext::new(), "headless context") else {
@@ -569,8 +575,8 @@ fn interleaved_clouds_render_like_the_merged_cloud_through_the_reference() {
     let cam = look_at_fov_deg(Vec3::new(0.5, 0.6, 3.2), Vec3::ZERO, 50.0, 80, 64);
     let bg = [0.05, 0.05, 0.08];
     let merged = |mb: Mat4| {
-        let mut m = splatgl::load::gltf::apply_node_transform(&a, ma.as_dmat4()).unwrap();
-        let tb = splatgl::load::gltf::apply_node_transform(&b, mb.as_dmat4()).unwrap();
+        let mut m = place(&a, ma);
+        let tb = place(&b, mb);
         m.append(tb);
         m
     };
@@ -595,8 +601,7 @@ fn interleaved_clouds_render_like_the_merged_cloud_through_the_reference() {
     r.settings_mut().depth_test = false;
     let separate = render_scene(gl, &cam, bg, &mut || {
         for (cloud, model) in [(&a, ma), (&b, mb(0.3))] {
-            let placed =
-                splatgl::load::gltf::apply_node_transform(cloud, model.as_dmat4()).unwrap();
+            let placed = place(cloud, model);
             r.upload(gl, &placed).unwrap();
             let mut order = Vec::new();
             sort_back_to_front(&placed.positions, cam.eye(), &mut order);

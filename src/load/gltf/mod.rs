@@ -37,15 +37,6 @@ use std::cell::Cell;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// A local-space cloud under a node's global matrix, exactly as the loader places a
-/// primitive (positions, Σ = M C Cᵀ Mᵀ, SH rotated by M's polar rotation); `None` when the
-/// transform makes a splat non-finite. Public for the GL scene tests, which compare model
-/// matrices applied in the shader with this (hidden from the documented API).
-#[doc(hidden)]
-pub fn apply_node_transform(local: &SplatCloud, m: DMat4) -> Option<SplatCloud> {
-    transform::apply(local, m, 0, &mut Vec::new())
-}
-
 /// Why a glTF file could not be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum GltfError {
