@@ -16,14 +16,17 @@
 //! with scales × 0.2·(10⁵/n)^(1/3), so the covered screen area is about the same for both sizes;
 //! camera at distance 3.2, 50° vertical fov.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use std::time::{Duration, Instant};
 
+use common::gl::or_skip;
 use glam::Vec3;
 use glow::HasContext;
 use splatgl::camera::Camera;
-use splatgl::gl::sort::DistanceSorter;
-use splatgl::gl::{OffscreenTarget, SplatRenderer};
-use splatgl::headless::{HeadlessContext, HeadlessError};
+use splatgl::gl::{ColorFormat, DistanceSorter, OffscreenTarget, ReadbackTarget, SplatRenderer};
+use splatgl::headless::HeadlessContext;
 use splatgl::scene;
 
 /// CPU time of the whole process (all threads, so llvmpipe's rasterizer threads count), which
@@ -72,38 +75,15 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1.0);
-    let ctx = match HeadlessContext::new() {
-        Ok(c) => c,
-        Err(HeadlessError::EglUnavailable(m)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
+    let Some(ctx) = or_skip(HeadlessContext::new(), "headless context") else {
+        return;
     };
     let gl = ctx.gl();
     println!("context: {}", ctx.describe());
     let (w, h) = (1280u32, 720u32);
-    // SAFETY: creates and binds an RGBA8 renderbuffer FBO of the frame size on the current
-    // context; it stays bound for the whole benchmark and is deleted at the end.
-    let (fbo, rb) = unsafe {
-        let rb = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
-        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, w as i32, h as i32);
-        let fbo = gl.create_framebuffer().unwrap();
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::COLOR_ATTACHMENT0,
-            glow::RENDERBUFFER,
-            Some(rb),
-        );
-        assert_eq!(
-            gl.check_framebuffer_status(glow::FRAMEBUFFER),
-            glow::FRAMEBUFFER_COMPLETE
-        );
-        gl.viewport(0, 0, w as i32, h as i32);
-        (fbo, rb)
-    };
+    // An RGBA8 framebuffer of the frame size, bound for the whole benchmark.
+    let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8, None).unwrap();
+    frame.bind(gl).unwrap();
     let mut renderer = SplatRenderer::new(gl).unwrap();
     let mut offscreen = OffscreenTarget::new(gl, w, h).unwrap();
     let mut sorter = DistanceSorter::default();
@@ -152,9 +132,9 @@ fn main() {
             let t2 = Instant::now();
             let c2 = cpu_time();
             if float_target {
-                offscreen.begin(gl, [0.0; 4]);
+                offscreen.begin(gl, [0.0; 4]).unwrap();
                 renderer.draw_current(gl, &cam).unwrap();
-                offscreen.resolve(gl, false);
+                offscreen.resolve(gl, false).unwrap();
             } else {
                 renderer.draw_current(gl, &cam).unwrap();
             }
@@ -191,10 +171,5 @@ fn main() {
     }
     renderer.destroy(gl);
     offscreen.destroy(gl);
-    // SAFETY: deleting the objects created above.
-    unsafe {
-        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-        gl.delete_framebuffer(fbo);
-        gl.delete_renderbuffer(rb);
-    }
+    frame.destroy(gl);
 }

@@ -6,11 +6,12 @@ uniform int u_encode_srgb;    // 1: linear -> sRGB transfer function on RGB
 
 layout(location = 0) out vec4 o_frag_color;
 
+// The sRGB curve of splatgl::profile (SRGB_* defines).
 vec3 linear_to_srgb(vec3 c) {
     c = clamp(c, 0.0, 1.0);
-    vec3 lo = c * 12.92;
-    vec3 hi = 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055;
-    return mix(hi, lo, lessThanEqual(c, vec3(0.0031308)));
+    vec3 lo = c * SRGB_LINEAR_SLOPE;
+    vec3 hi = SRGB_SCALE * pow(c, vec3(1.0 / SRGB_GAMMA)) - SRGB_OFFSET;
+    return mix(hi, lo, lessThanEqual(c, vec3(SRGB_ENCODE_THRESHOLD)));
 }
 
 void main() {

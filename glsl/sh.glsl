@@ -1,5 +1,6 @@
 // Spherical-harmonics colour (vertex stage), RC basis with the Condon-Shortley phase
-// (identical to 3DGS computeColorFromSH). Constants SH_C* come from splatgl::sh.
+// (identical to 3DGS computeColorFromSH). Constants SH_C* come from splatgl::sh, SH_DC_BIAS
+// and the texel counts from splatgl::profile.
 
 vec4 sh_texels[MAX_SH_TEXELS];
 
@@ -11,34 +12,31 @@ vec3 sh_coef(int k) {
 
 vec3 sh_color(int splat, vec3 view_dir) {
     int degree = u_sh_degree;
-    int coeffs = (degree + 1) * (degree + 1);
-    int needed = (3 * coeffs + 3) / 4;
     for (int i = 0; i < MAX_SH_TEXELS; ++i) {
-        if (i >= needed) break;
+        if (i >= u_sh_fetch_texels) break;
         int linear_index = splat * u_sh_texels + i;
-        sh_texels[i] = texelFetch(u_sh, ivec2(linear_index & (TEX_WIDTH - 1),
-                                              linear_index >> TEX_WIDTH_LOG2), 0);
+        sh_texels[i] = texelFetch(u_sh, texel_coord(linear_index), 0);
     }
     float x = view_dir.x, y = view_dir.y, z = view_dir.z;
     vec3 result = SH_C0 * sh_coef(0);
 #ifdef ERRATUM_E
-    // Appendix literal: no Condon-Shortley signs, 2.89 for coefficient 14, sigmoid colour.
+    // Appendix literal: no Condon-Shortley signs (the magnitudes of the RC's constants, which
+    // the appendix spells to 10 digits), 2.89 (SH_C3_1) for coefficient 14, sigmoid colour.
     if (degree >= 1) {
-        result += 0.4886025119 * y * sh_coef(1) + 0.4886025119 * z * sh_coef(2)
-                + 0.4886025119 * x * sh_coef(3);
+        result += SH_C1 * y * sh_coef(1) + SH_C1 * z * sh_coef(2) + SH_C1 * x * sh_coef(3);
         if (degree >= 2) {
             float xx = x * x, yy = y * y, zz = z * z;
-            result += 1.09254843059 * x * y * sh_coef(4) + 1.09254843059 * y * z * sh_coef(5)
-                    + 0.31539156525 * (3.0 * zz - 1.0) * sh_coef(6)
-                    + 1.09254843059 * x * z * sh_coef(7) + 0.54627421529 * (xx - yy) * sh_coef(8);
+            result += SH_C2_0 * x * y * sh_coef(4) + abs(SH_C2_1) * y * z * sh_coef(5)
+                    + SH_C2_2 * (3.0 * zz - 1.0) * sh_coef(6)
+                    + abs(SH_C2_3) * x * z * sh_coef(7) + SH_C2_4 * (xx - yy) * sh_coef(8);
             if (degree >= 3) {
-                result += 0.5900435899 * y * (3.0 * xx - yy) * sh_coef(9)
-                        + 2.8906114426 * x * y * z * sh_coef(10)
-                        + 0.4570457996 * y * (5.0 * zz - 1.0) * sh_coef(11)
-                        + 0.3731763325 * z * (5.0 * zz - 3.0) * sh_coef(12)
-                        + 0.4570457996 * x * (5.0 * zz - 1.0) * sh_coef(13)
-                        + 2.8906114426 * z * (xx - yy) * sh_coef(14)
-                        + 0.5900435899 * x * (xx - 3.0 * yy) * sh_coef(15);
+                result += abs(SH_C3_0) * y * (3.0 * xx - yy) * sh_coef(9)
+                        + SH_C3_1 * x * y * z * sh_coef(10)
+                        + abs(SH_C3_2) * y * (5.0 * zz - 1.0) * sh_coef(11)
+                        + SH_C3_3 * z * (5.0 * zz - 3.0) * sh_coef(12)
+                        + abs(SH_C3_4) * x * (5.0 * zz - 1.0) * sh_coef(13)
+                        + SH_C3_1 * z * (xx - yy) * sh_coef(14)
+                        + abs(SH_C3_6) * x * (xx - 3.0 * yy) * sh_coef(15);
             }
         }
     }

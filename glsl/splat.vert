@@ -3,7 +3,9 @@
 // Mirrors the step structure of KHR_gaussian_splatting (review draft) Appendix A with every
 // erratum fixed; docs/appendix-errata.md lists each deviation. The `#version` line, precision
 // statements and every numeric constant (SH_C*, DILATION, CUTOFF_M2, ALPHA_MAX, ALPHA_MIN,
-// FOV_CLAMP, texture layout) are injected from Rust as `#define`s; `ERRATUM_*`
+// FOV_CLAMP, SH_DC_BIAS, texture layout GEOM_* / MAX_SH_TEXELS / TEX_WIDTH / LAYER_ROWS,
+// MAX_CLOUDS) are injected from
+// Rust (splatgl::profile, splatgl::sh) as `#define`s; `ERRATUM_*`
 // defines switch in the appendix's literal behaviour for the erratum tests only.
 //
 // Data path (erratum j): the appendix's 21 vertex attributes cannot link on GLES 3.0 (16
@@ -12,12 +14,15 @@
 
 layout(location = 0) in uint a_splat_index;
 
-// GEOM_TEXELS RGBA32F texels per splat: (position.xyz, opacity), rotation xyzw, (scale.xyz, 0).
-uniform highp sampler2D u_geometry;
+// GEOM_TEXELS RGBA32F texels per splat: (position.xyz, opacity), rotation xyzw,
+// (scale.xyz, model index) at GEOM_TEXEL_POSITION_OPACITY, GEOM_TEXEL_ROTATION,
+// GEOM_TEXEL_SCALE. Array textures: a cloud larger than one layer continues on the next.
+uniform highp sampler2DArray u_geometry;
 // ceil(3 * coefficients / 4) RGBA16F texels per splat: RGB triples, degree-major, m = -l..l.
-uniform highp sampler2D u_sh;
+uniform highp sampler2DArray u_sh;
 uniform int u_sh_texels;      // SH texels per splat in u_sh
 uniform int u_sh_degree;      // degree to evaluate, 0..=cloud degree (run-time choice)
+uniform int u_sh_fetch_texels; // SH texels holding degrees 0..=u_sh_degree
 
 uniform mat4 u_view_matrix;        // world -> GL eye space (looks down -z)
 uniform mat4 u_projection_matrix;  // GL eye -> clip
@@ -27,17 +32,25 @@ uniform vec3 u_camera_position;    // eye in world space
 uniform vec4 u_viewport;           // x, y, width, height in window pixels
 uniform float u_cull_depth;        // max(NEAR_CULL, camera near): 3DGS in_frustum
 uniform int u_splat_count;         // splats uploaded: an order index past them is culled
+// Model matrices of a scene's clouds (splat data is in model space); u_model_count = 0 when
+// every model is the identity, which skips the transform.
+uniform int u_model_count;
+uniform vec4 u_model_rows[3 * MAX_CLOUDS]; // rows 0..2 of each model's affine matrix
+uniform mat3 u_sh_rotation[MAX_CLOUDS];    // world -> model directions (polar rotation^T)
 
 flat out vec3 v_color;
 flat out float v_opacity;
 flat out vec3 v_cov2d_inv_upper;   // (S^-1)[0][0], (S^-1)[0][1], (S^-1)[1][1], window pixels
 flat out vec2 v_center_px;         // window pixels (gl_FragCoord's frame: y up)
 
-//@include sh.glsl
-
-ivec2 texel_coord(int linear_index) {
-    return ivec2(linear_index & (TEX_WIDTH - 1), linear_index >> TEX_WIDTH_LOG2);
+// Linear texel index -> (x, y, layer) in the data textures.
+ivec3 texel_coord(int linear_index) {
+    return ivec3(linear_index & (TEX_WIDTH - 1),
+                 (linear_index >> TEX_WIDTH_LOG2) & (LAYER_ROWS - 1),
+                 linear_index >> (TEX_WIDTH_LOG2 + LAYER_ROWS_LOG2));
 }
+
+//@include sh.glsl
 
 vec4 fetch_geometry(int splat, int k) {
     return texelFetch(u_geometry, texel_coord(splat * GEOM_TEXELS + k), 0);
@@ -59,11 +72,21 @@ void main() {
         return;
     }
     int splat = int(a_splat_index);
-    vec4 geom0 = fetch_geometry(splat, 0);
-    vec4 a_glob_rotation = fetch_geometry(splat, 1);
-    vec4 geom2 = fetch_geometry(splat, 2);
+    vec4 geom0 = fetch_geometry(splat, GEOM_TEXEL_POSITION_OPACITY);
+    vec4 a_glob_rotation = fetch_geometry(splat, GEOM_TEXEL_ROTATION);
+    vec4 geom2 = fetch_geometry(splat, GEOM_TEXEL_SCALE);
     vec3 a_glob_position = geom0.xyz;
     float a_glob_opacity = geom0.w;
+    // A scene's cloud: world position = model * position (the loader's node transform).
+    int model = min(int(geom2.w), MAX_CLOUDS - 1);
+    mat3 model_linear = mat3(1.0);
+    if (u_model_count > 0) {
+        vec4 r0 = u_model_rows[3 * model], r1 = u_model_rows[3 * model + 1],
+             r2 = u_model_rows[3 * model + 2];
+        vec4 p = vec4(a_glob_position, 1.0);
+        a_glob_position = vec3(dot(r0, p), dot(r1, p), dot(r2, p));
+        model_linear = transpose(mat3(r0.xyz, r1.xyz, r2.xyz));
+    }
 
     // --- STEP 1: view-space position and near cull ---
     vec4 view_space_pos = u_view_matrix * vec4(a_glob_position, 1.0);
@@ -97,6 +120,10 @@ void main() {
 #endif
     mat3 scale_matrix = mat3(scale.x, 0.0, 0.0, 0.0, scale.y, 0.0, 0.0, 0.0, scale.z);
     mat3 M = rotation_matrix * scale_matrix;
+    // A model matrix A: sigma3d = A R S S^T R^T A^T (the loader's M C C^T M^T), i.e. M = A R S.
+    if (u_model_count > 0) {
+        M = model_linear * M;
+    }
     // sigma3d = M * transpose(M); kept factored: Step 3 needs only M.
 
     // --- STEP 3: projection + Jacobian -> 2D covariance  Sigma' = J W Sigma W^T J^T ---
@@ -180,12 +207,19 @@ void main() {
     clip_space_pos.xy += offset_px * (2.0 / u_viewport.zw) * clip_space_pos.w;
 #endif
     // No far cull (3DGS has none, nor has the reference): keep the depth inside the clip
-    // volume so splats beyond the projection's far plane are not clipped away.
-    clip_space_pos.z = min(clip_space_pos.z, clip_space_pos.w * (1.0 - 1e-6));
+    // volume so splats beyond the projection's far plane are not clipped away (at +w for a
+    // standard projection, at -w for a reversed-Z one).
+    float z_limit = clip_space_pos.w * (1.0 - 1e-6);
+    clip_space_pos.z = clamp(clip_space_pos.z, -z_limit, z_limit);
     gl_Position = clip_space_pos;
 
     // --- STEP 5: view-dependent colour from spherical harmonics ---
     vec3 view_dir = normalize(a_glob_position - u_camera_position);
+    // In a cloud's model space, as the loader's Wigner-D rotation of the SH by the polar
+    // rotation of the model matrix does: colour'(d) = colour(R^T d).
+    if (u_model_count > 0) {
+        view_dir = u_sh_rotation[model] * view_dir;
+    }
     v_color = sh_color(splat, view_dir);
     if (any(isnan(v_color)) || any(isinf(v_color))) {
         cull();

@@ -3,15 +3,22 @@
 //! A renderer for 3D Gaussian splats and the reference implementation of the glTF extension
 //! `KHR_gaussian_splatting` (Release Candidate).
 //!
-//! Data flow, one module per stage:
-//! `load` (glTF / PLY → [`SplatCloud`]) → `sort` → `gl` (draw) with the CPU `reference`
-//! rasterizer beside it, and `compare` for image comparison.
+//! Data flow, one module per stage: [`load`] (glTF / PLY / SPZ / .splat / .ksplat / SOG →
+//! [`SplatCloud`], with its [`cloud`] metadata) → [`sort`] → `gl` (draw; `headless` drives it without a window) with
+//! the CPU [`reference`](mod@reference) rasterizer beside it, [`compare`] for image comparison, [`image`] for
+//! PNG / PFM files and [`write`](mod@write) for glTF / PLY output. [`camera`] holds the camera model,
+//! [`profile`] every number of the rendering profile and [`sh`] the spherical harmonics.
+//! The module map with the documentation pages is in the README.
 #![warn(missing_docs)]
 
 pub mod camera;
 pub mod cloud;
-pub mod color;
 pub mod compare;
+pub mod conformance;
+pub mod convert;
+// Covariance algebra behind the loader's node transforms: public for the node-transform tests,
+// not part of the documented API (`SplatCloud::covariance` is the user-facing form).
+#[doc(hidden)]
 pub mod covariance;
 pub mod files;
 #[cfg(feature = "gl")]
@@ -20,7 +27,11 @@ pub mod gl;
 pub mod headless;
 pub mod image;
 pub mod load;
+pub mod profile;
 pub mod reference;
+// Synthetic scenes (the CLI's default scene, seeded random clouds for tests, benches and
+// examples): public for those targets, not part of the documented API.
+#[doc(hidden)]
 pub mod scene;
 pub mod sh;
 pub mod sort;

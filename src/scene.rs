@@ -4,7 +4,7 @@
 
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
-use crate::sh::{SH_C0, SH_C1};
+use crate::sh::{SH_C1, dc_from_color};
 use glam::{Quat, Vec3};
 use std::f32::consts::TAU;
 
@@ -65,7 +65,7 @@ pub fn random_cloud(n: usize, sh_degree: u8, extent: f32, seed: u64) -> SplatClo
         let s = [(); 3].map(|_| rng.range(0.01, 0.08) * extent);
         let q = rng.quat();
         let o = rng.range(0.2, 1.0);
-        sh[0] = [(); 3].map(|_| (rng.range(0.1, 0.9) - 0.5) / SH_C0 as f32);
+        sh[0] = [(); 3].map(|_| dc_from_color(rng.range(0.1, 0.9) as f64));
         for c in sh.iter_mut().skip(1) {
             *c = [(); 3].map(|_| rng.range(-0.3, 0.3));
         }
@@ -81,7 +81,7 @@ fn sheen_sh(rgb: [f32; 3], n: Vec3, k: f32) -> [[f32; 3]; 4] {
     // Σ c·Y over degree 1 = −C1·y·c₋₁ + C1·z·c₀ − C1·x·c₁ = −k (nx x + ny y + nz z).
     let (cm1, c0, cp1) = (k * n.y / c1, -k * n.z / c1, k * n.x / c1);
     [
-        rgb.map(|c| (c - 0.5) / SH_C0 as f32),
+        rgb.map(|c| dc_from_color(c as f64)),
         [cm1; 3],
         [c0; 3],
         [cp1; 3],

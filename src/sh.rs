@@ -8,6 +8,7 @@
 //! linear system — no Euler-angle recursion to get wrong. The tests check the result at other
 //! directions.
 
+use crate::profile::SH_DC_BIAS;
 use glam::{DMat3, DVec3};
 
 /// Y₀₀.
@@ -32,6 +33,17 @@ pub const SH_C3: [f64; 7] = [
     1.445_305_721_320_277,
     -0.590_043_589_926_643_5,
 ];
+
+/// The DC coefficient whose colour (the DC term alone: `SH_C0·dc + 0.5`, RC §Lighting) is `c`:
+/// `(c − 0.5) / SH_C0`, in f64, rounded once to f32. The inverse of [`color_from_dc`].
+pub fn dc_from_color(c: f64) -> f32 {
+    ((c - SH_DC_BIAS) / SH_C0) as f32
+}
+
+/// The colour of a DC coefficient alone: `SH_C0·dc + 0.5` (before any clamping).
+pub fn color_from_dc(dc: f32) -> f64 {
+    dc as f64 * SH_C0 + SH_DC_BIAS
+}
 
 /// Evaluates the 16 basis functions at a unit direction (coefficient order of the cloud).
 pub fn basis(d: [f64; 3]) -> [f64; 16] {
@@ -62,7 +74,7 @@ pub fn basis(d: [f64; 3]) -> [f64; 16] {
 pub fn eval_color(coeffs: &[[f32; 3]], degree: u8, dir: [f32; 3]) -> [f32; 3] {
     let n = crate::cloud::sh_coeff_count(degree).min(coeffs.len());
     let y = basis(dir.map(f64::from));
-    let mut c = [0.5f64; 3];
+    let mut c = [SH_DC_BIAS; 3];
     for (k, coef) in coeffs[..n].iter().enumerate() {
         for ch in 0..3 {
             c[ch] += y[k] * coef[ch] as f64;
@@ -218,5 +230,16 @@ mod tests {
         let col = eval_color(&c, 1, [0.0, 1.0, 0.0]);
         assert!((col[0] - (0.5 - SH_C1 as f32)).abs() < 1e-6);
         assert_eq!(col[1], 0.5);
+    }
+
+    #[test]
+    fn dc_conversions_invert_each_other_and_match_eval_color() {
+        for c in [0.0, 0.1, 0.5, 0.73, 1.0, 1.4] {
+            let dc = dc_from_color(c);
+            assert!((color_from_dc(dc) - c).abs() < 1e-6, "{c}");
+            let col = eval_color(&[[dc; 3]], 0, [0.0, 0.0, 1.0]);
+            assert!((col[0] as f64 - c).abs() < 1e-6, "{c}: {col:?}");
+        }
+        assert_eq!(dc_from_color(0.5), 0.0);
     }
 }

@@ -1,6 +1,9 @@
-//! The `info` and `validate` commands: JSON keys (a contract for users' scripts) and exit codes.
+//! The command line: `info` and `validate` JSON keys (a contract for users' scripts) and exit
+//! codes, `render` with both backends and from a glTF camera, `compare`, and errors reported as
+//! messages, not panics.
 
 mod common;
+use splatgl::image::Image;
 use std::process::Command;
 
 fn splatgl(args: &[&str]) -> (i32, String, String) {
@@ -25,7 +28,7 @@ fn tmp(name: &str, bytes: &[u8]) -> std::path::PathBuf {
 
 #[test]
 fn validate_exit_codes() {
-    let cloud = common::random_cloud(1, 10, 2);
+    let cloud = common::random_cloud(10, 2, 5.0, 1);
     let good = tmp(
         "good.glb",
         &splatgl::write::to_glb(&cloud, &Default::default()),
@@ -47,7 +50,7 @@ fn validate_exit_codes() {
 
 #[test]
 fn info_json_keys() {
-    let cloud = common::random_cloud(2, 33, 1);
+    let cloud = common::random_cloud(33, 1, 5.0, 2);
     let p = tmp("c.ply", &splatgl::write::to_inria_ply(&cloud));
     let (code, out, err) = splatgl(&["info", "--json", p.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
@@ -70,6 +73,80 @@ fn info_json_keys() {
     let (code, _, err) = splatgl(&["info", "/nonexistent.glb"]);
     assert_eq!(code, 2);
     assert!(err.contains("nonexistent.glb"), "{err}");
+}
+
+/// `info` on quantized containers: the container keys (`container`, `container_version`,
+/// `compression`, `gltf_extension`, `quantization`, `lossy`, `antialiased`) in `--json`, null
+/// for plain files, and the same facts as text; `validate` takes the SPZ-compressed `.glb` as
+/// valid, and `--spz-axes` is accepted by both.
+#[test]
+fn info_reports_the_container_and_validate_accepts_spz_compression() {
+    let cloud = common::random_cloud(20, 1, 5.0, 4);
+    let o = splatgl::write::SpzWriteOptions {
+        version: splatgl::write::SpzVersion::V3,
+        antialiased: true,
+        ..Default::default()
+    };
+    let spz = tmp("c.spz", &splatgl::write::to_spz_with(&cloud, &o).unwrap());
+    let glb = tmp("c_spz.glb", &splatgl::write::to_glb_spz(&cloud).unwrap());
+    let ply = tmp("plain.ply", &splatgl::write::to_inria_ply(&cloud));
+    let json = |p: &std::path::Path| -> serde_json::Value {
+        let (code, out, err) = splatgl(&["info", "--json", p.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let v = json(&spz);
+    assert_eq!(v["format"], "spz");
+    assert_eq!(v["container"], "spz");
+    assert_eq!(v["container_version"], "3");
+    assert_eq!(v["compression"], "gzip");
+    assert_eq!(v["gltf_extension"], serde_json::Value::Null);
+    assert_eq!(v["antialiased"], true);
+    let q = v["quantization"].as_array().unwrap();
+    let bits = |a: &str| {
+        q.iter()
+            .find(|e| e["attribute"] == a)
+            .map(|e| e["bits"].clone())
+    };
+    assert_eq!(bits("position"), Some(serde_json::json!(24)));
+    assert_eq!(bits("rotation"), Some(serde_json::json!(10)));
+    assert_eq!(bits("sh"), Some(serde_json::json!(8)));
+    assert!(!v["lossy"].as_array().unwrap().is_empty());
+    let v = json(&glb);
+    assert_eq!(v["format"], "glb");
+    assert_eq!(v["container_version"], "2");
+    assert_eq!(
+        v["gltf_extension"],
+        "KHR_gaussian_splatting_compression_spz_2"
+    );
+    assert_eq!(v["antialiased"], false);
+    let v = json(&ply);
+    for key in [
+        "container",
+        "container_version",
+        "quantization",
+        "lossy",
+        "antialiased",
+    ] {
+        assert_eq!(v[key], serde_json::Value::Null, "{key} of a plain PLY");
+    }
+    let (code, out, _) = splatgl(&["info", spz.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    assert!(out.contains("container:      spz v3, gzip"), "{out}");
+    assert!(out.contains("antialiased:    yes"), "{out}");
+    assert!(out.contains("position  24 bits"), "{out}");
+    let (code, out, _) = splatgl(&["validate", "--spz-axes", "raw", glb.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+    let (code, out, _) = splatgl(&["validate", "--json", glb.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (v["status"].as_str(), v["splat_count"].as_u64()),
+        (Some("valid"), Some(20))
+    );
+    let (code, _, err) = splatgl(&["info", "--spz-axes", "sideways", spz.to_str().unwrap()]);
+    assert_eq!(code, 2, "clap's usage error");
+    assert!(err.contains("expected auto, rub or raw"), "{err}");
 }
 
 /// Both backends show a `lin_rec709_display` cloud the same way: blended in linear, encoded
@@ -146,7 +223,7 @@ fn backends_agree_on_linear_colour_space() {
 #[test]
 fn render_takes_the_view_from_a_gltf_camera_node() {
     use base64::Engine;
-    let cloud = common::random_cloud(7, 200, 1);
+    let cloud = common::random_cloud(200, 1, 5.0, 7);
     let (mut doc, bin) = splatgl::write::build(&cloud, &Default::default());
     doc["nodes"]
         .as_array_mut()
@@ -187,4 +264,71 @@ fn render_takes_the_view_from_a_gltf_camera_node() {
     let (code, _, err) = splatgl(&[&args[..2], &["--gltf-camera", "1", "-o", o]].concat());
     assert_eq!(code, 2);
     assert!(err.contains("1 perspective camera node"), "{err}");
+}
+
+#[test]
+fn renders_the_default_scene_and_compares() {
+    let dir = std::env::temp_dir().join(format!("splatgl-cli-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, pfm, png16) = (dir.join("a.png"), dir.join("a.pfm"), dir.join("b.png"));
+    let p = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    let size = ["--width", "64", "--height", "48"];
+    for (out, extra) in [(&png, None), (&pfm, None), (&png16, Some("--depth16"))] {
+        let mut args = vec!["render", "--backend", "reference", "-o"];
+        let out = p(out);
+        args.push(&out);
+        args.extend(size);
+        args.extend(extra);
+        let (code, _, err) = splatgl(&args);
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            err.contains("splats") && err.contains("ms"),
+            "progress line: {err}"
+        );
+    }
+    let a = Image::read(&png).unwrap();
+    let f = Image::read(&pfm).unwrap();
+    assert_eq!((a.width, a.height), (64, 48));
+    // The 8-bit PNG is the float image quantised.
+    for (q, x) in a.pixels.iter().zip(&f.pixels) {
+        for c in 0..3 {
+            assert!((q[c] - x[c].clamp(0.0, 1.0)).abs() <= 0.5 / 255.0 + 1e-6);
+        }
+    }
+    let (code, out, _) = splatgl(&["compare", &p(&pfm), &p(&pfm), "--json", "--max-abs", "0"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["identical"], true);
+    let diff = p(&dir.join("d.png"));
+    let (code, out, _) = splatgl(&[
+        "compare",
+        &p(&png),
+        &p(&png16),
+        "--diff",
+        &diff,
+        "--max-abs",
+        "0",
+    ]);
+    assert_eq!(code, 1, "8- and 16-bit quantisations differ: {out}");
+    assert!(Image::read(&diff).is_ok());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn errors_are_reported_not_panics() {
+    let cases: [&[&str]; 5] = [
+        &["render", "--look-at", "1,2,3", "-o", "x.png"],
+        &["render", "--gltf-camera", "0", "-o", "x.png"],
+        &["render", "-o", "x.jpg", "--width", "8", "--height", "8"],
+        &["render", "/nonexistent/scene.ply"],
+        &["compare", "/nonexistent/a.png", "/nonexistent/b.png"],
+    ];
+    for args in cases {
+        let (code, _, err) = splatgl(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
 }

@@ -21,7 +21,7 @@ fn dir(name: &str) -> PathBuf {
 
 /// `asset/scene.gltf` whose buffer is `uri`; the buffer's bytes are also returned.
 fn scene_with_uri(asset: &Path, uri: &str) -> (PathBuf, Vec<u8>) {
-    let (mut doc, bin) = build(&random_cloud(1, 6, 1), &GltfWriteOptions::default());
+    let (mut doc, bin) = build(&random_cloud(6, 1, 5.0, 1), &GltfWriteOptions::default());
     doc["buffers"][0]["uri"] = json!(uri);
     let p = asset.join("scene.gltf");
     std::fs::write(&p, serde_json::to_vec(&doc).unwrap()).unwrap();
@@ -150,7 +150,7 @@ fn symlinks_are_followed_before_the_containment_check() {
 
 #[test]
 fn a_resolver_serves_external_buffers_from_memory() {
-    let (mut doc, bin) = build(&random_cloud(2, 5, 0), &GltfWriteOptions::default());
+    let (mut doc, bin) = build(&random_cloud(5, 0, 5.0, 2), &GltfWriteOptions::default());
     doc["buffers"][0]["uri"] = json!("mem/../../anything.bin");
     let json = serde_json::to_vec(&doc).unwrap();
     // Without a path (and without a resolver) the buffer cannot be found.
@@ -262,7 +262,11 @@ fn devices_fifos_directories_and_sockets_are_errors_at_once() {
         assert!(String::from_utf8_lossy(&out.stderr).contains(kind));
     }
     let scene = d.join("s.ply");
-    std::fs::write(&scene, splatgl::write::to_inria_ply(&random_cloud(3, 2, 0))).unwrap();
+    std::fs::write(
+        &scene,
+        splatgl::write::to_inria_ply(&random_cloud(2, 0, 5.0, 3)),
+    )
+    .unwrap();
     let s = scene.to_str().unwrap();
     for (p, kind) in special_files(&dir("special-cli")) {
         let (code, out) = splatgl(&[
@@ -286,7 +290,7 @@ fn limits_are_enforced_named_and_printed() {
     let scene = d.join("s.ply");
     std::fs::write(
         &scene,
-        splatgl::write::to_inria_ply(&random_cloud(4, 20, 0)),
+        splatgl::write::to_inria_ply(&random_cloud(20, 0, 5.0, 4)),
     )
     .unwrap();
     let s = scene.to_str().unwrap();

@@ -1,8 +1,8 @@
 //! Appendix A errata (spec-notes §2): the literal appendix behaviour, switched in through
 //! `splatgl::gl::Errata`, differs from the reference where ours matches.
 
-mod gl_support;
-use gl_support::*;
+mod common;
+use common::gl::*;
 
 /// Renders `cloud` with the correct renderer and with `errata`, returning both scores.
 fn erratum_scores(
@@ -13,7 +13,7 @@ fn erratum_scores(
 ) -> Option<(Score, Score)> {
     let mut good = headless()?;
     good.upload(cloud).unwrap();
-    let ours = good.render(c, &RenderOptions::default()).unwrap();
+    let ours = good.render(c, &HeadlessOptions::default()).unwrap();
     drop(good);
     let mut bad = headless_with(errata)?;
     bad.upload(cloud).unwrap();
@@ -21,10 +21,10 @@ fn erratum_scores(
         let mut order = Vec::new();
         splatgl::gl::sort_back_to_front(&cloud.positions, c.eye(), &mut order);
         order.reverse(); // the appendix's front-to-back
-        bad.render_with_order(c, &RenderOptions::default(), &order)
+        bad.render_with_order(c, &HeadlessOptions::default(), &order)
             .unwrap()
     } else {
-        bad.render(c, &RenderOptions::default()).unwrap()
+        bad.render(c, &HeadlessOptions::default()).unwrap()
     };
     let want = reference::render(cloud, c, &ref_opts(3, [0.0; 3]));
     let (s_ours, s_lit) = (score(&ours, &want), score(&literal, &want));
@@ -57,7 +57,7 @@ fn anisotropic_rotated_cloud() -> SplatCloud {
 #[test]
 fn erratum_a_transposed_rotation() {
     let cloud = anisotropic_rotated_cloud();
-    let c = cam(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         a_transposed_rotation: true,
         ..Default::default()
@@ -72,7 +72,7 @@ fn erratum_a_transposed_rotation() {
 fn erratum_b_transposed_view() {
     let cloud = anisotropic_rotated_cloud();
     // An oblique camera: its rotation is far from symmetric, so V ≠ Vᵀ matters.
-    let c = cam(Vec3::new(2.0, 1.5, 2.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(2.0, 1.5, 2.0), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         b_transposed_view: true,
         ..Default::default()
@@ -87,7 +87,7 @@ fn erratum_b_transposed_view() {
 fn erratum_d_focal_offset_and_centre() {
     let cloud = anisotropic_rotated_cloud();
     // 50° fov: P[0][0] ≠ 1, so the appendix's quad size and centre are wrong.
-    let c = cam(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         d_focal_offset: true,
         ..Default::default()
@@ -106,7 +106,7 @@ fn erratum_e_appendix_sh() {
             *c = c.map(|v| v * 2.0);
         }
     }
-    let c = cam(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         e_appendix_sh: true,
         ..Default::default()
@@ -131,7 +131,7 @@ fn erratum_e_sign_flips_alone_change_colour() {
         0.95,
         &sh,
     );
-    let c = cam(Vec3::new(0.0, -3.0, 0.5), Vec3::ZERO, 50.0, 32, 32);
+    let c = look_at_fov_deg(Vec3::new(0.0, -3.0, 0.5), Vec3::ZERO, 50.0, 32, 32);
     let errata = Errata {
         e_appendix_sh: true,
         ..Default::default()
@@ -145,7 +145,7 @@ fn erratum_e_sign_flips_alone_change_colour() {
 #[test]
 fn erratum_g_src_alpha_blend_front_to_back() {
     let cloud = scene::random_cloud(300, 0, 1.0, 17);
-    let c = cam(Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         g_src_alpha_blend: true,
         ..Default::default()
@@ -167,7 +167,7 @@ fn erratum_f_power_4_cuts_at_2_83_sigma() {
         0.99,
         &sh_for([1.0; 3], 0),
     );
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 60.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 60.0, 64, 64);
     let errata = Errata {
         f_power_4: true,
         ..Default::default()
@@ -190,7 +190,7 @@ fn erratum_i_no_dilation() {
         let p = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0];
         cloud.push(p, [0.003; 3], rng.quat(), 1.0, &sh_for([1.0, 1.0, 1.0], 0));
     }
-    let c = cam(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
     let errata = Errata {
         i_no_dilation: true,
         ..Default::default()
@@ -217,7 +217,7 @@ fn erratum_k_fov_clamp_and_alpha_cap() {
             &sh_for([0.9, 0.8, 0.3], 0),
         );
     }
-    let c = cam(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         k_no_clamp_no_cap: true,
         ..Default::default()
@@ -266,7 +266,7 @@ fn erratum_j_one_vertex_attribute() {
     );
     let fs =
         "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() { o = vec4(1.0); }\n";
-    let err = splatgl::gl::program::build_program(gl, "appendix-21", &vs, fs);
+    let err = splatgl::gl::build_program(gl, "appendix-21", &vs, fs);
     match &err {
         Err(splatgl::gl::GlError::Link { log, .. }) => eprintln!("21-attribute program: {log}"),
         other => eprintln!(

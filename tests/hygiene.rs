@@ -97,7 +97,7 @@ fn with_nodes(doc: &mut Value, node: Value, chain: usize) {
 
 #[test]
 fn nan_and_infinite_color0_splats_are_dropped_not_clamped() {
-    let cloud = random_cloud(3, 6, 0);
+    let cloud = random_cloud(6, 0, 5.0, 3);
     let o = GltfWriteOptions {
         color0: true,
         ..Default::default()
@@ -145,7 +145,7 @@ fn nan_and_infinite_color0_splats_are_dropped_not_clamped() {
 /// |v|·√2 overflows f32.
 fn sh_overflow_case(v: f32) -> (Vec<u8>, SplatCloud) {
     assert!(v.is_finite());
-    let mut cloud = random_cloud(4, 3, 1);
+    let mut cloud = random_cloud(3, 1, 5.0, 4);
     for c in [1, 3] {
         cloud.sh[4 + c] = [v; 3];
     }
@@ -206,7 +206,7 @@ fn sh_near_f32_max_rotated_to_minus_infinity_is_dropped() {
 
 /// Splats at the origin with zero scale: only the covariance and the SH rotation can break.
 fn origin_cloud(n: usize, degree: u8, scale: f32) -> SplatCloud {
-    let mut c = random_cloud(5, n, degree);
+    let mut c = random_cloud(n, degree, 5.0, 5);
     for i in 0..n {
         c.positions[i] = [0.0; 3];
         c.scales[i] = [scale; 3];
@@ -286,7 +286,7 @@ fn node_chain_overflowing_f64_drops_every_value_it_touches() {
 fn drops_after_a_transform_name_the_accessor_index() {
     // Splat 1 has a NaN position (dropped while decoding), splat 3 SH that overflow under the
     // node: the second finding names accessor index 3, not 2 (its index after the first drop).
-    let mut cloud = random_cloud(6, 5, 1);
+    let mut cloud = random_cloud(5, 1, 5.0, 6);
     for c in [1, 3] {
         cloud.sh[3 * 4 + c] = [f32::MAX * 0.9; 3];
     }
@@ -309,7 +309,7 @@ fn drops_after_a_transform_name_the_accessor_index() {
 
 #[test]
 fn ply_rows_with_unusable_values_are_dropped_with_a_warning() {
-    let cloud = random_cloud(7, 5, 0);
+    let cloud = random_cloud(5, 0, 5.0, 7);
     let mut bytes = to_inria_ply(&cloud);
     let body = bytes
         .windows(11)
@@ -332,7 +332,7 @@ fn ply_rows_with_unusable_values_are_dropped_with_a_warning() {
 
 #[test]
 fn cli_warns_about_dropped_splats_and_strict_fails() {
-    let mut bytes = to_inria_ply(&random_cloud(8, 3, 0));
+    let mut bytes = to_inria_ply(&random_cloud(3, 0, 5.0, 8));
     let body = bytes
         .windows(11)
         .position(|w| w == b"end_header\n")

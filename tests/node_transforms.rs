@@ -26,7 +26,7 @@ fn assert_close(a: DMat3, b: DMat3, rel: f64) {
 }
 
 fn check_transform(m: DMat4) {
-    let local = random_cloud(42, 50, 3);
+    let local = random_cloud(50, 3, 5.0, 42);
     let o = GltfWriteOptions {
         node_matrix: Some(m.to_cols_array()),
         ..Default::default()
@@ -74,7 +74,7 @@ fn non_uniform_scale_and_shear_keep_exact_covariance() {
 
 #[test]
 fn sh_rotated_by_node_rotation() {
-    let local = random_cloud(7, 20, 3);
+    let local = random_cloud(20, 3, 5.0, 7);
     let r = DQuat::from_euler(glam::EulerRot::ZXY, 1.3, 0.2, -0.7);
     let m = DMat4::from_scale_rotation_translation(DVec3::splat(1.7), r, DVec3::new(0.0, 1.0, 0.0));
     let o = GltfWriteOptions {
@@ -105,7 +105,7 @@ fn sh_rotated_by_node_rotation() {
 
 #[test]
 fn hierarchy_composes_and_instances_merge() {
-    let local = random_cloud(3, 10, 1);
+    let local = random_cloud(10, 1, 5.0, 3);
     let (mut doc, bin) = build(&local, &GltfWriteOptions::default());
     let a = DMat4::from_scale_rotation_translation(
         DVec3::splat(2.0),
@@ -145,7 +145,7 @@ fn hierarchy_composes_and_instances_merge() {
 
 #[test]
 fn mirrored_node_is_flagged() {
-    let local = random_cloud(1, 4, 0);
+    let local = random_cloud(4, 0, 5.0, 1);
     let m = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
     let o = GltfWriteOptions {
         node_matrix: Some(m.to_cols_array()),

@@ -44,7 +44,7 @@ fn header(format: &str, n: usize, props: &[(&str, &str)]) -> String {
 
 #[test]
 fn big_endian_and_ascii_match_little_endian() {
-    let c = random_cloud(5, 40, 2);
+    let c = random_cloud(40, 2, 5.0, 5);
     let le = splatgl::write::to_inria_ply(&c);
     let want = load(&le);
     let (props, rows) = parse_le(&le);
@@ -69,7 +69,7 @@ fn big_endian_and_ascii_match_little_endian() {
 
 #[test]
 fn doubles_extra_properties_and_preceding_elements() {
-    let c = random_cloud(6, 10, 0);
+    let c = random_cloud(10, 0, 5.0, 6);
     let want = load(&splatgl::write::to_inria_ply(&c));
     let (props, rows) = parse_le(&splatgl::write::to_inria_ply(&c));
     // A leading element with a list, every value as double, plus normals and a uchar extra.

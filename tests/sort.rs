@@ -549,3 +549,10 @@ fn warm_sorter_allocates_nothing() {
     });
     assert_eq!(count, 0, "allocations in warm sorts");
 }
+
+#[test]
+fn quantized_sort_puts_infinities_at_the_ends() {
+    let mut s = Sorter::new().with_precision(Precision::Quantized { bits: 16 });
+    assert_eq!(s.sort_keys(&[1.0, f32::INFINITY]), &[1, 0]);
+    assert_eq!(s.sort_keys(&[f32::NEG_INFINITY, 1.0]), &[1, 0]);
+}

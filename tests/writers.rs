@@ -59,7 +59,7 @@ fn interrupted_write_leaves_the_previous_file_byte_identical() {
 fn writing_over_an_input_is_refused_through_any_name() {
     let d = dir("inputs");
     let scene = d.join("scene.ply");
-    let cloud = random_cloud(1, 4, 1);
+    let cloud = random_cloud(4, 1, 5.0, 1);
     save(&cloud, &scene, &[]).unwrap();
     let before = std::fs::read(&scene).unwrap();
     std::fs::hard_link(&scene, d.join("alias.ply")).unwrap();
@@ -68,7 +68,7 @@ fn writing_over_an_input_is_refused_through_any_name() {
         d.join("alias.ply"),
         d.join(".").join("scene.ply"),
     ] {
-        let e = save(&random_cloud(2, 9, 0), &out, &[&scene]).unwrap_err();
+        let e = save(&random_cloud(9, 0, 5.0, 2), &out, &[&scene]).unwrap_err();
         assert!(
             e.to_string()
                 .contains("refusing to write over the input file"),
@@ -102,7 +102,7 @@ fn render_and_compare_refuse_to_overwrite_their_inputs() {
     let d = dir("cli");
     // A PLY named .png (formats are found by magic bytes), rendered onto itself.
     let scene = d.join("scene.png");
-    save(&random_cloud(3, 4, 0), &d.join("scene.ply"), &[]).unwrap();
+    save(&random_cloud(4, 0, 5.0, 3), &d.join("scene.ply"), &[]).unwrap();
     std::fs::rename(d.join("scene.ply"), &scene).unwrap();
     let before = std::fs::read(&scene).unwrap();
     let s = scene.to_str().unwrap();

@@ -5,7 +5,9 @@ use std::process::ExitCode;
 /// Help of `info --json`.
 pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
     kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
-    non_unit_quaternions, memory_bytes, warnings; with -v also limits)";
+    non_unit_quaternions, memory_bytes, warnings; for quantized containers also container, \
+    container_version, compression, gltf_extension, quantization[{attribute, bits, encoding}], \
+    lossy, antialiased — null otherwise; with -v also limits)";
 
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
 pub fn run(a: super::FileArgs) -> ExitCode {
@@ -36,6 +38,10 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "memory_bytes": c.memory_bytes(),
         "warnings": r.warning_lines(),
     });
+    let details = r.details.as_ref();
+    if let Some(obj) = info.as_object_mut() {
+        obj.extend(splatgl::load::Details::json_keys(details));
+    }
     let limits = opts.limits.entries();
     if a.verbose {
         let map: serde_json::Map<_, _> = limits
@@ -69,6 +75,9 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "memory:         {:.1} MiB",
         c.memory_bytes() as f64 / 1048576.0
     );
+    if let Some(d) = details {
+        print_details(d);
+    }
     if a.verbose {
         println!("limits:");
         for (k, v) in limits {
@@ -79,4 +88,21 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         println!("warning: {w}");
     }
     ExitCode::SUCCESS
+}
+
+/// The container lines of the text output.
+fn print_details(d: &splatgl::load::Details) {
+    println!("container:      {}", d.summary());
+    println!(
+        "antialiased:    {}",
+        if d.antialiased { "yes" } else { "no" }
+    );
+    println!("quantization:");
+    for q in &d.quantization {
+        println!("  {:<9} {:>2} bits  {}", q.attribute, q.bits, q.encoding);
+    }
+    println!("lossy:");
+    for l in &d.lossy {
+        println!("  - {l}");
+    }
 }

@@ -5,12 +5,14 @@ use splatgl::load::Limits;
 use std::process::ExitCode;
 
 mod compare;
+mod conformance;
+mod convert;
 mod info;
 mod render;
 mod validate;
 
 /// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
-/// INRIA PLY).
+/// INRIA PLY, Niantic SPZ, .splat, .ksplat, PlayCanvas SOG).
 #[derive(Parser, Debug)]
 #[command(name = "splatgl", version, about, long_about = None)]
 pub struct Cli {
@@ -27,7 +29,9 @@ enum Command {
     /// Check a file against every MUST of KHR_gaussian_splatting (RC) and report findings.
     /// Exit status: 0 valid (warnings allowed), 1 invalid, 2 unreadable.
     #[command(mut_arg("json", |a| a.help(validate::JSON_HELP)))]
-    #[command(mut_arg("file", |a| a.help("The file to check (.gltf, .glb or .ply)")))]
+    #[command(mut_arg("file", |a| a.help(
+        "The file to check (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json)"
+    )))]
     #[command(mut_arg("verbose", |a| a.hide(true)))]
     Validate(FileArgs),
     /// Render an image (without a scene: the bundled default scene).
@@ -36,12 +40,18 @@ enum Command {
     /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
     /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
     Compare(compare::Args),
+    /// Convert a splat file to glTF (.glb/.gltf, KHR_gaussian_splatting RC) or INRIA PLY.
+    /// Exit status: 0, or 2 on any error.
+    Convert(convert::Args),
+    /// The KHR_gaussian_splatting conformance suite: generate it, or run it on images.
+    #[command(subcommand)]
+    Conformance(conformance::Command),
 }
 
 /// The arguments of `info` and `validate`: one file, read with the loader options.
 #[derive(clap::Args, Debug)]
 pub struct FileArgs {
-    /// The file (.gltf, .glb or .ply).
+    /// The file (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
     pub file: std::path::PathBuf,
     /// Print JSON (each command lists its keys).
     #[arg(long)]
@@ -60,6 +70,12 @@ pub struct LoadArgs {
     /// draft's log space), linear (RC) or log.
     #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
     pub scale_space: splatgl::load::ScaleSpace,
+    /// Axes of SPZ data: rub (Niantic's RUB, converted to splatgl's frame: RDF for .spz files,
+    /// glTF's LUF inside glTF), raw (no conversion: what splat-transform 3.x writes into .spz,
+    /// and CesiumJS expects inside glTF) or auto (.spz: rub; glTF: what POSITION min/max show,
+    /// else rub for KHR_gaussian_splatting_compression_spz_2 and raw for the legacy extension).
+    #[arg(long, default_value = "auto", value_name = "auto|rub|raw")]
+    pub spz_axes: splatgl::load::spz::SpzAxes,
     /// Fail on a splat with a non-finite or overflowing value instead of dropping it.
     #[arg(long)]
     pub strict: bool,
@@ -95,6 +111,7 @@ impl LoadArgs {
     pub fn options(&self) -> splatgl::load::LoadOptions {
         splatgl::load::LoadOptions {
             scale_space: self.scale_space,
+            spz_axes: self.spz_axes,
             strict: self.strict,
             allow_outside_paths: self.allow_outside_paths,
             resolver: None,
@@ -115,5 +132,7 @@ pub fn run() -> ExitCode {
         Command::Validate(a) => validate::run(a),
         Command::Render(a) => render::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Convert(a) => convert::run(a),
+        Command::Conformance(c) => conformance::run(c),
     }
 }

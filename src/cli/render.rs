@@ -44,7 +44,8 @@ pub enum SortArg {
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (.ply, .gltf, .glb). Without it: the bundled default scene.
+    /// Scene file (.ply, .gltf, .glb, .spz, .splat, .ksplat, .sog, SOG meta.json). Without it:
+    /// the bundled default scene.
     pub scene: Option<PathBuf>,
     /// 3DGS cameras.json to take the view from (see --view).
     #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
@@ -63,7 +64,8 @@ pub struct Args {
     /// Use the N-th glTF camera node of the scene.
     ///
     /// Without any camera option the view frames the scene: glTF from +Z with +Y up, PLY
-    /// (COLMAP axes) from +Z with −Y up; the default scene has its own camera.
+    /// (COLMAP axes, also SPZ, .splat, .ksplat and SOG) from +Z with −Y up; the default scene
+    /// has its own camera.
     #[arg(long, value_name = "N")]
     pub gltf_camera: Option<usize>,
     /// Image width (default 640, or the cameras.json view's, scaled).
@@ -201,7 +203,8 @@ fn camera(
     if a.scene.is_none() {
         return Ok(splatgl::scene::default_camera(w, h));
     }
-    let framed = if format == Some(Format::Ply) {
+    // Every format but glTF is in PLY axes (SPZ is converted to them).
+    let framed = if !matches!(format, Some(Format::Gltf | Format::Glb)) {
         // INRIA/COLMAP axes: −Y up. Look from +Z, slightly from above (−Y).
         let fwd = Vec3::new(0.0, 0.35, -1.0);
         Camera::frame_points_along(&cloud.positions, fwd, -Vec3::Y, fov, w, h)
@@ -318,7 +321,9 @@ fn go(a: &Args) -> Result<(), String> {
     let (img, backend, visible) = match gl {
         Some(img) => (img, "gl", None),
         None => {
-            let (img, stats) = render_reference(&cloud, &cam, &opts);
+            // As displayed (sRGB-encoded for lin_rec709_display): what the GL backend gives.
+            let space = cloud.meta.color_space.effective();
+            let (img, stats) = splatgl::reference::render_display(&cloud, &cam, &opts, space);
             (img, "reference", Some(stats.visible))
         }
     };
@@ -337,30 +342,6 @@ fn go(a: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The reference render as it is displayed: for `lin_rec709_display` clouds the background is
-/// taken as a display value (decoded), the splats blend in linear, and the result is
-/// sRGB-encoded once at the end — exactly what the GL backend does.
-fn render_reference(
-    cloud: &splatgl::SplatCloud,
-    cam: &Camera,
-    opts: &RenderOptions,
-) -> (Image, splatgl::reference::RenderStats) {
-    use splatgl::cloud::ColorSpace;
-    use splatgl::color::{srgb_decode, srgb_encode};
-    if cloud.meta.color_space.effective() != ColorSpace::LinRec709Display {
-        return splatgl::reference::render_with_stats(cloud, cam, opts);
-    }
-    let mut o = *opts;
-    o.background = opts.background.map(|v| srgb_decode(v as f64) as f32);
-    let (mut img, stats) = splatgl::reference::render_with_stats(cloud, cam, &o);
-    for p in &mut img.pixels {
-        for c in &mut p[..3] {
-            *c = srgb_encode(*c as f64) as f32;
-        }
-    }
-    (img, stats)
-}
-
 #[cfg(feature = "gl")]
 fn render_gl(
     a: &Args,
@@ -368,11 +349,11 @@ fn render_gl(
     cam: &Camera,
     opts: &RenderOptions,
 ) -> Result<Image, String> {
-    use splatgl::headless::{RenderOptions as GlOptions, TargetKind};
+    use splatgl::headless::{HeadlessOptions, TargetKind};
     if a.sort != SortArg::Distance {
         return Err("--sort view-depth is only implemented by --backend reference".into());
     }
-    let o = GlOptions {
+    let o = HeadlessOptions {
         target: match a.target {
             TargetArg::Rgba8 => TargetKind::Rgba8,
             TargetArg::Rgba16f => TargetKind::Rgba16fResolve,

@@ -1,19 +1,31 @@
-//! Texture layout of the splat data, uploaded once per cloud.
+//! Texture layout of the splat data, uploaded once per cloud (or scene).
 //!
-//! Both textures are `W = 2^w` texels wide, the largest power of two ≤ min(8192,
-//! `GL_MAX_TEXTURE_SIZE`) (so at least 2048 on any GLES 3.0 device; [`tex_width_log2`]); splat
-//! `i`'s `k`-th texel is at linear index `i·T + k` (T texels per splat), i.e.
-//! `(idx & (W − 1), idx >> w)`. Both use `NEAREST` filtering and are read with `texelFetch`.
-//! Capacity: `W · GL_MAX_TEXTURE_SIZE / max(3, T_sh)` splats — 11.2M at SH degree 3 and 44.7M
-//! at degree 0 with llvmpipe's 16384; [`SplatTextures::upload`] reports an error beyond.
+//! Both data textures are `TEXTURE_2D_ARRAY`s `W = 2^w` texels wide, the largest power of two
+//! ≤ min(8192, `GL_MAX_TEXTURE_SIZE`), whose full layers are `H = 2^h` rows high (the largest
+//! power of two ≤ `GL_MAX_TEXTURE_SIZE`); a cloud that fits one layer gets a single layer just
+//! as high as it needs. Splat `i`'s `k`-th texel is at linear index `idx = i·T + k` (T texels
+//! per splat): `(idx & (W − 1), (idx >> w) & (H − 1), idx >> (w + h))` — x, y, layer. Both use
+//! `NEAREST` filtering and are read with `texelFetch`. [`TextureLayout`] holds W, H and the
+//! layer limit; the shader gets them as `#define`s.
+//!
+//! Capacity: `W · H · GL_MAX_ARRAY_TEXTURE_LAYERS / max(3, T_sh)` splats — with llvmpipe's
+//! 16384 and 2048 layers far beyond memory; on a GLES 3.0 device with 2048 and 256 layers,
+//! 89M (SH 0) or 22M (SH 3) splats where one 2048² texture would hold 1.4M. Beyond it
+//! [`SplatTextures::upload`] fails with [`GlError::Capacity`], naming the limits and the count
+//! that fits.
+//!
+//! The layout constants (texels per splat, which geometry texel holds what) are
+//! [`crate::profile`]'s; the shaders get them as `#define`s.
 //!
 //! | texture | format | texels/splat | content | bytes/splat |
 //! |---|---|---|---|---|
-//! | geometry | `RGBA32F` | 3 | (position.xyz, opacity), rotation xyzw, (scale.xyz, 0) | 48 |
+//! | geometry | `RGBA32F` | 3 | (position.xyz, opacity), rotation xyzw, (scale.xyz, model index) | 48 |
 //! | SH | `RGBA16F` | ⌈3·K/4⌉ | the K = (d+1)² RGB coefficients, packed tightly, zero-padded | 8, 24, 56, 96 for degree 0–3 |
 //!
 //! Total: **56 / 72 / 104 / 144 bytes per splat** for SH degree 0 / 1 / 2 / 3 (resident in
-//! GPU memory), plus the 4-byte order index, the only data uploaded per frame.
+//! GPU memory), plus the 4-byte order index, the only data uploaded per frame. The model index
+//! (the cloud's entry in a [`SplatScene`](super::SplatScene), 0 for a single cloud) is a small
+//! integer stored as a float, exact.
 //!
 //! Geometry stays f32: positions need it for large scenes and scale/rotation feed the
 //! covariance, where f16 would add ~1e-3 relative error to Σ'. SH is f16 (11-bit mantissa):
@@ -24,130 +36,228 @@
 use glow::HasContext;
 
 use super::GlError;
-use crate::cloud::{SplatCloud, sh_coeff_count};
+use super::fault;
+use super::objects::{Creating, Owned};
+use crate::cloud::SplatCloud;
+use crate::profile::{
+    GEOM_TEXEL_POSITION_OPACITY, GEOM_TEXEL_ROTATION, GEOM_TEXEL_SCALE, GEOM_TEXELS, sh_texels,
+};
 
 /// log2 of the widest data texture used (8192 texels).
-pub const MAX_TEX_WIDTH_LOG2: u32 = 13;
+const MAX_TEX_WIDTH_LOG2: u32 = 13;
 
-/// log2 of the data textures' width for a context with this `GL_MAX_TEXTURE_SIZE`: the largest
-/// power of two ≤ min(8192, max_texture_size), and at least 2048 (the GLES 3.0 minimum).
-pub fn tex_width_log2(max_texture_size: i32) -> u32 {
-    let m = max_texture_size.max(2048) as u32;
-    (31 - m.leading_zeros()).min(MAX_TEX_WIDTH_LOG2)
+/// Width, full-layer height and layer limit of the data textures on one context (fixed when
+/// the renderer is created: the shader is compiled with them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct TextureLayout {
+    /// log2 of the width W.
+    pub(crate) width_log2: u32,
+    /// log2 of the rows H of a full layer.
+    pub(crate) layer_rows_log2: u32,
+    /// `GL_MAX_ARRAY_TEXTURE_LAYERS`.
+    pub(crate) max_layers: usize,
+    /// `GL_MAX_TEXTURE_SIZE` (for the error message).
+    max_size: usize,
 }
-/// Texels per splat in the geometry texture.
-pub const GEOM_TEXELS: usize = 3;
 
-/// RGBA16F texels per splat holding SH coefficients of degree `degree`.
-pub const fn sh_texels(degree: u8) -> usize {
-    (3 * sh_coeff_count(degree)).div_ceil(4)
+/// log2 of the largest power of two ≤ `v` (0 for `v` ≤ 1).
+fn floor_log2(v: usize) -> u32 {
+    usize::BITS - 1 - v.max(1).leading_zeros()
+}
+
+impl TextureLayout {
+    /// The layout for these limits.
+    pub(crate) fn for_limits(max_texture_size: i32, max_layers: i32) -> Self {
+        let max_size = max_texture_size.max(1) as usize;
+        TextureLayout {
+            width_log2: floor_log2(max_size).min(MAX_TEX_WIDTH_LOG2),
+            layer_rows_log2: floor_log2(max_size),
+            max_layers: max_layers.max(1) as usize,
+            max_size,
+        }
+    }
+
+    /// The layout for the context's limits (as lowered by the fault hooks, if injected).
+    pub(crate) fn for_context(gl: &glow::Context) -> Self {
+        let size = fault::limit(gl, glow::MAX_TEXTURE_SIZE);
+        let layers = fault::limit(gl, glow::MAX_ARRAY_TEXTURE_LAYERS);
+        Self::for_limits(size, layers)
+    }
+
+    fn width(&self) -> usize {
+        1 << self.width_log2
+    }
+
+    fn layer_rows(&self) -> usize {
+        1 << self.layer_rows_log2
+    }
+
+    /// The most splats of `per_splat` texels that fit (the shader's texel indices are `int`s:
+    /// at most 2³¹ − 1 texels).
+    pub(crate) fn capacity(&self, per_splat: usize) -> usize {
+        let texels = self.width() * self.layer_rows() * self.max_layers;
+        texels.min(i32::MAX as usize) / per_splat
+    }
+
+    /// `(rows per layer, layers)` of a texture holding `n` splats of `per_splat` texels.
+    fn shape(&self, n: usize, per_splat: usize) -> (usize, usize) {
+        let rows = (n * per_splat).div_ceil(self.width()).max(1);
+        if rows <= self.layer_rows() {
+            (rows, 1)
+        } else {
+            (self.layer_rows(), rows.div_ceil(self.layer_rows()))
+        }
+    }
+
+    /// [`GlError::Capacity`] unless `n` splats of `per_splat` texels fit.
+    fn check(&self, n: usize, per_splat: usize) -> Result<(), GlError> {
+        let fits = self.capacity(per_splat);
+        if n <= fits {
+            return Ok(());
+        }
+        Err(GlError::Capacity {
+            splats: n,
+            fits,
+            limits: format!(
+                "{} layers (GL_MAX_ARRAY_TEXTURE_LAYERS) of {}×{} texels (GL_MAX_TEXTURE_SIZE \
+                 {}), at most 2^31 texels, at {per_splat} texels per splat",
+                self.max_layers,
+                self.width(),
+                self.layer_rows(),
+                self.max_size
+            ),
+        })
+    }
 }
 
 /// GPU-resident bytes per splat for a cloud of SH degree `degree` (geometry + SH).
-pub const fn bytes_per_splat(degree: u8) -> usize {
+#[cfg(test)]
+const fn bytes_per_splat(degree: u8) -> usize {
     GEOM_TEXELS * 16 + sh_texels(degree) * 8
 }
 
-/// Rows of a `width`-wide texture holding `n` splats of `per_splat` texels.
-fn rows(n: usize, per_splat: usize, width: usize) -> usize {
-    (n * per_splat).div_ceil(width).max(1)
+/// The clouds uploaded together: splat `i` of the whole is splat `i − start[k]` of cloud `k`
+/// (the model index of its splats).
+pub(crate) struct CloudSet<'a> {
+    clouds: &'a [&'a SplatCloud],
+    /// First global index of each cloud, then the total.
+    starts: Vec<usize>,
+    /// SH degree of the set (the highest; lower clouds are zero-padded, which adds nothing).
+    pub(crate) sh_degree: u8,
 }
 
-/// The two data textures of an uploaded cloud.
-#[derive(Debug)]
-pub struct SplatTextures {
-    /// Geometry texture (`RGBA32F`).
-    pub geometry: glow::Texture,
-    /// SH texture (`RGBA16F`).
-    pub sh: glow::Texture,
-    /// SH texels per splat.
-    pub sh_texels: usize,
-    /// Splats uploaded.
-    pub len: usize,
-}
+impl<'a> CloudSet<'a> {
+    /// The set (checks every cloud's invariants).
+    pub(crate) fn new(clouds: &'a [&'a SplatCloud]) -> Result<Self, GlError> {
+        let mut starts = Vec::with_capacity(clouds.len() + 1);
+        let mut total = 0;
+        for (k, c) in clouds.iter().enumerate() {
+            c.check_lengths()
+                .map_err(|e| GlError::Upload(format!("cloud {k}: {e}")))?;
+            starts.push(total);
+            total += c.len();
+        }
+        starts.push(total);
+        let sh_degree = clouds.iter().map(|c| c.sh_degree).max().unwrap_or(0);
+        Ok(CloudSet {
+            clouds,
+            starts,
+            sh_degree,
+        })
+    }
 
-/// Writes splat `i`'s geometry texels (12 floats).
-fn geometry_of(cloud: &SplatCloud, i: usize, out: &mut [f32]) {
-    let p = cloud.positions[i];
-    let q = cloud.rotations[i];
-    let s = cloud.scales[i];
-    out.copy_from_slice(&[
-        p[0],
-        p[1],
-        p[2],
+    /// Splats in all clouds.
+    pub(crate) fn len(&self) -> usize {
+        self.starts.last().copied().unwrap_or(0)
+    }
+
+    /// `(cloud, index in it)` of global splat `i`.
+    fn locate(&self, i: usize) -> (usize, usize) {
+        let k = self.starts.partition_point(|&s| s <= i) - 1;
+        (k, i - self.starts[k])
+    }
+
+    /// Writes splat `i`'s geometry texels (`GEOM_TEXELS` × 4 floats).
+    fn geometry(&self, i: usize, out: &mut [f32]) {
+        let (k, j) = self.locate(i);
+        let cloud = self.clouds[k];
+        let [x, y, z] = cloud.positions[j];
+        let [sx, sy, sz] = cloud.scales[j];
         // Splats the reference skips (non-finite data) get opacity 0: the shader culls them.
-        if cloud.is_drawable(i) {
-            cloud.opacities[i]
+        let opacity = if cloud.is_drawable(j) {
+            cloud.opacities[j]
         } else {
             0.0
-        },
-        q[0],
-        q[1],
-        q[2],
-        q[3],
-        s[0],
-        s[1],
-        s[2],
-        0.0,
-    ]);
+        };
+        let texel = |t: usize| 4 * t..4 * t + 4;
+        out[texel(GEOM_TEXEL_POSITION_OPACITY)].copy_from_slice(&[x, y, z, opacity]);
+        out[texel(GEOM_TEXEL_ROTATION)].copy_from_slice(&cloud.rotations[j]);
+        out[texel(GEOM_TEXEL_SCALE)].copy_from_slice(&[sx, sy, sz, k as f32]);
+    }
+
+    /// Writes splat `i`'s SH texels (its coefficients, zero-padded to the set's degree).
+    fn sh(&self, i: usize, out: &mut [f32]) {
+        let (k, j) = self.locate(i);
+        out.fill(0.0);
+        for (t, c) in self.clouds[k].sh_of(j).iter().enumerate() {
+            out[3 * t..3 * t + 3].copy_from_slice(c);
+        }
+    }
 }
 
-/// Uploads a `width`-wide float texture whose linear texel stream is produced by `fill`
+/// Uploads a float array texture in `layout` whose linear texel stream is produced by `fill`
 /// (called per splat with a slice of `per_splat · 4` floats), a few rows at a time so the
-/// staging memory stays small for large clouds.
+/// staging memory stays small for large clouds. The caller has set the unpack state to tight
+/// client-memory rows and restores the binding of `TEXTURE_2D_ARRAY`.
 fn upload_texture(
-    gl: &glow::Context,
+    objects: &mut Creating<'_>,
     internal_format: u32,
-    width: usize,
+    layout: &TextureLayout,
     n: usize,
     per_splat: usize,
     mut fill: impl FnMut(usize, &mut [f32]),
 ) -> Result<glow::Texture, GlError> {
-    let height = rows(n, per_splat, width);
+    let width = layout.width();
+    let (mut height, mut layers) = layout.shape(n, per_splat);
+    let allocated_layers = match fault::get(|f| f.oversize_layers) {
+        Some(l) => {
+            (height, layers) = (layout.layer_rows(), 1);
+            l as usize
+        }
+        None => layers,
+    };
+    let gl = objects.gl();
+    let tex = objects.texture()?;
     // SAFETY: texture creation/allocation on the current context with sizes checked by the
-    // caller against GL_MAX_TEXTURE_SIZE; sub-image uploads stay inside the allocated storage
-    // (row ranges computed below) and read exactly width·rows·4 floats from `staging`.
+    // caller against the limits; sub-image uploads stay inside the allocated storage (row and
+    // layer ranges computed below) and read exactly width·rows·4 floats from `staging`.
     unsafe {
-        let tex = gl.create_texture().map_err(|message| GlError::Create {
-            what: "texture",
-            message,
-        })?;
-        gl.bind_texture(glow::TEXTURE_2D, Some(tex));
-        gl.tex_storage_2d(
-            glow::TEXTURE_2D,
-            1,
-            internal_format,
-            width as i32,
-            height as i32,
-        );
+        gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(tex));
+        let (w, h, d) = (width as i32, height as i32, allocated_layers as i32);
+        gl.tex_storage_3d(glow::TEXTURE_2D_ARRAY, 1, internal_format, w, h, d);
         for (pname, v) in [
             (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
             (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
             (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
             (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
         ] {
-            gl.tex_parameter_i32(glow::TEXTURE_2D, pname, v as i32);
+            gl.tex_parameter_i32(glow::TEXTURE_2D_ARRAY, pname, v as i32);
         }
-        // Whatever unpack state the host left must not offset or redirect the read of
-        // `staging`: client memory, tight rows, no skipped rows or pixels.
-        gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
-        gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
-        gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 0);
-        gl.pixel_store_i32(glow::UNPACK_SKIP_ROWS, 0);
-        gl.pixel_store_i32(glow::UNPACK_SKIP_PIXELS, 0);
         const ROWS_PER_CHUNK: usize = 64;
         let floats_per_row = width * 4;
-        let mut staging = vec![0.0f32; ROWS_PER_CHUNK * floats_per_row];
+        let mut staging = vec![0.0f32; ROWS_PER_CHUNK.min(height) * floats_per_row];
         let mut tmp = vec![0.0f32; per_splat * 4];
         let total_floats = n * per_splat * 4;
-        let mut row = 0;
-        while row < height {
-            let chunk_rows = ROWS_PER_CHUNK.min(height - row);
+        let stride = per_splat * 4;
+        let rows_used = (n * per_splat).div_ceil(width).max(1);
+        let mut row = 0; // global row
+        while row < rows_used.min(height * layers) {
+            let (layer, y) = (row / height, row % height);
+            let chunk_rows = ROWS_PER_CHUNK.min(height - y).min(rows_used - row);
             let start = row * floats_per_row;
             let end = start + chunk_rows * floats_per_row;
             staging[..chunk_rows * floats_per_row].fill(0.0);
             // Splats overlapping [start, end) of the linear float stream.
-            let stride = per_splat * 4;
             let first = start / stride;
             let last = end.min(total_floats).div_ceil(stride);
             for i in first..last {
@@ -157,13 +267,15 @@ fn upload_texture(
                 let b = (s0 + stride).min(end);
                 staging[a - start..b - start].copy_from_slice(&tmp[a - s0..b - s0]);
             }
-            gl.tex_sub_image_2d(
-                glow::TEXTURE_2D,
+            gl.tex_sub_image_3d(
+                glow::TEXTURE_2D_ARRAY,
                 0,
                 0,
-                row as i32,
+                y as i32,
+                layer as i32,
                 width as i32,
                 chunk_rows as i32,
+                1,
                 glow::RGBA,
                 glow::FLOAT,
                 glow::PixelUnpackData::Slice(Some(bytemuck::cast_slice(
@@ -172,70 +284,64 @@ fn upload_texture(
             );
             row += chunk_rows;
         }
-        gl.bind_texture(glow::TEXTURE_2D, None);
         Ok(tex)
     }
 }
 
+/// The two data textures of an uploaded cloud or scene.
+#[derive(Debug)]
+pub(crate) struct SplatTextures {
+    /// Geometry texture (`RGBA32F` array).
+    pub(crate) geometry: glow::Texture,
+    /// SH texture (`RGBA16F` array).
+    pub(crate) sh: glow::Texture,
+    /// SH texels per splat.
+    pub(crate) sh_texels: usize,
+    /// Splats uploaded.
+    pub(crate) len: usize,
+    owned: Owned,
+}
+
 impl SplatTextures {
-    /// Uploads a cloud into textures `2^width_log2` texels wide (checks the cloud's invariants
-    /// and the texture size limit first).
-    pub fn upload(
+    /// Uploads a set of clouds in `layout` (checks the capacity first). The caller holds the
+    /// error scope and the unpack / binding state (see `state::UploadState`).
+    pub(crate) fn upload(
         gl: &glow::Context,
-        cloud: &SplatCloud,
-        width_log2: u32,
+        set: &CloudSet<'_>,
+        layout: &TextureLayout,
     ) -> Result<Self, GlError> {
-        let width = 1usize << width_log2;
-        cloud.check_lengths().map_err(GlError::Upload)?;
-        super::clear_pending_errors(gl);
-        let n = cloud.len();
-        let sh_t = sh_texels(cloud.sh_degree);
-        let k = cloud.coeffs_per_splat();
-        // SAFETY: a plain integer query.
-        let max_size = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) } as usize;
-        let need = rows(n, GEOM_TEXELS.max(sh_t), width);
-        if need > max_size {
-            return Err(GlError::Upload(format!(
-                "{n} splats need {need} texture rows; GL_MAX_TEXTURE_SIZE is {max_size}"
-            )));
-        }
-        let geometry = upload_texture(gl, glow::RGBA32F, width, n, GEOM_TEXELS, |i, out| {
-            geometry_of(cloud, i, out)
+        let n = set.len();
+        let sh_t = sh_texels(set.sh_degree);
+        layout.check(n, GEOM_TEXELS.max(sh_t))?;
+        let mut objects = Creating::new(gl);
+        let geometry = upload_texture(
+            &mut objects,
+            glow::RGBA32F,
+            layout,
+            n,
+            GEOM_TEXELS,
+            |i, o| set.geometry(i, o),
+        )?;
+        let sh = upload_texture(&mut objects, glow::RGBA16F, layout, n, sh_t, |i, o| {
+            set.sh(i, o)
         })?;
-        let sh = upload_texture(gl, glow::RGBA16F, width, n, sh_t, |i, out| {
-            out.fill(0.0);
-            for (j, c) in cloud.sh[i * k..(i + 1) * k].iter().enumerate() {
-                out[3 * j..3 * j + 3].copy_from_slice(c);
-            }
-        });
-        let sh = match sh {
-            Ok(t) => t,
-            Err(e) => {
-                // SAFETY: deleting the texture created just above.
-                unsafe { gl.delete_texture(geometry) };
-                return Err(e);
-            }
-        };
-        let textures = SplatTextures {
+        Ok(SplatTextures {
             geometry,
             sh,
             sh_texels: sh_t,
             len: n,
-        };
-        if let Err(e) = super::check_error(gl, "uploading splat textures") {
-            textures.destroy(gl);
-            return Err(e);
-        }
-        Ok(textures)
+            owned: objects.keep("SplatTextures"),
+        })
     }
 
-    /// Deletes both textures.
-    pub fn destroy(&self, gl: &glow::Context) {
-        // SAFETY: deleting textures this struct created.
-        unsafe {
-            gl.delete_texture(self.geometry);
-            gl.delete_texture(self.sh);
-        }
+    /// Deletes both textures (once).
+    pub(crate) fn destroy(&mut self, gl: &glow::Context) {
+        self.owned.destroy(gl);
+    }
+
+    /// Forgets the textures without GL calls (their context is already gone).
+    pub(crate) fn abandon(&mut self) {
+        self.owned.abandon();
     }
 }
 
@@ -245,14 +351,34 @@ mod tests {
 
     #[test]
     fn layout_sizes() {
-        assert_eq!([0, 1, 2, 3].map(sh_texels), [1, 3, 7, 12]);
         assert_eq!([0, 1, 2, 3].map(bytes_per_splat), [56, 72, 104, 144]);
-        assert_eq!(rows(0, 3, 2048), 1);
-        assert_eq!(rows(2048, 3, 2048), 3);
-        assert_eq!(rows(2049, 3, 2048), 4);
-        assert_eq!(tex_width_log2(16384), 13);
-        assert_eq!(tex_width_log2(4096), 12);
-        assert_eq!(tex_width_log2(3000), 11);
-        assert_eq!(tex_width_log2(0), 11);
+        let l = TextureLayout::for_limits(2048, 256);
+        assert_eq!((l.width(), l.layer_rows()), (2048, 2048));
+        assert_eq!(l.shape(0, 3), (1, 1));
+        assert_eq!(l.shape(2048, 3), (3, 1));
+        assert_eq!(l.shape(2049, 3), (4, 1));
+        // One full layer holds 2048²/3 splats; one more needs a second layer.
+        let per_layer = 2048 * 2048 / 3;
+        assert_eq!(l.shape(per_layer, 3), (2048, 1));
+        assert_eq!(l.shape(per_layer + 1, 3), (2048, 2));
+        assert_eq!(l.capacity(12), 2048 * 2048 * 256 / 12);
+        assert_eq!(TextureLayout::for_limits(16384, 2048).width_log2, 13);
+        assert_eq!(TextureLayout::for_limits(16384, 2048).layer_rows_log2, 14);
+        assert_eq!(TextureLayout::for_limits(4096, 1).width_log2, 12);
+        assert_eq!(TextureLayout::for_limits(3000, 1).width_log2, 11);
+        assert_eq!(TextureLayout::for_limits(64, 1).width_log2, 6);
+    }
+
+    #[test]
+    fn over_capacity_names_limits_and_what_fits() {
+        let l = TextureLayout::for_limits(64, 2);
+        assert!(l.check(64 * 64 * 2 / 12, 12).is_ok());
+        let e = l.check(64 * 64 * 2 / 12 + 1, 12).unwrap_err().to_string();
+        assert!(e.contains("683 splats do not fit"), "{e}");
+        assert!(e.contains("at most 682 splats"), "{e}");
+        assert!(
+            e.contains("2 layers (GL_MAX_ARRAY_TEXTURE_LAYERS) of 64×64"),
+            "{e}"
+        );
     }
 }

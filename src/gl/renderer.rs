@@ -1,23 +1,70 @@
-//! [`SplatRenderer`]: draws an uploaded cloud into the host's framebuffer.
+//! [`SplatRenderer`]: uploads clouds and draws them into the host's framebuffer; its
+//! [`DrawSettings`]. The draw calls themselves are in `draw.rs`.
 
-use glam::Mat4;
+use std::cell::Cell;
+
+use glam::{DMat3, Mat4};
 use glow::HasContext;
 
 use super::GlError;
-use super::data::SplatTextures;
-use super::program::{self, Errata, GlslVersion};
-use crate::camera::Camera;
+use super::context::ContextInfo;
+use super::data::{CloudSet, SplatTextures, TextureLayout};
+use super::error::ErrorScope;
+use super::fault;
+use super::glsl::{self, Errata, GlslVersion};
+use super::objects::{Creating, Owned};
+use super::program;
+use super::state::{Bindings, StateCalls};
 use crate::cloud::{ColorSpace, SplatCloud};
 
-/// Per-draw settings; change them between draws with [`SplatRenderer::settings_mut`].
+/// The depth comparison of [`DrawSettings::depth_func`] (the host's convention: `Less` /
+/// `LessEqual` for a standard depth buffer cleared to 1, `Greater` / `GreaterEqual` for a
+/// reversed-Z one cleared to 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DepthFunc {
+    /// `GL_LESS` (the default).
+    #[default]
+    Less,
+    /// `GL_LEQUAL`.
+    LessEqual,
+    /// `GL_GREATER`.
+    Greater,
+    /// `GL_GEQUAL`.
+    GreaterEqual,
+}
+
+impl DepthFunc {
+    /// The GL enum.
+    pub fn gl_enum(self) -> u32 {
+        match self {
+            DepthFunc::Less => glow::LESS,
+            DepthFunc::LessEqual => glow::LEQUAL,
+            DepthFunc::Greater => glow::GREATER,
+            DepthFunc::GreaterEqual => glow::GEQUAL,
+        }
+    }
+}
+
+/// Per-draw settings: the renderer's own ([`SplatRenderer::settings_mut`], used by
+/// [`SplatRenderer::draw`] and [`SplatRenderer::set_order`]) or given for one draw
+/// ([`SplatRenderer::draw_current_with`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DrawSettings {
     /// SH degree to evaluate (clamped to the cloud's degree); `None` = the cloud's degree.
     pub sh_degree: Option<u8>,
-    /// Test against the bound depth buffer (`LESS`, never writing depth), so splats hide behind
-    /// the host's opaque geometry. On by default (embedding); without a depth attachment the
-    /// test always passes. The headless renderer turns it off.
+    /// Test against the bound depth buffer with [`DrawSettings::depth_func`], never writing
+    /// depth, so splats hide behind the host's opaque geometry. On by default (embedding);
+    /// without a depth attachment the test always passes. The headless renderer turns it off.
     pub depth_test: bool,
+    /// The depth comparison (the host's convention; `Less` by default).
+    pub depth_func: DepthFunc,
+    /// Put back every piece of GL state the call changes (`true`, recommended for legacy
+    /// hosts), or leave the documented values (`false`, the default: no state queries). See
+    /// [`super::state`].
+    pub restore_state: bool,
+    /// The colour space to draw as (`None` = the uploaded cloud's): decides
+    /// `GL_FRAMEBUFFER_SRGB` where it can be switched (see [`SplatRenderer`]).
+    pub color_space: Option<ColorSpace>,
 }
 
 impl Default for DrawSettings {
@@ -25,29 +72,84 @@ impl Default for DrawSettings {
         DrawSettings {
             sh_degree: None,
             depth_test: true,
+            depth_func: DepthFunc::Less,
+            restore_state: false,
+            color_space: None,
         }
     }
 }
 
-#[derive(Debug)]
-struct Uniforms {
-    geometry: Option<glow::UniformLocation>,
-    sh: Option<glow::UniformLocation>,
-    sh_texels: Option<glow::UniformLocation>,
-    sh_degree: Option<glow::UniformLocation>,
-    view: Option<glow::UniformLocation>,
-    projection: Option<glow::UniformLocation>,
-    focal: Option<glow::UniformLocation>,
-    tan_half_fov: Option<glow::UniformLocation>,
-    camera_position: Option<glow::UniformLocation>,
-    viewport: Option<glow::UniformLocation>,
-    cull_depth: Option<glow::UniformLocation>,
-    splat_count: Option<glow::UniformLocation>,
+/// Declares `Uniforms`, one location per uniform the renderer sets, each field named exactly
+/// like its GLSL uniform (so the two cannot get out of step).
+macro_rules! uniforms {
+    ($($name:ident),* $(,)?) => {
+        /// The locations of the uniforms the renderer sets.
+        #[derive(Debug)]
+        pub(super) struct Uniforms {
+            $(pub(super) $name: Option<glow::UniformLocation>,)*
+        }
+
+        impl Uniforms {
+            /// Looks them up; for the correct program (`check`), a debug build asserts that
+            /// they all exist.
+            fn new(gl: &glow::Context, program: glow::Program, check: bool) -> Self {
+                let names = [$(stringify!($name)),*];
+                let [$($name),*] = program::uniform_locations(gl, program, "splat", names, check);
+                Uniforms { $($name),* }
+            }
+        }
+    };
+}
+
+uniforms! {
+    u_geometry, u_sh, u_sh_texels, u_sh_fetch_texels, u_sh_degree, u_view_matrix,
+    u_projection_matrix, u_focal_length, u_tan_half_fov, u_camera_position, u_viewport,
+    u_cull_depth, u_splat_count, u_model_count, u_model_rows, u_sh_rotation,
+}
+
+/// The model matrices of the uploaded clouds, as the shader reads them: rows 0..2 of each
+/// affine matrix and the transposed polar rotation (world → model directions, for the SH).
+/// `count == 0`: every model is the identity (the shader skips the transform).
+#[derive(Debug, Clone)]
+pub(super) struct Models {
+    pub(super) rows: [[f32; 12]; SplatScene::MAX_CLOUDS],
+    pub(super) sh_rotation: [[f32; 9]; SplatScene::MAX_CLOUDS],
+    pub(super) count: usize,
+}
+
+use super::SplatScene;
+
+impl Models {
+    const IDENTITY: Models = Models {
+        rows: [[0.0; 12]; SplatScene::MAX_CLOUDS],
+        sh_rotation: [[0.0; 9]; SplatScene::MAX_CLOUDS],
+        count: 0,
+    };
+
+    /// The uniforms for `models` (finite affine matrices, at most `MAX_CLOUDS`).
+    pub(super) fn set(&mut self, models: &[Mat4]) {
+        if models.iter().all(|m| *m == Mat4::IDENTITY) {
+            self.count = 0;
+            return;
+        }
+        for (k, m) in models.iter().enumerate() {
+            let rows = [m.row(0), m.row(1), m.row(2)];
+            for (r, row) in rows.iter().enumerate() {
+                self.rows[k][4 * r..4 * r + 4].copy_from_slice(&row.to_array());
+            }
+            // The loader's SH rotation: the polar factor of the 3×3 (identity when singular).
+            let linear = DMat3::from_mat4(m.as_dmat4());
+            let r = crate::covariance::polar_rotation(linear).unwrap_or(DMat3::IDENTITY);
+            self.sh_rotation[k] = r.transpose().as_mat3().to_cols_array();
+        }
+        self.count = models.len();
+    }
 }
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
-/// [`super::state`] for the GL state each call changes. All methods must be called with the
-/// same context current.
+/// [`super::state`] for the GL state each call changes in each mode. All methods must be
+/// called with the same context current. One renderer draws one cloud; a [`SplatScene`]
+/// draws several in one order.
 ///
 /// Per frame only the order is uploaded (`glBufferSubData`, 4 bytes per splat) and nothing is
 /// allocated on the host.
@@ -55,141 +157,198 @@ struct Uniforms {
 /// # Colour spaces
 ///
 /// The shader writes the reconstructed colours as they are (premultiplied). For
-/// `srgb_rec709_display` clouds that is final. For `lin_rec709_display` clouds
-/// ([`SplatRenderer::color_space`]) blending must happen on linear values and the result be
-/// sRGB-encoded once at the end: draw into an `SRGB8_ALPHA8` framebuffer (ES always converts;
-/// desktop GL needs `GL_FRAMEBUFFER_SRGB`), or into an [`super::OffscreenTarget`] resolved with
-/// `encode_srgb = true`.
+/// `srgb_rec709_display` clouds that is final: draw into a framebuffer that stores values as
+/// written (the draw disables `GL_FRAMEBUFFER_SRGB` where it can be switched; on ES without
+/// `GL_EXT_sRGB_write_control` do not draw them into an sRGB framebuffer). For
+/// `lin_rec709_display` clouds ([`SplatRenderer::color_space`]) blending must happen on linear
+/// values and the result be sRGB-encoded once at the end: draw into an `SRGB8_ALPHA8`
+/// framebuffer (the draw enables `GL_FRAMEBUFFER_SRGB` on desktop GL; ES always converts), or
+/// into an [`super::OffscreenTarget`] resolved with `encode_srgb = true`.
+///
+/// # Lifetime
+///
+/// It owns GL objects but not the context: call [`SplatRenderer::destroy`] with the context
+/// current before dropping it (dropping a live renderer leaks its objects and warns once).
+/// After `destroy` every method returns [`GlError::Destroyed`].
 #[derive(Debug)]
 pub struct SplatRenderer {
-    program: glow::Program,
-    uniforms: Uniforms,
-    vao: glow::VertexArray,
+    pub(super) program: glow::Program,
+    pub(super) uniforms: Uniforms,
+    pub(super) vao: glow::VertexArray,
     order_buffer: glow::Buffer,
+    /// Indices the order buffer holds (grown, never shrunk).
+    order_allocated: usize,
+    /// Indices `set_order` may write (the uploaded splats).
     order_capacity: usize,
-    instances: usize,
-    textures: Option<SplatTextures>,
-    cloud_degree: u8,
-    color_space: ColorSpace,
+    pub(super) instances: usize,
+    pub(super) textures: Option<SplatTextures>,
+    pub(super) cloud_degree: u8,
+    pub(super) color_space: ColorSpace,
     settings: DrawSettings,
-    errata: Errata,
-    tex_width_log2: u32,
+    pub(super) errata: Errata,
+    pub(super) ctx: ContextInfo,
+    layout: TextureLayout,
+    pub(super) models: Models,
+    pub(super) state_calls: Cell<StateCalls>,
+    pub(super) owned: Owned,
 }
 
 impl SplatRenderer {
-    /// Compiles the splat program for the context's GLSL flavour and creates the (empty) order
-    /// buffer and vertex array.
+    /// Checks the context (OpenGL ≥ 3.3 or OpenGL ES ≥ 3.0, else
+    /// [`GlError::ContextVersion`] naming the version found), compiles the splat program for
+    /// its GLSL flavour and creates the (empty) order buffer and vertex array. Leaves every
+    /// binding as it found it.
     pub fn new(gl: &glow::Context) -> Result<Self, GlError> {
         Self::with_errata(gl, Errata::default())
     }
 
     /// Like [`SplatRenderer::new`], with some of the review draft's Appendix A errata switched
-    /// back in. **Tests and demonstrations only.**
+    /// back in. **Erratum tests only** (hidden from the documented API).
+    #[doc(hidden)]
     pub fn with_errata(gl: &glow::Context, errata: Errata) -> Result<Self, GlError> {
-        let version = GlslVersion::for_context(gl);
-        // SAFETY: a plain integer query.
-        let max_texture_size = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE) };
-        let tex_width_log2 = super::data::tex_width_log2(max_texture_size);
-        let vs = program::assemble(version, &errata, tex_width_log2, program::SPLAT_VERT);
-        let fs = program::assemble(version, &errata, tex_width_log2, program::SPLAT_FRAG);
-        let program = program::build_program(gl, "splat", &vs, &fs)?;
-        // SAFETY: queries on the program just linked, and creation of a VAO and a buffer; on
-        // failure everything created so far is deleted.
-        unsafe {
-            let loc = |name: &str| gl.get_uniform_location(program, name);
-            let uniforms = Uniforms {
-                geometry: loc("u_geometry"),
-                sh: loc("u_sh"),
-                sh_texels: loc("u_sh_texels"),
-                sh_degree: loc("u_sh_degree"),
-                view: loc("u_view_matrix"),
-                projection: loc("u_projection_matrix"),
-                focal: loc("u_focal_length"),
-                tan_half_fov: loc("u_tan_half_fov"),
-                camera_position: loc("u_camera_position"),
-                viewport: loc("u_viewport"),
-                cull_depth: loc("u_cull_depth"),
-                splat_count: loc("u_splat_count"),
-            };
-            let vao = match gl.create_vertex_array() {
-                Ok(v) => v,
-                Err(message) => {
-                    gl.delete_program(program);
-                    return Err(GlError::Create {
-                        what: "vertex array",
-                        message,
-                    });
-                }
-            };
-            let order_buffer = match gl.create_buffer() {
-                Ok(b) => b,
-                Err(message) => {
-                    gl.delete_vertex_array(vao);
-                    gl.delete_program(program);
-                    return Err(GlError::Create {
-                        what: "buffer",
-                        message,
-                    });
-                }
-            };
-            // The only vertex attribute: the sorted splat index, one u32 per instance.
-            gl.bind_vertex_array(Some(vao));
-            gl.bind_buffer(glow::ARRAY_BUFFER, Some(order_buffer));
-            gl.enable_vertex_attrib_array(0);
-            gl.vertex_attrib_pointer_i32(0, 1, glow::UNSIGNED_INT, 4, 0);
-            gl.vertex_attrib_divisor(0, 1);
-            gl.bind_vertex_array(None);
-            gl.bind_buffer(glow::ARRAY_BUFFER, None);
-            Ok(SplatRenderer {
-                program,
-                uniforms,
-                vao,
-                order_buffer,
-                order_capacity: 0,
-                instances: 0,
-                textures: None,
-                cloud_degree: 0,
-                color_space: ColorSpace::default(),
-                settings: DrawSettings::default(),
-                errata,
-                tex_width_log2,
-            })
+        let ctx = ContextInfo::check(gl)?;
+        let version = GlslVersion::for_context(ctx);
+        let layout = TextureLayout::for_context(gl);
+        let source = |stage: &str, body: &str| {
+            let s = glsl::assemble(version, &errata, &layout, body);
+            match fault::get(|f| f.edit_shader) {
+                Some(edit) => edit(stage, s),
+                None => s,
+            }
+        };
+        let vs = source("vertex", glsl::SPLAT_VERT);
+        let fs = source("fragment", glsl::SPLAT_FRAG);
+        let mut objects = Creating::new(gl);
+        let program = program::build_program_in(&mut objects, "splat", &vs, &fs)?;
+        // Erratum variants may compile some uniforms away: only the correct program is checked.
+        let uniforms = Uniforms::new(gl, program, errata == Errata::default());
+        let vao = objects.vertex_array()?;
+        let order_buffer = objects.buffer()?;
+        {
+            let _host = Bindings::for_new(gl);
+            // SAFETY: configures the VAO and buffer created just above; `_host` binds the
+            // host's VAO and array buffer back.
+            unsafe {
+                // The only vertex attribute: the sorted splat index, one u32 per instance.
+                gl.bind_vertex_array(Some(vao));
+                gl.bind_buffer(glow::ARRAY_BUFFER, Some(order_buffer));
+                gl.enable_vertex_attrib_array(0);
+                gl.vertex_attrib_pointer_i32(0, 1, glow::UNSIGNED_INT, 4, 0);
+                gl.vertex_attrib_divisor(0, 1);
+            }
         }
+        Ok(SplatRenderer {
+            program,
+            uniforms,
+            vao,
+            order_buffer,
+            order_allocated: 0,
+            order_capacity: 0,
+            instances: 0,
+            textures: None,
+            cloud_degree: 0,
+            color_space: ColorSpace::default(),
+            settings: DrawSettings::default(),
+            errata,
+            ctx,
+            layout,
+            models: Models::IDENTITY,
+            state_calls: Cell::new(StateCalls::default()),
+            owned: objects.keep("SplatRenderer"),
+        })
     }
 
     /// Uploads a cloud's data into textures (once per cloud; replaces any previous cloud) and
-    /// sizes the order buffer for `cloud.len()` indices.
+    /// sizes the order buffer for `cloud.len()` indices. A cloud larger than one texture is
+    /// spread over the layers of array textures; beyond the context's limits it fails with
+    /// [`GlError::Capacity`]. GL errors (e.g. `GL_OUT_OF_MEMORY`) are returned as
+    /// [`GlError::Gl`]; the host's pending errors are kept ([`super::state`]). On failure the
+    /// previous cloud stays uploaded. Leaves every binding and the unpack state as it found
+    /// them.
     pub fn upload(&mut self, gl: &glow::Context, cloud: &SplatCloud) -> Result<(), GlError> {
-        let textures = SplatTextures::upload(gl, cloud, self.tex_width_log2)?;
-        // The order buffer first: on failure the previous cloud stays complete and usable.
-        // SAFETY: (re)allocates the renderer's own order buffer.
-        unsafe {
-            gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.order_buffer));
-            gl.buffer_data_size(
-                glow::ARRAY_BUFFER,
-                (cloud.len().max(1) * 4) as i32,
-                glow::DYNAMIC_DRAW,
-            );
-            gl.bind_buffer(glow::ARRAY_BUFFER, None);
-        }
-        if let Err(e) = super::check_error(gl, "allocating the order buffer") {
-            textures.destroy(gl);
-            self.instances = 0; // the buffer's old contents are gone
-            return Err(e);
-        }
-        if let Some(old) = self.textures.replace(textures) {
-            old.destroy(gl);
-        }
-        self.cloud_degree = cloud.sh_degree;
-        self.color_space = cloud.meta.color_space.effective();
-        self.instances = 0;
-        self.order_capacity = cloud.len();
+        self.upload_clouds(gl, &[cloud])?;
+        self.models = Models::IDENTITY;
         Ok(())
     }
 
-    /// The linked splat program (for inspection, e.g. its active attributes).
+    /// Uploads several clouds as one (cloud `k`'s splats get model index `k`; the colour
+    /// space is the first cloud's). For [`SplatScene`].
+    pub(super) fn upload_clouds(
+        &mut self,
+        gl: &glow::Context,
+        clouds: &[&SplatCloud],
+    ) -> Result<(), GlError> {
+        self.owned.check()?;
+        let set = CloudSet::new(clouds)?;
+        let n = set.len();
+        let errors = ErrorScope::begin(gl)?;
+        let host = Bindings::for_upload(gl, self.ctx);
+        let mut textures = SplatTextures::upload(gl, &set, &self.layout)?;
+        drop(host);
+        if let Err(e) = errors.end("uploading splat textures") {
+            textures.destroy(gl);
+            return Err(e);
+        }
+        if n > self.order_allocated
+            && let Err(e) = self.grow_order_buffer(gl, n)
+        {
+            textures.destroy(gl);
+            return Err(e);
+        }
+        if let Some(mut old) = self.textures.replace(textures) {
+            old.destroy(gl);
+        }
+        self.cloud_degree = set.sh_degree;
+        self.color_space = clouds
+            .first()
+            .map_or(ColorSpace::default(), |c| c.meta.color_space.effective());
+        self.instances = 0;
+        self.order_capacity = n;
+        Ok(())
+    }
+
+    /// Reallocates the order buffer for `n` indices. On failure its contents and size are
+    /// unknown: the previous order must be set again (and fit).
+    fn grow_order_buffer(&mut self, gl: &glow::Context, n: usize) -> Result<(), GlError> {
+        let errors = ErrorScope::begin(gl)?;
+        {
+            let _host = Bindings::for_new(gl);
+            // SAFETY: (re)allocates the renderer's own order buffer; `_host` rebinds the
+            // host's array buffer.
+            unsafe {
+                gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.order_buffer));
+                let bytes = i32::try_from(n * 4).unwrap_or(i32::MAX);
+                gl.buffer_data_size(glow::ARRAY_BUFFER, bytes, glow::DYNAMIC_DRAW);
+            }
+        }
+        let result = errors.end("allocating the order buffer");
+        self.instances = 0;
+        match &result {
+            Ok(()) => self.order_allocated = n,
+            Err(_) => {
+                self.order_allocated = 0;
+                self.order_capacity = 0;
+            }
+        }
+        result
+    }
+
+    /// Points model `k`'s uniforms at `models` (see [`SplatScene`]).
+    pub(super) fn set_models(&mut self, models: &[Mat4]) {
+        self.models.set(models);
+    }
+
+    /// The linked splat program (for inspection, e.g. its active attributes; erratum tests).
+    #[doc(hidden)]
     pub fn program(&self) -> glow::Program {
         self.program
+    }
+
+    /// GL calls the state handling of the last draw made (restore mode adds queries and
+    /// restoring calls). **For the state-cost measurement** (hidden from the documented API).
+    #[doc(hidden)]
+    pub fn last_state_calls(&self) -> StateCalls {
+        self.state_calls.get()
     }
 
     /// Number of splats uploaded.
@@ -224,8 +383,11 @@ impl SplatRenderer {
     }
 
     /// Uploads a draw order (`glBufferSubData`, 4 bytes per index): splat indices back to front,
-    /// each `< len()`. May be shorter than the cloud (culled or partial draws).
+    /// each `< len()`. May be shorter than the cloud (culled or partial draws). Binds the order
+    /// buffer as `GL_ARRAY_BUFFER`: put back with [`DrawSettings::restore_state`] (of the
+    /// renderer's settings), else left 0.
     pub fn set_order(&mut self, gl: &glow::Context, order: &[u32]) -> Result<(), GlError> {
+        self.owned.check()?;
         if self.textures.is_none() {
             return Err(GlError::NotUploaded);
         }
@@ -236,133 +398,39 @@ impl SplatRenderer {
             });
         }
         // SAFETY: writes `order.len() * 4` bytes into the order buffer, which holds
-        // `order_capacity * 4 >= order.len() * 4` bytes.
+        // `order_allocated * 4 >= order_capacity * 4 >= order.len() * 4` bytes; binds the
+        // host's array buffer back (restore mode) or none.
         unsafe {
+            let host = if self.settings.restore_state {
+                gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING)
+            } else {
+                None
+            };
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.order_buffer));
             gl.buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, 0, bytemuck::cast_slice(order));
-            gl.bind_buffer(glow::ARRAY_BUFFER, None);
+            gl.bind_buffer(glow::ARRAY_BUFFER, host);
         }
         self.instances = order.len();
         Ok(())
     }
 
-    /// Uploads `order` ([`SplatRenderer::set_order`]) and draws ([`SplatRenderer::draw_current`]).
-    pub fn draw(
-        &mut self,
-        gl: &glow::Context,
-        camera: &Camera,
-        order: &[u32],
-    ) -> Result<(), GlError> {
-        self.set_order(gl, order)?;
-        self.draw_current(gl, camera)
-    }
-
-    /// Draws the splats of the last uploaded order into the bound framebuffer and viewport,
-    /// blending premultiplied colour with `ONE, ONE_MINUS_SRC_ALPHA`. When the camera's
-    /// `width`/`height` differ from the viewport's (e.g. a camera in logical pixels on a HiDPI
-    /// surface), its intrinsics are scaled to the viewport ([`Camera::resized`]).
-    pub fn draw_current(&self, gl: &glow::Context, camera: &Camera) -> Result<(), GlError> {
-        let Some(tex) = &self.textures else {
-            return Err(GlError::NotUploaded);
-        };
-        let u = &self.uniforms;
-        let degree = self
-            .settings
-            .sh_degree
-            .unwrap_or(self.cloud_degree)
-            .min(self.cloud_degree);
-        let mut viewport = [0i32; 4];
-        // SAFETY: a plain integer query into a 4-element array.
-        unsafe { gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport) };
-        let (vw, vh) = (viewport[2].max(0) as u32, viewport[3].max(0) as u32);
-        let scaled;
-        let camera = if (camera.width, camera.height) != (vw, vh) && vw > 0 && vh > 0 {
-            scaled = camera.resized(vw, vh);
-            &scaled
-        } else {
-            camera
-        };
-        let view: Mat4 = camera.gl_view();
-        let proj: Mat4 = camera.gl_projection();
-        let eye = camera.eye();
-        let tan = camera.tan_half_fov();
-        // SAFETY: binds objects this renderer owns, sets uniforms of its own program with values
-        // of the declared types, and draws `instances` instances, which `set_order` bounded by
-        // the order buffer's size; the shader culls any index past the uploaded splats.
-        unsafe {
-            gl.use_program(Some(self.program));
-            gl.uniform_matrix_4_f32_slice(u.view.as_ref(), false, &view.to_cols_array());
-            gl.uniform_matrix_4_f32_slice(u.projection.as_ref(), false, &proj.to_cols_array());
-            gl.uniform_2_f32(u.focal.as_ref(), camera.fx, camera.fy);
-            gl.uniform_2_f32(u.tan_half_fov.as_ref(), tan.x, tan.y);
-            gl.uniform_3_f32(u.camera_position.as_ref(), eye.x, eye.y, eye.z);
-            gl.uniform_4_f32(
-                u.viewport.as_ref(),
-                viewport[0] as f32,
-                viewport[1] as f32,
-                viewport[2] as f32,
-                viewport[3] as f32,
-            );
-            gl.uniform_1_f32(
-                u.cull_depth.as_ref(),
-                super::consts::NEAR_CULL.max(camera.near),
-            );
-            gl.uniform_1_i32(u.sh_degree.as_ref(), i32::from(degree));
-            gl.uniform_1_i32(u.sh_texels.as_ref(), tex.sh_texels as i32);
-            gl.uniform_1_i32(u.splat_count.as_ref(), tex.len as i32);
-            gl.uniform_1_i32(u.geometry.as_ref(), 0);
-            gl.uniform_1_i32(u.sh.as_ref(), 1);
-            // A host sampler object on these units would override the textures' NEAREST
-            // filtering (RGBA32F is not filterable on ES 3.0): unbind samplers.
-            gl.bind_sampler(0, None);
-            gl.bind_sampler(1, None);
-            gl.active_texture(glow::TEXTURE0);
-            gl.bind_texture(glow::TEXTURE_2D, Some(tex.geometry));
-            gl.active_texture(glow::TEXTURE1);
-            gl.bind_texture(glow::TEXTURE_2D, Some(tex.sh));
-
-            gl.enable(glow::BLEND);
-            gl.blend_equation(glow::FUNC_ADD);
-            if self.errata.g_src_alpha_blend {
-                gl.blend_func(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA);
-            } else {
-                gl.blend_func(glow::ONE, glow::ONE_MINUS_SRC_ALPHA);
-            }
-            gl.disable(glow::CULL_FACE);
-            gl.depth_mask(false);
-            if self.settings.depth_test {
-                gl.enable(glow::DEPTH_TEST);
-                gl.depth_func(glow::LESS);
-            } else {
-                gl.disable(glow::DEPTH_TEST);
-            }
-
-            gl.bind_vertex_array(Some(self.vao));
-            if self.instances > 0 {
-                gl.draw_arrays_instanced(glow::TRIANGLE_STRIP, 0, 4, self.instances as i32);
-            }
-
-            gl.bind_vertex_array(None);
-            gl.bind_texture(glow::TEXTURE_2D, None);
-            gl.active_texture(glow::TEXTURE0);
-            gl.bind_texture(glow::TEXTURE_2D, None);
-            gl.use_program(None);
-        }
-        Ok(())
-    }
-
-    /// Deletes every GL object the renderer created. The renderer must not be used afterwards.
+    /// Deletes every GL object the renderer created (once; afterwards every method returns
+    /// [`GlError::Destroyed`]). Call it with the renderer's context current. None of them is
+    /// bound after any call of the renderer, so no binding changes.
     pub fn destroy(&mut self, gl: &glow::Context) {
-        if let Some(t) = self.textures.take() {
+        if let Some(mut t) = self.textures.take() {
             t.destroy(gl);
         }
-        // SAFETY: deleting objects this renderer created.
-        unsafe {
-            gl.delete_buffer(self.order_buffer);
-            gl.delete_vertex_array(self.vao);
-            gl.delete_program(self.program);
-        }
+        self.owned.destroy(gl);
         self.order_capacity = 0;
         self.instances = 0;
+    }
+
+    /// Forgets the objects without GL calls (their context is already gone).
+    pub(crate) fn abandon(&mut self) {
+        if let Some(mut t) = self.textures.take() {
+            t.abandon();
+        }
+        self.owned.abandon();
     }
 }

@@ -1,9 +1,16 @@
-//! Which format a file is: magic bytes first, then the extension, then a look at the content.
+//! Which format a file is, by content first: magic bytes (glTF, PLY, SPZ's `NGSP`, gzip, zip),
+//! confirmed where the magic is shared (a gzip member must begin with an SPZ header, a zip
+//! must hold `meta.json`), then the keys of a JSON document (SOG meta vs glTF) and a
+//! self-consistent `.ksplat` layout; the extension only when the content says nothing, and
+//! `.splat` (which has no header) last, by plausibility. A file whose extension names another
+//! format than its content loads as its content, with a warning naming both.
 //!
-//! To add a format: a [`Format`] variant with its [`Format::name`], [`Format::magic`] and
-//! [`Format::extensions`], and its reader in [`super::read`]. Formats splatgl recognises but
-//! does not read yet are listed in [`NOT_YET`], so they fail by name.
+//! To add a format: a [`Format`] variant with its [`Format::name`], [`Format::magic`] (and a
+//! [`confirmed`] rule if that magic is shared) and [`Format::extensions`], and its reader in
+//! [`super::read`].
 
+use super::{ksplat, sog, splat, spz};
+use std::io::Read;
 use std::path::Path;
 
 /// The file formats splatgl reads.
@@ -15,11 +22,27 @@ pub enum Format {
     Glb,
     /// INRIA 3DGS PLY (binary little/big endian or ASCII), and PlayCanvas compressed PLY.
     Ply,
+    /// Niantic SPZ, versions 1–4.
+    Spz,
+    /// antimatter15 `.splat`.
+    Splat,
+    /// mkkellogg `.ksplat`.
+    Ksplat,
+    /// PlayCanvas SOG (bundled `.sog` or `meta.json` + WebP).
+    Sog,
 }
 
 impl Format {
-    /// Every format, in the order detection tries them.
-    const ALL: [Format; 3] = [Format::Gltf, Format::Glb, Format::Ply];
+    /// Every format, in the order detection tries their magic bytes.
+    const ALL: [Format; 7] = [
+        Format::Gltf,
+        Format::Glb,
+        Format::Ply,
+        Format::Spz,
+        Format::Splat,
+        Format::Ksplat,
+        Format::Sog,
+    ];
 
     /// Short lowercase name used in `info` output.
     pub fn name(self) -> &'static str {
@@ -27,68 +50,106 @@ impl Format {
             Format::Gltf => "gltf",
             Format::Glb => "glb",
             Format::Ply => "ply",
+            Format::Spz => "spz",
+            Format::Splat => "splat",
+            Format::Ksplat => "ksplat",
+            Format::Sog => "sog",
         }
     }
 
-    /// Leading bytes that identify the format whatever the file is called.
+    /// Leading bytes that identify the format whatever the file is called (gzip and zip only
+    /// once [`confirmed`]).
     fn magic(self) -> &'static [&'static [u8]] {
         match self {
-            Format::Gltf => &[],
+            Format::Gltf | Format::Splat | Format::Ksplat => &[],
             Format::Glb => &[b"glTF"],
             Format::Ply => &[b"ply\n", b"ply\r\n"],
+            Format::Spz => &[spz::MAGIC, GZIP],
+            Format::Sog => &[b"PK\x03\x04"],
         }
     }
 
-    /// File extensions (lowercase, without the dot).
+    /// File extensions (lowercase, without the dot); `meta.json` and other `.json`: SOG.
     fn extensions(self) -> &'static [&'static str] {
         match self {
             Format::Gltf => &["gltf"],
             Format::Glb => &["glb"],
             Format::Ply => &["ply"],
+            Format::Spz => &["spz"],
+            Format::Splat => &["splat"],
+            Format::Ksplat => &["ksplat"],
+            Format::Sog => &["sog", "json"],
         }
     }
 }
 
-/// Splat formats splatgl recognises but does not read yet: (name, magic, extensions).
-pub(super) const NOT_YET: &[(&str, &[u8], &[&str])] = &[
-    ("Niantic SPZ", b"NGSP", &["spz"]),
-    ("antimatter15 .splat", b"", &["splat"]),
-    ("mkkellogg .ksplat", b"", &["ksplat"]),
-    ("PlayCanvas SOG", b"", &["sog"]),
-];
+const GZIP: &[u8] = &[0x1f, 0x8b];
 
-fn extension(path: Option<&Path>) -> Option<String> {
-    path.and_then(|p| p.extension())
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
+/// Whether the content past a shared magic agrees with `f`: a gzip member must begin with an
+/// SPZ header (SPZ v1–v3), a zip must hold `meta.json` (bundled SOG).
+fn confirmed(f: Format, bytes: &[u8]) -> bool {
+    match f {
+        Format::Spz if bytes.starts_with(GZIP) => {
+            let mut head = [0u8; 4];
+            let ok = flate2::read::GzDecoder::new(bytes)
+                .read_exact(&mut head)
+                .is_ok();
+            ok && &head == spz::MAGIC
+        }
+        Format::Sog => sog::is_bundle(bytes),
+        _ => true,
+    }
 }
 
-/// Detects the format from magic bytes, then the extension; a file that is neither but starts
-/// with `{` is taken for glTF JSON.
-pub fn detect_format(bytes: &[u8], path: Option<&Path>) -> Option<Format> {
+/// The format the content itself shows, if any.
+fn sniff(bytes: &[u8]) -> Option<Format> {
     let by_magic = Format::ALL
         .into_iter()
-        .find(|f| f.magic().iter().any(|m| bytes.starts_with(m)));
+        .find(|&f| f.magic().iter().any(|m| bytes.starts_with(m)) && confirmed(f, bytes));
     if by_magic.is_some() {
         return by_magic;
     }
-    let ext = extension(path);
-    let by_ext = Format::ALL
-        .into_iter()
-        .find(|f| ext.as_deref().is_some_and(|e| f.extensions().contains(&e)));
-    if by_ext.is_some() {
-        return by_ext;
+    if bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{') {
+        return Some(if sog::is_meta_json(bytes) {
+            Format::Sog
+        } else {
+            Format::Gltf
+        });
     }
-    let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
-    (first == Some(&b'{')).then_some(Format::Gltf)
+    ksplat::looks_like(bytes).then_some(Format::Ksplat)
 }
 
-/// The name of a format splatgl recognises but does not read yet.
-pub(super) fn not_yet(bytes: &[u8], path: Option<&Path>) -> Option<&'static str> {
-    let ext = extension(path);
-    NOT_YET.iter().find_map(|&(name, magic, exts)| {
-        let by_magic = !magic.is_empty() && bytes.starts_with(magic);
-        let by_ext = ext.as_deref().is_some_and(|e| exts.contains(&e));
-        (by_magic || by_ext).then_some(name)
-    })
+fn by_extension(path: Option<&Path>) -> Option<Format> {
+    let ext = path?.extension()?.to_str()?.to_ascii_lowercase();
+    Format::ALL
+        .into_iter()
+        .find(|f| f.extensions().contains(&ext.as_str()))
+}
+
+/// Detects the format: content first (magic bytes, header, zip directory, JSON keys), then the
+/// extension, then `.splat` plausibility.
+pub fn detect_format(bytes: &[u8], path: Option<&Path>) -> Option<Format> {
+    sniff(bytes)
+        .or_else(|| by_extension(path))
+        .or_else(|| splat::looks_like(bytes).then_some(Format::Splat))
+}
+
+/// The warning for a file whose extension names another format than its content, naming
+/// both; `None` when they agree or there is no extension. `.gltf` and `.glb` count as one.
+pub(super) fn extension_mismatch(found: Format, path: Option<&Path>) -> Option<String> {
+    let ext = path?.extension()?.to_str()?;
+    let gltf = |f: Format| matches!(f, Format::Gltf | Format::Glb);
+    match by_extension(path) {
+        Some(f) if f == found || (gltf(f) && gltf(found)) => None,
+        Some(f) => Some(format!(
+            "the extension '.{ext}' says {}, the content is {}: loaded as {}",
+            f.name(),
+            found.name(),
+            found.name()
+        )),
+        None => Some(format!(
+            "the extension '.{ext}' names no splat format; the content is {}",
+            found.name()
+        )),
+    }
 }

@@ -1,6 +1,8 @@
-//! Loaders: glTF 2.0 (`.gltf`, `.glb`) with `KHR_gaussian_splatting`, and INRIA 3DGS PLY.
+//! Loaders: glTF 2.0 (`.gltf`, `.glb`) with `KHR_gaussian_splatting`, INRIA 3DGS PLY, and the
+//! packed formats of other tools: Niantic SPZ, antimatter15 `.splat`, mkkellogg `.ksplat` and
+//! PlayCanvas SOG (`docs/formats.md`).
 //!
-//! [`load_path`] picks the format by magic bytes (then by extension, see [`detect_format`])
+//! [`load_path`] picks the format by content (then by extension, see [`detect_format`])
 //! and parses the file once into a [`Scene`]: the [`SplatCloud`], the glTF cameras, and a
 //! [`LoadReport`] (format, scale space seen, [`Finding`]s). [`validate`] checks a file with the
 //! same readers and reports the same findings.
@@ -15,15 +17,22 @@
 //! non-finite or overflowing value leaves a loader (`hygiene.rs`): such splats are dropped with
 //! a finding, or fail the load in [`LoadOptions::strict`] mode.
 
+pub mod codec;
+mod details;
 mod finding;
 mod format;
 pub mod gltf;
 pub(crate) mod hygiene;
+pub mod ksplat;
 mod limits;
 pub mod ply;
 mod report;
+pub mod sog;
+pub mod splat;
+pub mod spz;
 pub mod validate;
 
+pub use details::{AttributeBits, Details};
 pub use finding::{Finding, Severity};
 pub use format::{Format, detect_format};
 pub use limits::{LimitExceeded, Limits, check_json_depth};
@@ -69,6 +78,8 @@ pub type Resolver = Arc<dyn Fn(&str) -> Result<Vec<u8>, String> + Send + Sync>;
 pub struct LoadOptions {
     /// How glTF SCALE values are read (PLY scales are always log, as INRIA writes them).
     pub scale_space: ScaleSpace,
+    /// Which axes SPZ payloads are taken to be in (files and glTF SPZ compression).
+    pub spz_axes: spz::SpzAxes,
     /// A splat with a non-finite or overflowing value fails the load (a [`LoadError`] naming
     /// the field, the element and the index) instead of being dropped with a warning.
     pub strict: bool,
@@ -88,6 +99,7 @@ impl std::fmt::Debug for LoadOptions {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LoadOptions")
             .field("scale_space", &self.scale_space)
+            .field("spz_axes", &self.spz_axes)
             .field("strict", &self.strict)
             .field("allow_outside_paths", &self.allow_outside_paths)
             .field("resolver", &self.resolver.as_ref().map(|_| "Fn(&str)"))
@@ -120,18 +132,8 @@ pub enum LoadError {
         /// The OS error.
         source: std::io::Error,
     },
-    /// A splat format splatgl recognises but does not read yet.
-    #[error(
-        "{path}: {kind} files are not supported yet (splatgl reads glTF/GLB with KHR_gaussian_splatting and PLY)"
-    )]
-    NotYet {
-        /// The file.
-        path: PathBuf,
-        /// The format.
-        kind: &'static str,
-    },
-    /// Neither magic bytes nor extension say what the file is.
-    #[error("{path}: unknown file format (expected .gltf, .glb or .ply)")]
+    /// Neither content nor extension say what the file is.
+    #[error("{path}: unknown file format (expected glTF/GLB, PLY, SPZ, .splat, .ksplat or SOG)")]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -168,6 +170,38 @@ pub enum LoadError {
         /// Where, which field, which index.
         finding: Finding,
     },
+    /// An SPZ problem.
+    #[error("{path}: SPZ: {source}")]
+    Spz {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: spz::SpzError,
+    },
+    /// A `.splat` problem.
+    #[error("{path}: .splat: {source}")]
+    Splat {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: splat::SplatError,
+    },
+    /// A `.ksplat` problem.
+    #[error("{path}: .ksplat: {source}")]
+    Ksplat {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: ksplat::KsplatError,
+    },
+    /// A SOG problem.
+    #[error("{path}: SOG: {source}")]
+    Sog {
+        /// The file.
+        path: PathBuf,
+        /// What.
+        source: sog::SogError,
+    },
 }
 
 /// Loads a file of any supported format.
@@ -198,18 +232,25 @@ pub fn load_bytes(
 ) -> Result<Scene, LoadError> {
     let shown = path.map_or_else(|| PathBuf::from("<memory>"), Path::to_owned);
     let Some(format) = detect_format(bytes, path) else {
-        return Err(match format::not_yet(bytes, path) {
-            Some(kind) => LoadError::NotYet { path: shown, kind },
-            None => LoadError::UnknownFormat { path: shown },
-        });
+        return Err(LoadError::UnknownFormat { path: shown });
     };
-    let mut report = LoadReport::new(format);
+    let mut report = report_for(format, path);
     let (cloud, cameras) = read(format, bytes, path, opts, &mut report).map_err(|e| e.at(shown))?;
     Ok(Scene {
         cloud,
         cameras,
         report,
     })
+}
+
+/// A fresh report for a file detected as `format`, with the warning for an extension that
+/// names another format ([`load_bytes`] and [`validate`] start from it).
+pub(crate) fn report_for(format: Format, path: Option<&Path>) -> LoadReport {
+    let mut report = LoadReport::new(format);
+    if let Some(w) = format::extension_mismatch(format, path) {
+        report.findings.push(Finding::warning("", w));
+    }
+    report
 }
 
 /// Why a reader stopped, before the file name is attached (see [`LoadError`]).
@@ -223,6 +264,14 @@ pub(crate) enum ReadError {
     Limit(#[from] LimitExceeded),
     #[error("{0}")]
     Unusable(Finding),
+    #[error(transparent)]
+    Spz(#[from] spz::SpzError),
+    #[error(transparent)]
+    Splat(#[from] splat::SplatError),
+    #[error(transparent)]
+    Ksplat(#[from] ksplat::KsplatError),
+    #[error(transparent)]
+    Sog(#[from] sog::SogError),
 }
 
 impl ReadError {
@@ -234,15 +283,22 @@ impl ReadError {
             ReadError::Ply(source) => LoadError::Ply { path, source },
             ReadError::Gltf(source) => LoadError::Gltf { path, source },
             ReadError::Unusable(finding) => LoadError::Unusable { path, finding },
+            ReadError::Spz(source) => LoadError::Spz { path, source },
+            ReadError::Splat(source) => LoadError::Splat { path, source },
+            ReadError::Ksplat(source) => LoadError::Ksplat { path, source },
+            ReadError::Sog(source) => LoadError::Sog { path, source },
         }
     }
     /// Whether the file's framing could not be read at all (`validate`'s "unreadable").
     fn unreadable(&self) -> bool {
-        matches!(
-            self,
-            ReadError::Ply(ply::PlyError::Header { .. })
-                | ReadError::Gltf(gltf::GltfError::Container(_))
-        )
+        match self {
+            ReadError::Ply(e) => matches!(e, ply::PlyError::Header { .. }),
+            ReadError::Gltf(e) => matches!(e, gltf::GltfError::Container(_)),
+            // A limit or a strict-mode splat: the file was read, its data is refused.
+            ReadError::Limit(_) | ReadError::Unusable(_) => false,
+            // The packed formats have no structure to report findings on once they fail.
+            _ => true,
+        }
     }
 }
 
@@ -263,6 +319,10 @@ pub(crate) fn read(
     let (mut cloud, cameras) = match format {
         Format::Ply => (ply::read(bytes, opts, report)?, Vec::new()),
         Format::Gltf | Format::Glb => gltf::read(bytes, format, path, opts, report)?,
+        Format::Spz => (spz::read(bytes, opts.spz_axes, report)?, Vec::new()),
+        Format::Splat => (splat::read(bytes, report)?, Vec::new()),
+        Format::Ksplat => (ksplat::read(bytes, report)?, Vec::new()),
+        Format::Sog => (sog::read(bytes, path, report)?, Vec::new()),
     };
     opts.limits
         .check_splats(cloud.len() as u64, "the loaded cloud")?;
@@ -278,7 +338,12 @@ pub(crate) fn read(
     Ok((cloud, cameras))
 }
 
-/// Normalises a quaternion `[x, y, z, w]`; returns it and whether it was off unit length by
+/// A quaternion whose norm is 1 within this (4 f32 ulps at 1) is kept as stored: renormalising
+/// an already normalised f32 quaternion can flip last bits, so a file written from a loaded
+/// cloud would not load back bit for bit. Renderers normalise again anyway.
+pub(crate) const UNIT_NORM_ROUNDING: f64 = 4.0 * f32::EPSILON as f64;
+
+/// Normalises a quaternion `[x, y, z, w]` (kept as is when unit to f32 rounding); returns it and whether it was off unit length by
 /// more than 1e-3. A zero or non-finite quaternion is an error (`None`).
 pub(crate) fn normalize_quat(q: [f32; 4]) -> Option<([f32; 4], bool)> {
     let n2: f64 = q.iter().map(|&v| (v as f64) * (v as f64)).sum();
@@ -287,5 +352,8 @@ pub(crate) fn normalize_quat(q: [f32; 4]) -> Option<([f32; 4], bool)> {
     }
     let n = n2.sqrt();
     let off = (n - 1.0).abs() > 1e-3;
+    if (n - 1.0).abs() <= UNIT_NORM_ROUNDING {
+        return Some((q, off)); // unit to f32 rounding: dividing would only flip last bits
+    }
     Some((q.map(|v| (v as f64 / n) as f32), off))
 }

@@ -1,6 +1,6 @@
 //! [`LoadReport`]: what a reader learnt about a file besides the splats.
 
-use super::{Finding, Format, finding};
+use super::{Details, Finding, Format, finding};
 
 /// Scale space as read from the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,6 +43,9 @@ pub struct LoadReport {
     /// What the reader noticed, in file order. None of them stopped the load (a finding that
     /// does is the [`super::LoadError`]); `splatgl validate` lists the same findings.
     pub findings: Vec<Finding>,
+    /// Container version, quantization, flags and lossy steps (quantized containers: SPZ,
+    /// `.splat`, `.ksplat`, SOG, compressed PLY, glTF with SPZ compression).
+    pub details: Option<Details>,
 }
 
 impl LoadReport {
@@ -52,6 +55,7 @@ impl LoadReport {
             scale_space: None,
             non_unit_quaternions: 0,
             findings: Vec::new(),
+            details: None,
         }
     }
 

@@ -2,10 +2,10 @@
 //! structural errors, and loadability for other input, as a list of [`Finding`]s.
 //!
 //! The checks are the loader's own: the same readers, the same findings in the same
-//! [`LoadReport`], so what `validate` accepts is exactly what `load` reads. For glTF the
+//! [`super::LoadReport`], so what `validate` accepts is exactly what `load` reads. For glTF the
 //! findings go on past the first blocking one (the walk reports every problem it can reach).
 
-use super::{Finding, Format, LoadOptions, LoadReport, Severity, detect_format, gltf};
+use super::{Finding, Format, LoadOptions, Severity, detect_format, gltf};
 use std::path::Path;
 
 /// Overall verdict; the process exit status of `splatgl validate`.
@@ -101,13 +101,13 @@ pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> 
             format: None,
             findings: vec![Finding::fatal(
                 "",
-                "unknown file format (expected glTF, GLB or PLY)",
+                "unknown file format (expected glTF, GLB, PLY, SPZ, .splat, .ksplat or SOG)",
             )],
             readable: false,
             splat_count: None,
         };
     };
-    let mut load = LoadReport::new(format);
+    let mut load = super::report_for(format, path);
     let mut readable = true;
     let mut splat_count = None;
     match format {

@@ -2,29 +2,34 @@
 //! directly from the spec text and the original 3DGS forward pass, independent of the shaders.
 //!
 //! Pipeline (see `docs/rendering-profile.md` for every choice the spec leaves open):
-//! 1. [`project::ViewContext::project`] per splat, in parallel: cull at view z ≤
+//! 1. `ViewContext::project` per splat, in parallel: cull at view z ≤
 //!    [`RenderOptions::cull_depth`], Σ = R S² Rᵀ (global), Σ' = J W Σ Wᵀ Jᵀ with the
 //!    ±1.3·tan(half fov) clamp inside J, + 0.3 px² on the diagonal, colour from SH of degree
 //!    min(cloud, requested) along normalize(mean − eye), the 3σ bounding box.
 //! 2. [`back_to_front`]: camera distance (default) or view depth, stable, ties by index.
-//! 3. [`raster::bin`] into 16×16 tiles, then [`raster::rasterize`] per tile row in parallel:
+//! 3. binning into 16×16 tiles, then rasterizing per tile row in parallel:
 //!    at each pixel centre (x + 0.5, y + 0.5), m² = dᵀ Σ'⁻¹ d, skip m² > 9,
 //!    α = min(0.99, opacity · exp(−½ m²)), skip α < 1/255, and in f32
 //!    `C ← c·α + C·(1 − α)`, `A ← α + A·(1 − α)`, starting from (background, 0).
+//!
+//! [`render`] returns the blended values as they are (scene-referred for
+//! `lin_rec709_display`); [`render_display`] returns what a display shows, the image the GL
+//! backend and `splatgl render` produce. The constants are [`crate::profile`]'s.
 
-pub mod project;
-pub mod raster;
+mod project;
+mod raster;
 mod sort;
 
-pub use project::{NEAR_CULL_3DGS, Projected, ViewContext};
+use project::{Projected, ViewContext};
 pub use sort::{SortMode, back_to_front, sort_key};
 
 /// Most (splat, tile) bin entries held at once (4 bytes each): 64 MiB.
 pub const MAX_BIN_ENTRIES: u64 = 16 << 20;
 
 use crate::camera::Camera;
-use crate::cloud::SplatCloud;
+use crate::cloud::{ColorSpace, SplatCloud};
 use crate::image::Image;
+use crate::profile::{srgb_decode, srgb_encode};
 use rayon::prelude::*;
 
 /// Options of a reference render.
@@ -46,7 +51,7 @@ impl Default for RenderOptions {
             sh_degree: 3,
             background: [0.0; 3],
             sort: SortMode::Distance,
-            near_cull: NEAR_CULL_3DGS as f32,
+            near_cull: crate::profile::NEAR_CULL as f32,
         }
     }
 }
@@ -123,5 +128,33 @@ pub fn render_with_stats(
         visible: splats.len(),
         tile_entries: tile_entries as usize,
     };
+    (image, stats)
+}
+
+/// The reference render as a display shows it, in `color_space` (pass
+/// `cloud.meta.color_space.effective()`, or an override): for `lin_rec709_display` the
+/// background is taken as a display value (sRGB-decoded), the splats blend in linear, and the
+/// result is sRGB-encoded once at the end ([`crate::profile::srgb_encode`], unclamped above 1);
+/// `srgb_rec709_display` clouds are shown as blended. This is exactly what the GL backend
+/// ([`crate::headless`]) and `splatgl render` produce, and what they are compared against.
+pub fn render_display(
+    cloud: &SplatCloud,
+    camera: &Camera,
+    opts: &RenderOptions,
+    color_space: ColorSpace,
+) -> (Image, RenderStats) {
+    if color_space != ColorSpace::LinRec709Display {
+        return render_with_stats(cloud, camera, opts);
+    }
+    let linear = RenderOptions {
+        background: opts.background.map(|v| srgb_decode(v as f64) as f32),
+        ..*opts
+    };
+    let (mut image, stats) = render_with_stats(cloud, camera, &linear);
+    for p in &mut image.pixels {
+        for c in &mut p[..3] {
+            *c = srgb_encode(*c as f64) as f32;
+        }
+    }
     (image, stats)
 }

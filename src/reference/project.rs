@@ -4,47 +4,35 @@
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
 use crate::covariance::c_matrix;
+use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2, JACOBIAN_CLAMP};
 use glam::{DMat3, DMat4, DVec3};
-
-/// 3DGS culls splats whose camera-space depth is ≤ 0.2 (`in_frustum`).
-pub const NEAR_CULL_3DGS: f64 = 0.2;
-/// Added to the diagonal of Σ' (px²): the 3DGS low-pass / dilation.
-pub const DILATION_PX2: f64 = 0.3;
-/// x/z and y/z inside J are clamped to ±1.3·tan(half fov) (3DGS `computeCov2D`).
-pub const JACOBIAN_CLAMP: f64 = 1.3;
-/// Mahalanobis² cut-off: the RC's 3σ.
-pub const CUTOFF_M2: f32 = 9.0;
-/// α cap (3DGS `min(0.99, …)`).
-pub const ALPHA_MAX: f32 = 0.99;
-/// α below this is skipped (3DGS `alpha < 1/255`).
-pub const ALPHA_MIN: f32 = 1.0 / 255.0;
 
 /// One splat ready for rasterization (f32, pixel units).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Projected {
+pub(crate) struct Projected {
     /// Index in the cloud.
-    pub index: u32,
+    pub(crate) index: u32,
     /// Projected mean in pixels (top-left corner of the image = (0, 0)).
-    pub mean: [f32; 2],
+    pub(crate) mean: [f32; 2],
     /// Σ' after dilation, `[xx, xy, yy]` px².
-    pub cov: [f32; 3],
+    pub(crate) cov: [f32; 3],
     /// Σ'⁻¹, `[xx, xy, yy]`.
-    pub conic: [f32; 3],
+    pub(crate) conic: [f32; 3],
     /// Opacity attribute.
-    pub opacity: f32,
+    pub(crate) opacity: f32,
     /// A pure optimisation: beyond this m² no pixel can reach α ≥ 1/255, so the exponential
     /// is skipped: `min(9, 2·ln(255·opacity) + 1e-3)` (the margin covers f32 rounding).
-    pub m2_max: f32,
+    pub(crate) m2_max: f32,
     /// SH colour (negatives clamped to 0).
-    pub color: [f32; 3],
+    pub(crate) color: [f32; 3],
     /// `[x0, x1, y0, y1]`: the pixels `x0..x1` × `y0..y1` (exclusive ends) whose centres lie in
     /// the bounding box of the 3σ ellipse, clipped to the image; never empty.
-    pub bbox: [u32; 4],
+    pub(crate) bbox: [u32; 4],
 }
 
 /// Per-view constants shared by all splats.
 #[derive(Debug, Clone, Copy)]
-pub struct ViewContext {
+pub(crate) struct ViewContext {
     w2c: DMat4,
     w: DMat3,
     eye: DVec3,
@@ -60,7 +48,7 @@ pub struct ViewContext {
 
 impl ViewContext {
     /// Constants for `camera`; splats with view z ≤ `cull_z` are culled; SH up to `sh_degree`.
-    pub fn new(camera: &Camera, cull_z: f64, sh_degree: u8) -> Self {
+    pub(crate) fn new(camera: &Camera, cull_z: f64, sh_degree: u8) -> Self {
         let w2c = camera.world_to_camera.as_dmat4();
         let tan = camera.tan_half_fov().as_dvec2();
         ViewContext {
@@ -78,28 +66,11 @@ impl ViewContext {
         }
     }
 
-    /// Σ' = J W Σ Wᵀ Jᵀ + 0.3·I for a camera-space mean `t` and world covariance `sigma`,
-    /// as `[xx, xy, yy]`.
-    pub fn cov2d(&self, t: DVec3, sigma: DMat3) -> [f64; 3] {
-        let txtz = (t.x / t.z).max(-self.lim[0]).min(self.lim[0]);
-        let tytz = (t.y / t.z).max(-self.lim[1]).min(self.lim[1]);
-        let j0 = DVec3::new(self.fx / t.z, 0.0, -self.fx * txtz / t.z);
-        let j1 = DVec3::new(0.0, self.fy / t.z, -self.fy * tytz / t.z);
-        // Rows of J·W are Wᵀ jᵢ.
-        let (r0, r1) = (self.w.transpose() * j0, self.w.transpose() * j1);
-        let (s0, s1) = (sigma * r0, sigma * r1);
-        [
-            r0.dot(s0) + DILATION_PX2,
-            r0.dot(s1),
-            r1.dot(s1) + DILATION_PX2,
-        ]
-    }
-
-    /// The same Σ' from the factor C of Σ = C Cᵀ (C = R·diag(s)): with P = J W C (rows p₀, p₁),
-    /// Σ' = P Pᵀ + 0.3·I, returned as `([xx, xy, yy], det)` where the determinant comes from
+    /// Σ' = J W Σ Wᵀ Jᵀ + 0.3·I from the factor C of Σ = C Cᵀ (C = R·diag(s)): with
+    /// P = J W C (rows p₀, p₁), Σ' = P Pᵀ + 0.3·I, returned as `([xx, xy, yy], det)` where the determinant comes from
     /// Cauchy–Binet, `|p₀ × p₁|² + 0.3·(|p₀|² + |p₁|²) + 0.09`. Positive definite by
     /// construction: no cancellation even for needles seen end-on.
-    pub fn cov2d_factored(&self, t: DVec3, c: DMat3) -> ([f64; 3], f64) {
+    pub(crate) fn cov2d_factored(&self, t: DVec3, c: DMat3) -> ([f64; 3], f64) {
         let txtz = (t.x / t.z).max(-self.lim[0]).min(self.lim[0]);
         let tytz = (t.y / t.z).max(-self.lim[1]).min(self.lim[1]);
         let j0 = DVec3::new(self.fx / t.z, 0.0, -self.fx * txtz / t.z);
@@ -114,7 +85,7 @@ impl ViewContext {
     }
 
     /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
-    pub fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
+    pub(crate) fn project(&self, cloud: &SplatCloud, i: usize) -> Option<Projected> {
         if !cloud.is_drawable(i) {
             return None;
         }

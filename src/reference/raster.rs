@@ -1,15 +1,16 @@
 //! Tile binning and per-pixel blending (f32, back to front).
 
-use super::project::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, Projected};
+use super::project::Projected;
 use crate::image::Image;
+use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2};
 use rayon::prelude::*;
 
 /// Tile edge in pixels.
-pub const TILE: u32 = 16;
+pub(crate) const TILE: u32 = 16;
 
 /// Bin entries per tile row (how many (splat, tile) pairs each row of tiles holds), so the
 /// caller can bin in bands of rows with bounded memory.
-pub fn row_entries(splats: &[Projected], height: u32) -> Vec<u64> {
+pub(crate) fn row_entries(splats: &[Projected], height: u32) -> Vec<u64> {
     let mut rows = vec![0u64; height.div_ceil(TILE) as usize];
     for s in splats {
         let [x0, x1, y0, y1] = s.bbox;
@@ -24,7 +25,7 @@ pub fn row_entries(splats: &[Projected], height: u32) -> Vec<u64> {
 /// For each tile of the tile rows `rows` (row-major from `rows.start`), the positions in
 /// `splats` (already in blending order) of the splats whose 3σ bounding box touches it, in
 /// blending order.
-pub fn bin(splats: &[Projected], width: u32, rows: std::ops::Range<u32>) -> Vec<Vec<u32>> {
+pub(crate) fn bin(splats: &[Projected], width: u32, rows: std::ops::Range<u32>) -> Vec<Vec<u32>> {
     let tw = width.div_ceil(TILE);
     let mut tiles = vec![Vec::new(); (tw * (rows.end - rows.start)) as usize];
     for (k, s) in splats.iter().enumerate() {
@@ -45,7 +46,7 @@ pub fn bin(splats: &[Projected], width: u32, rows: std::ops::Range<u32>) -> Vec<
 /// Blends one splat over one pixel `px` (RGBA, RGB composited, A = 1 − T) at pixel centre
 /// offset `(dx, dy)` from the mean; the exact per-pixel rule of the reference.
 #[inline]
-pub fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
+pub(crate) fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
     let [a, b, c] = s.conic;
     let m2 = a * dx * dx + 2.0 * b * dx * dy + c * dy * dy;
     // Written so that NaN (and a negative m², impossible for a positive-definite conic) skip.
@@ -67,7 +68,7 @@ pub fn blend(px: &mut [f32; 4], s: &Projected, dx: f32, dy: f32) {
 /// filled with the background, A = 0). Bands of one tile row run in parallel; every pixel sees
 /// its splats in the same order whatever the thread count, so the result is bit-identical
 /// across runs and thread counts.
-pub fn rasterize(
+pub(crate) fn rasterize(
     image: &mut Image,
     splats: &[Projected],
     tiles: &[Vec<u32>],

@@ -4,7 +4,14 @@ use crate::cloud::SplatCloud;
 
 /// Writes a cloud as INRIA binary little-endian PLY (log scale, logit opacity, w-first
 /// quaternion, channel-major `f_rest`) — the inverse of the
-/// [PLY loader](crate::load::ply), used by tests and benches.
+/// [PLY loader](crate::load::ply).
+///
+/// Exact: each logit and log value is the f32 nearest the exact inverse for which the
+/// loader's decoding (`sigmoid` / `exp` in f64, rounded to f32) gives back the cloud's value
+/// bit for bit, whenever such an f32 lies within 64 ulps (it always does for values that were
+/// themselves decoded from a PLY). Opacity 1 and 0 and scale 0 are written as finite values
+/// that decode to exactly 1, 0 and 0 (±110: `sigmoid(±110)` and `exp(−110)` round to them),
+/// so no ±inf reaches other tools.
 pub fn to_inria_ply(cloud: &SplatCloud) -> Vec<u8> {
     let k = cloud.coeffs_per_splat();
     let mut out = Vec::new();
@@ -34,12 +41,50 @@ pub fn to_inria_ply(cloud: &SplatCloud) -> Vec<u8> {
                 row.push(c[ch]);
             }
         }
-        let o = cloud.opacities[i] as f64;
-        row.push((o / (1.0 - o)).ln() as f32);
-        row.extend(cloud.scales[i].map(f32::ln));
+        row.push(encode_exact(cloud.opacities[i], logit, sigmoid));
+        row.extend(cloud.scales[i].map(|s| encode_exact(s, f64::ln, f64::exp)));
         let q = cloud.rotations[i];
         row.extend_from_slice(&[q[3], q[0], q[1], q[2]]);
         out.extend_from_slice(bytemuck::cast_slice(&row));
     }
     out
+}
+
+/// Beyond this a logit or log decodes to exactly 0 or 1 (see [`to_inria_ply`]).
+const SATURATED: f32 = 110.0;
+
+fn logit(o: f64) -> f64 {
+    (o / (1.0 - o)).ln()
+}
+
+/// The PLY loader's sigmoid (f64).
+fn sigmoid(x: f64) -> f64 {
+    if x >= 0.0 {
+        1.0 / (1.0 + (-x).exp())
+    } else {
+        let e = x.exp();
+        e / (1.0 + e)
+    }
+}
+
+/// The f32 `x` near `inverse(v)` with `decode(x) as f32 == v`, searching ±64 ulps (nearest
+/// first); the rounded inverse itself when none decodes exactly. Infinite inverses are
+/// clamped to ±[`SATURATED`].
+fn encode_exact(v: f32, inverse: fn(f64) -> f64, decode: fn(f64) -> f64) -> f32 {
+    let x0 = (inverse(v as f64) as f32).clamp(-SATURATED, SATURATED);
+    if x0.is_nan() {
+        return x0;
+    }
+    let exact = |x: f32| (decode(x as f64) as f32).to_bits() == v.to_bits();
+    let (mut up, mut down) = (x0, x0);
+    for _ in 0..=64 {
+        if exact(up) {
+            return up;
+        }
+        if exact(down) {
+            return down;
+        }
+        (up, down) = (up.next_up(), down.next_down());
+    }
+    x0
 }

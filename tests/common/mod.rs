@@ -1,37 +1,61 @@
-//! Shared test helpers: a seeded PRNG and random clouds.
-#![allow(dead_code)]
+//! Shared test helpers: the seeded generator and random clouds (from `splatgl::scene`), the
+//! real-data folder, cameras and single-colour SH. The GL helpers (headless renderer, scores,
+//! error bounds) are in [`gl`]; test-side encoders of the packed formats in [`packed`].
+#![allow(dead_code, unused_imports)]
 
-use splatgl::SplatCloud;
+use glam::Vec3;
+use splatgl::camera::Camera;
+use std::path::{Path, PathBuf};
 
-pub use splatgl::scene::Rng;
+pub use splatgl::scene::{Rng, random_cloud};
 
-/// A random cloud of `n` splats, SH degree `degree`.
-pub fn random_cloud(seed: u64, n: usize, degree: u8) -> SplatCloud {
-    let mut r = Rng::new(seed);
-    let mut c = SplatCloud::with_capacity(degree, n);
-    let k = c.coeffs_per_splat();
-    for _ in 0..n {
-        let p = [0; 3].map(|_| r.range(-5.0, 5.0));
-        let s = [0; 3].map(|_| r.range(0.01, 0.5));
-        let q = r.quat();
-        let o = r.range(0.05, 1.0);
-        let sh: Vec<[f32; 3]> = (0..k)
-            .map(|j| [0; 3].map(|_| r.range(-1.0, 1.0) / (1 + j) as f32))
-            .collect();
-        c.push(p, s, q, o, &sh);
-    }
-    c
+#[cfg(feature = "gl")]
+pub mod gl;
+pub mod packed;
+
+/// The shared real-data folder (`../shared/data/real`, beside the checkout).
+fn real_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real")
 }
 
 /// Path of a file in the shared real-data folder (None, with a note, if absent).
-pub fn real(name: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/real")
-        .join(name);
+pub fn real(name: &str) -> Option<PathBuf> {
+    let p = real_dir().join(name);
     if p.exists() {
         Some(p)
     } else {
         eprintln!("skipping: {} not found", p.display());
         None
     }
+}
+
+/// Every file in the shared real-data folder, sorted by name (None, with a note, if the folder
+/// is absent).
+pub fn real_files() -> Option<Vec<PathBuf>> {
+    let dir = real_dir();
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!("skipping: {} not found", dir.display());
+        return None;
+    };
+    let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    Some(paths)
+}
+
+/// A camera at `eye` looking at `target` (up +Y) with vertical field of view `fov_deg` degrees.
+pub fn look_at_fov_deg(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
+    Camera::look_at(eye, target, Vec3::Y, fov_deg.to_radians(), w, h)
+}
+
+/// A camera at `eye` looking at `target` (up +Y) with vertical focal length `focal_px` pixels.
+pub fn look_at_focal_px(eye: Vec3, target: Vec3, focal_px: f32, w: u32, h: u32) -> Camera {
+    let fov = 2.0 * (0.5 * h as f32 / focal_px).atan();
+    Camera::look_at(eye, target, Vec3::Y, fov, w, h)
+}
+
+/// SH coefficients of degree `degree` showing the constant colour `rgb` (higher bands zero).
+pub fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
+    let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
+    sh[0] = rgb.map(|c| splatgl::sh::dc_from_color(c as f64));
+    sh
 }

@@ -93,7 +93,7 @@ fn dims_of(d: Dimensions) -> Option<usize> {
 }
 
 /// The bytes of a buffer view, bounds-checked.
-fn view_bytes<'b>(
+pub(super) fn view_bytes<'b>(
     view: &gltf::buffer::View,
     buffers: &'b [Vec<u8>],
     path: &str,

@@ -14,7 +14,12 @@ pub const PREFIX: &str = "KHR_gaussian_splatting:";
 pub const EXT: &str = "KHR_gaussian_splatting";
 
 /// Extensions whose presence in `extensionsRequired` splatgl can honour.
-pub const SUPPORTED_REQUIRED: &[&str] = &[EXT, "KHR_mesh_quantization"];
+pub const SUPPORTED_REQUIRED: &[&str] = &[
+    EXT,
+    "KHR_mesh_quantization",
+    super::spz::SPZ_2,
+    super::spz::LEGACY,
+];
 
 /// A parsed glTF asset.
 pub struct Parsed {

@@ -7,7 +7,7 @@
 //! - positions by the full matrix;
 //! - covariance per the RC, Σ = M C Cᵀ Mᵀ, stored back as scale + rotation. For a similarity M
 //!   this is closed form (rotation composed, scale multiplied); otherwise Σ is eigen-decomposed
-//!   in f64, which represents every Σ exactly up to rounding (see [`crate::covariance`]);
+//!   in f64, which represents every Σ exactly up to rounding (`src/covariance.rs`);
 //! - SH rotated by the orthogonal factor of M's polar decomposition (real Wigner-D, see
 //!   [`crate::sh::ShRotation`]).
 //!
@@ -20,7 +20,14 @@ mod container;
 mod meta;
 mod primitive;
 mod rules;
+mod spz;
 mod transform;
+
+/// Applies a node's global matrix to a local-space cloud exactly as the loader does
+/// (positions, Σ = M C Cᵀ Mᵀ, SH rotated by the polar factor); findings name `nodes[node]`;
+/// `None` when a value becomes non-finite or overflows (a blocking finding names the first
+/// splat: what the loader would drop, or refuse in strict mode).
+pub use transform::apply_checked as apply_node_transform;
 
 use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen, Severity, hygiene};
 use crate::camera::GltfPerspective;
@@ -87,7 +94,7 @@ pub(crate) fn walk(
     let mut w = Walk {
         cloud: None,
         cameras: Vec::new(),
-        splat_primitives: count_splat_primitives(&parsed.json),
+        splat_primitives: count_splat_primitives(&parsed.json, true),
     };
     let Some(doc) = &parsed.doc else {
         return Ok(w);
@@ -136,9 +143,11 @@ fn decode_primitives(
         for (pi, prim) in array(mesh, "primitives").iter().enumerate() {
             let ppath = format!("meshes[{mi}].primitives[{pi}]");
             let exts = prim.get("extensions").and_then(Value::as_object);
+            let legacy_spz = exts.is_some_and(|e| e.contains_key(spz::LEGACY));
             if let Some(legacy) = exts.and_then(|e| {
-                e.keys()
-                    .find(|k| k.as_str() != EXT && k.contains("gaussian_splats"))
+                e.keys().find(|k| {
+                    k.as_str() != EXT && k.as_str() != spz::LEGACY && k.contains("gaussian_splats")
+                })
             }) {
                 findings.push(Finding::fatal(
                     format!("{ppath}.extensions.{legacy}"),
@@ -147,19 +156,21 @@ fn decode_primitives(
                 blocked = true;
                 continue;
             }
-            let Some(ext) = exts.and_then(|e| e.get(EXT)) else {
-                continue;
-            };
-            let Some(ext) = ext.as_object() else {
-                findings.push(Finding::fatal(
-                    format!("{ppath}.extensions.{EXT}"),
-                    "must be an object",
-                ));
-                blocked = true;
-                continue;
-            };
             let before = findings.len();
-            let meta = meta::read(ext, &ppath, &used, findings);
+            let meta = match exts.and_then(|e| e.get(EXT)) {
+                Some(Value::Object(ext)) => meta::read(ext, &ppath, &used, findings),
+                Some(_) => {
+                    findings.push(Finding::fatal(
+                        format!("{ppath}.extensions.{EXT}"),
+                        "must be an object",
+                    ));
+                    blocked = true;
+                    continue;
+                }
+                // The legacy draft had no extension object: the RC's defaults.
+                None if legacy_spz => crate::cloud::SplatMeta::default(),
+                None => continue,
+            };
             if findings[before..].iter().any(|f| f.blocks_loading) {
                 blocked = true;
                 continue;
@@ -170,6 +181,7 @@ fn decode_primitives(
                 path: ppath,
                 scale_space: opts.scale_space,
                 opts,
+                spz_axes: opts.spz_axes,
                 budget,
                 quantization: used.contains(&"KHR_mesh_quantization"),
             };
@@ -247,6 +259,9 @@ fn instantiate(
             }
             report.scale_space = Some(ScaleSeen::merge(report.scale_space, ls.scale_seen));
             report.non_unit_quaternions += ls.non_unit;
+            if report.details.is_none() {
+                report.details.clone_from(&ls.details);
+            }
             let Some(c) = &mut cloud else {
                 cloud = Some(global);
                 continue;
@@ -268,7 +283,9 @@ fn instantiate(
     cloud
 }
 
-fn count_splat_primitives(json: &Value) -> usize {
+/// Primitives with `KHR_gaussian_splatting` (and, with `legacy`, those with the legacy SPZ
+/// extension instead).
+fn count_splat_primitives(json: &Value, legacy: bool) -> usize {
     let prims = json
         .get("meshes")
         .and_then(Value::as_array)
@@ -277,7 +294,8 @@ fn count_splat_primitives(json: &Value) -> usize {
         .filter_map(|m| m.get("primitives").and_then(Value::as_array))
         .flatten();
     prims
-        .filter(|p| p.get("extensions").and_then(|e| e.get(EXT)).is_some())
+        .filter_map(|p| p.get("extensions"))
+        .filter(|e| e.get(EXT).is_some() || (legacy && e.get(spz::LEGACY).is_some()))
         .count()
 }
 
@@ -286,7 +304,7 @@ fn uses_extension_check(json: &Value, findings: &mut Vec<Finding>) {
         .get("extensionsUsed")
         .and_then(Value::as_array)
         .is_some_and(|a| a.iter().any(|v| v.as_str() == Some(EXT)));
-    if count_splat_primitives(json) > 0 && !used {
+    if count_splat_primitives(json, false) > 0 && !used {
         findings.push(Finding::error(
             "extensionsUsed",
             format!("{EXT} is used by primitives but not listed in extensionsUsed"),

@@ -5,7 +5,8 @@ use super::accessor::{Decoded, decode};
 use super::container::PREFIX;
 use super::rules;
 use crate::cloud::{ColorSpace, SplatCloud, SplatMeta};
-use crate::load::{Finding, LoadOptions, ScaleSeen, ScaleSpace, Severity, hygiene};
+use crate::load::spz::SpzAxes;
+use crate::load::{Details, Finding, LoadOptions, ScaleSeen, ScaleSpace, Severity, hygiene};
 use gltf::accessor::DataType;
 use serde_json::{Map, Value};
 
@@ -20,6 +21,8 @@ pub struct LocalSplats {
     pub non_unit: usize,
     /// Accessor index of each splat, when the hygiene pass dropped some.
     pub origin: Option<Vec<u32>>,
+    /// Container facts of a compressed primitive (SPZ), `None` for plain accessors.
+    pub details: Option<Details>,
 }
 
 /// Context for reading one primitive.
@@ -30,10 +33,12 @@ pub struct Ctx<'a> {
     pub buffers: &'a [Vec<u8>],
     /// `meshes[m].primitives[p]`.
     pub path: String,
-    /// Options.
+    /// How SCALE values are read.
     pub scale_space: ScaleSpace,
     /// All options (limits, strict mode).
     pub opts: &'a LoadOptions,
+    /// Axes of SPZ payloads (compressed primitives).
+    pub spz_axes: SpzAxes,
     /// Whether `KHR_mesh_quantization` is in `extensionsUsed` (quantized POSITION allowed).
     pub quantization: bool,
     /// Values the document may still decode (see [`decode`]).
@@ -52,12 +57,18 @@ pub fn read(
     f: &mut Vec<Finding>,
 ) -> Option<LocalSplats> {
     check_primitive(&ctx.path, prim, f);
-    let attrs = fetch(ctx, prim, f)?;
-    rules::check_types_and_counts(ctx, &attrs, f)?;
-    let degree = rules::sh_degree(&ctx.path, &attrs.higher, f);
-    let log = rules::scale_space(ctx, &attrs.scale, f)?;
-    rules::check_opacity(&ctx.path, &attrs.opacity, f)?;
-    let mut ls = assemble(ctx, &attrs, meta, degree, log, f);
+    let mut ls = if let Some((kind, ext, ext_path)) = super::spz::compression(prim, &ctx.path) {
+        let mut ls = super::spz::read(ctx, prim, kind, ext, &ext_path, f)?;
+        ls.cloud.meta = meta.clone();
+        ls
+    } else {
+        let attrs = fetch(ctx, prim, f)?;
+        rules::check_types_and_counts(ctx, &attrs, f)?;
+        let degree = rules::sh_degree(&ctx.path, &attrs.higher, f);
+        let log = rules::scale_space(ctx, &attrs.scale, f)?;
+        rules::check_opacity(&ctx.path, &attrs.opacity, f)?;
+        assemble(ctx, &attrs, meta, degree, log, f)
+    };
     let site = hygiene::Site {
         path: &ctx.path,
         what: "",
@@ -273,7 +284,11 @@ fn assemble(
             if (norm - 1.0).abs() > tol {
                 non_unit.add(i);
             }
-            q.map(|v| (v as f64 / norm) as f32)
+            if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
+                q // unit to f32 rounding: kept bit for bit
+            } else {
+                q.map(|v| (v as f64 / norm) as f32)
+            }
         };
         let s: [f32; 3] = a.scale.get(i);
         let s = if log {
@@ -324,6 +339,7 @@ fn assemble(
         scale_seen,
         non_unit: non_unit.count,
         origin: None,
+        details: None,
     }
 }
 
@@ -338,10 +354,10 @@ fn dc_from_color0(c: [f32; 3], srgb: bool) -> [f32; 3] {
         }
         let v = v.clamp(0.0, 1.0) as f64;
         let v = if srgb {
-            crate::color::srgb_encode(v)
+            crate::profile::srgb_encode(v)
         } else {
             v
         };
-        ((v - 0.5) / crate::sh::SH_C0) as f32
+        crate::sh::dc_from_color(v)
     })
 }

@@ -94,3 +94,26 @@ pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Findi
     }
     out
 }
+
+/// The node transform of `apply` (above), then the loader contract on the result: `None` (with
+/// a blocking finding at `nodes[node]` naming the first broken splat) when the transform made a
+/// value non-finite.
+pub fn apply_checked(
+    local: &SplatCloud,
+    m: DMat4,
+    node: usize,
+    findings: &mut Vec<Finding>,
+) -> Option<SplatCloud> {
+    let out = apply(local, m, node, findings);
+    match out.validate() {
+        Ok(()) => Some(out),
+        Err(v) => {
+            let mut f = Finding::fatal(format!("nodes[{node}]"), v.message);
+            if let Some(i) = v.index {
+                f = f.at(i as u64);
+            }
+            findings.push(f);
+            None
+        }
+    }
+}

@@ -15,6 +15,7 @@
 use super::header::{Element, Encoding, Header, Scalar};
 use super::{PlyError, Unusable};
 use crate::cloud::{SplatCloud, sh_coeff_count};
+use crate::load::Details;
 
 /// Splats per chunk.
 const CHUNK: usize = 256;
@@ -294,7 +295,7 @@ fn push_splat(
             (Some(lo), Some(hi)) => lerp(chunk_val(lo), chunk_val(hi), rgba[ch]),
             _ => rgba[ch],
         };
-        coeffs[0][ch] = ((v as f64 - 0.5) / crate::sh::SH_C0) as f32;
+        coeffs[0][ch] = crate::sh::dc_from_color(v as f64);
     }
     let finite = pos
         .iter()
@@ -310,6 +311,36 @@ fn push_splat(
     }
     cloud.push(pos, scale, rot, rgba[3], coeffs);
     Ok(())
+}
+
+/// What the compressed layout keeps of each attribute (`splatgl info`).
+pub(super) fn details(degree: u8) -> Details {
+    let mut d = Details::new("compressed_ply", "none");
+    d.bits(
+        "position",
+        11,
+        "11/10/11-bit unorm x/y/z in the chunk's box",
+    );
+    d.bits(
+        "scale",
+        11,
+        "11/10/11-bit unorm ln(scale) in the chunk's range",
+    );
+    d.bits(
+        "rotation",
+        10,
+        "smallest three: 2-bit index, 3 × 10-bit components",
+    );
+    d.bits("color", 8, "8-bit colour in the chunk's range (or [0, 1])");
+    d.bits("opacity", 8, "b/255 (linear)");
+    d.lossy("positions and log scales in 2047/1023 steps of each 256-splat chunk's range");
+    d.lossy("rotation components in 1023 steps of [−1/√2, 1/√2]");
+    d.lossy("colours and opacity in 255 steps");
+    if degree > 0 {
+        d.bits("sh", 8, "((b + 0.5)/256 − 0.5) · 8");
+        d.lossy("SH in steps of 1/32, clamped to [−4, 4]");
+    }
+    d
 }
 
 #[cfg(test)]

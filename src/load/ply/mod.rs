@@ -246,7 +246,7 @@ fn convert_row(
         }
         sh[0][k] = match l.dc_is_color {
             None => d as f32,
-            Some(div) => ((d / div - 0.5) / crate::sh::SH_C0) as f32,
+            Some(div) => crate::sh::dc_from_color(d / div),
         };
         if !sh[0][k].is_finite() {
             return Err(bad(l.dc[k], "colour coefficient overflows f32"));
@@ -361,6 +361,7 @@ pub(crate) fn read(
     report.scale_space = Some(ScaleSeen::Log);
     if compressed::is_compressed(vertex) {
         let (mut cloud, bad) = compressed::decode(&header, body)?;
+        report.details = Some(compressed::details(cloud.sh_degree));
         report.findings.push(Finding::warning(
             "",
             "PlayCanvas compressed PLY: quantised positions, scales, rotations and colours",

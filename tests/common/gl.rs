@@ -1,5 +1,6 @@
-//! Shared helpers of the GL test crates (`tests/gl.rs`, `tests/gl_errata.rs`): GL backend
-//! (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU reference rasterizer.
+//! Shared helpers of the GL test crates (`tests/gl_vs_reference.rs`, `tests/gl_embedding.rs`,
+//! `tests/gl_errata.rs`): GL backend (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU
+//! reference rasterizer. `use common::gl::*` brings these and the general helpers.
 //!
 //! Every test renders small images (≤ 96 px) so the suite stays fast on llvmpipe. Tests skip
 //! (with a message) only when EGL cannot be opened at all; any other GL failure fails them.
@@ -25,13 +26,16 @@
 //! PSNR must be ≥ 45 dB everywhere.
 #![allow(dead_code, unused_imports)]
 
+pub use super::{look_at_fov_deg, real_files, sh_for};
 pub use glam::{Quat, Vec3};
 pub use splatgl::SplatCloud;
 pub use splatgl::camera::Camera;
 pub use splatgl::cloud::ColorSpace;
 pub use splatgl::compare::compare;
 pub use splatgl::gl::Errata;
-pub use splatgl::headless::{GlApi, HeadlessError, HeadlessRenderer, RenderOptions, TargetKind};
+pub use splatgl::headless::{
+    GlApi, HeadlessContext, HeadlessError, HeadlessOptions, HeadlessRenderer, TargetKind,
+};
 pub use splatgl::image::Image;
 pub use splatgl::reference;
 pub use splatgl::scene::{self, Rng};
@@ -42,16 +46,22 @@ pub const MAX_ERR_SPARSE: f32 = 1.5 / 255.0 + 0.0111;
 pub const MAX_ERR_DENSE: f32 = 8.0 / 255.0 + 0.0111;
 pub const MIN_PSNR: f64 = 45.0;
 
-/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
-pub fn headless_with(errata: Errata) -> Option<HeadlessRenderer> {
-    match HeadlessRenderer::with_errata(errata) {
-        Ok(r) => Some(r),
+/// The value, or `None` (test skipped, with a message) when EGL cannot be opened at all; any
+/// other error panics with `what`.
+pub fn or_skip<T>(r: Result<T, HeadlessError>, what: &str) -> Option<T> {
+    match r {
+        Ok(v) => Some(v),
         Err(HeadlessError::EglUnavailable(msg)) => {
             eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
             None
         }
-        Err(e) => panic!("headless GL failed: {e}"),
+        Err(e) => panic!("{what}: {e}"),
     }
+}
+
+/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
+pub fn headless_with(errata: Errata) -> Option<HeadlessRenderer> {
+    or_skip(HeadlessRenderer::with_errata(errata), "headless GL failed")
 }
 
 pub fn headless() -> Option<HeadlessRenderer> {
@@ -63,15 +73,6 @@ pub fn ref_opts(degree: u8, background: [f32; 3]) -> reference::RenderOptions {
         sh_degree: degree,
         background,
         ..Default::default()
-    }
-}
-
-pub fn srgb_encode(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
     }
 }
 
@@ -103,7 +104,8 @@ pub fn score(gl: &Image, want: &Image) -> Score {
     }
 }
 
-/// Reference image of `cloud` (SH degree `degree`, background `bg`), in display values.
+/// Reference image of `cloud` (SH degree `degree`, background `bg`), in display values
+/// (`linear`: as a `lin_rec709_display` cloud is shown).
 pub fn reference_image(
     cloud: &SplatCloud,
     cam: &Camera,
@@ -111,18 +113,12 @@ pub fn reference_image(
     bg: [f32; 3],
     linear: bool,
 ) -> Image {
-    if !linear {
-        return reference::render(cloud, cam, &ref_opts(degree, bg));
-    }
-    // lin_rec709_display: blend linear (background decoded), encode to sRGB at the end.
-    let bg_lin = bg.map(splatgl::headless::srgb_to_linear);
-    let mut img = reference::render(cloud, cam, &ref_opts(degree, bg_lin));
-    for p in &mut img.pixels {
-        for c in &mut p[..3] {
-            *c = srgb_encode(*c);
-        }
-    }
-    img
+    let space = if linear {
+        ColorSpace::LinRec709Display
+    } else {
+        ColorSpace::SrgbRec709Display
+    };
+    reference::render_display(cloud, cam, &ref_opts(degree, bg), space).0
 }
 
 /// How far the brightest splat colour seen by `cam` exceeds 1 (0 if none does).
@@ -145,7 +141,7 @@ pub fn check(
     r: &mut HeadlessRenderer,
     cloud: &SplatCloud,
     cam: &Camera,
-    opts: &RenderOptions,
+    opts: &HeadlessOptions,
     max_err: f32,
 ) -> Score {
     r.upload(cloud).unwrap();
@@ -196,20 +192,10 @@ pub fn check(
     s
 }
 
-pub fn cam(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
-    Camera::look_at(eye, target, Vec3::Y, fov_deg.to_radians(), w, h)
-}
-
-pub fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
-    let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
-    sh[0] = rgb.map(|c| (c - 0.5) / splatgl::sh::SH_C0 as f32);
-    sh
-}
-
-pub fn both_targets() -> [RenderOptions; 2] {
+pub fn both_targets() -> [HeadlessOptions; 2] {
     [
-        RenderOptions::default(),
-        RenderOptions {
+        HeadlessOptions::default(),
+        HeadlessOptions {
             target: TargetKind::Rgba16fResolve,
             ..Default::default()
         },

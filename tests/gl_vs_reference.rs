@@ -1,17 +1,14 @@
-//! GL backend vs the CPU reference on Mesa EGL / llvmpipe (scene families, targets, embedding).
-//! Helpers and the error bound: `tests/gl_support/mod.rs`.
+//! GL backend vs the CPU reference on Mesa EGL / llvmpipe: scene families, SH degrees, colour
+//! spaces, both targets, edge cases (near plane, image border, non-finite splats, orders), real
+//! files. Helpers and the error bound: `tests/common/gl.rs`.
 
-mod gl_support;
-use gl_support::*;
-
-// ---------------------------------------------------------------------------------------------
-// GL vs reference
-// ---------------------------------------------------------------------------------------------
+mod common;
+use common::gl::*;
 
 #[test]
 fn single_splats_many_anisotropies_and_rotations() {
     let Some(mut r) = headless() else { return };
-    let c = cam(Vec3::new(0.3, 0.4, 4.0), Vec3::ZERO, 50.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.3, 0.4, 4.0), Vec3::ZERO, 50.0, 64, 64);
     let scales = [
         [0.4, 0.05, 0.05],
         [0.05, 0.5, 0.02],
@@ -43,7 +40,7 @@ fn single_splats_many_anisotropies_and_rotations() {
                 &mut r,
                 &cloud,
                 &c,
-                &RenderOptions {
+                &HeadlessOptions {
                     background: [0.1, 0.2, 0.3],
                     ..Default::default()
                 },
@@ -73,10 +70,10 @@ fn sh_degrees_0_to_3_from_several_views() {
     .into_iter()
     .enumerate()
     {
-        let c = cam(eye, Vec3::ZERO, 45.0, 64, 64);
+        let c = look_at_fov_deg(eye, Vec3::ZERO, 45.0, 64, 64);
         let mut prev: Option<Image> = None;
         for degree in 0..=3u8 {
-            let opts = RenderOptions {
+            let opts = HeadlessOptions {
                 sh_degree: Some(degree),
                 ..Default::default()
             };
@@ -106,7 +103,7 @@ fn sh_degrees_0_to_3_from_several_views() {
 fn dense_random_cloud_both_targets() {
     let Some(mut r) = headless() else { return };
     let cloud = scene::random_cloud(4000, 1, 1.0, 42);
-    let c = cam(Vec3::new(2.0, 1.0, 3.0), Vec3::ZERO, 50.0, 96, 72);
+    let c = look_at_fov_deg(Vec3::new(2.0, 1.0, 3.0), Vec3::ZERO, 50.0, 96, 72);
     for opts in both_targets() {
         check("dense", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
     }
@@ -140,14 +137,14 @@ fn splats_crossing_the_near_plane() {
         let rgb = [(); 3].map(|_| rng.range(0.1, 0.9));
         cloud.push(p, s, rng.quat(), rng.range(0.3, 1.0), &sh_for(rgb, 0));
     }
-    let mut c = cam(Vec3::ZERO, Vec3::Z, 70.0, 64, 64);
+    let mut c = look_at_fov_deg(Vec3::ZERO, Vec3::Z, 70.0, 64, 64);
     c.near = 0.05;
     check(
         "near plane",
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
     // A camera near larger than 0.2 moves the cull depth (max(0.2, near)).
@@ -157,7 +154,7 @@ fn splats_crossing_the_near_plane() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }
@@ -181,13 +178,13 @@ fn splats_crossing_the_image_border_and_fov_clamp() {
         let rgb = [(); 3].map(|_| rng.range(0.1, 0.9));
         cloud.push(p, s, rng.quat(), 0.8, &sh_for(rgb, 0));
     }
-    let mut c = cam(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 55.0, 80, 60);
+    let mut c = look_at_fov_deg(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 55.0, 80, 60);
     check(
         "border",
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
     // Off-centre principal point.
@@ -198,7 +195,7 @@ fn splats_crossing_the_image_border_and_fov_clamp() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }
@@ -218,13 +215,13 @@ fn tiny_sub_pixel_splats() {
         let rgb = [(); 3].map(|_| rng.range(0.3, 1.0));
         cloud.push(p, s, rng.quat(), 1.0, &sh_for(rgb, 0));
     }
-    let c = cam(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 45.0, 64, 64);
     check(
         "tiny",
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_SPARSE,
     );
 }
@@ -234,17 +231,17 @@ fn lin_rec709_display_both_targets() {
     let Some(mut r) = headless() else { return };
     let mut cloud = scene::random_cloud(1500, 2, 1.0, 9);
     cloud.meta.color_space = splatgl::cloud::Known::Known(ColorSpace::LinRec709Display);
-    let c = cam(Vec3::new(-2.0, 1.5, 3.0), Vec3::ZERO, 50.0, 80, 64);
+    let c = look_at_fov_deg(Vec3::new(-2.0, 1.5, 3.0), Vec3::ZERO, 50.0, 80, 64);
     for mut opts in both_targets() {
         opts.background = [0.2, 0.25, 0.3];
         check("lin_rec709", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
     }
     // And it is really different from blending the stored values as sRGB.
-    let lin = r.render(&c, &RenderOptions::default()).unwrap();
+    let lin = r.render(&c, &HeadlessOptions::default()).unwrap();
     let srgb = r
         .render(
             &c,
-            &RenderOptions {
+            &HeadlessOptions {
                 color_space: Some(ColorSpace::SrgbRec709Display),
                 ..Default::default()
             },
@@ -256,18 +253,15 @@ fn lin_rec709_display_both_targets() {
 #[test]
 fn desktop_gl_330_core_matches_reference() {
     // The same GLSL files compiled as `#version 330 core` on a desktop GL 3.3 core context.
-    let mut r = match HeadlessRenderer::with_api(GlApi::DesktopCore33, Errata::default()) {
-        Ok(r) => r,
-        Err(HeadlessError::EglUnavailable(msg)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
-            return;
-        }
-        Err(e) => panic!("desktop GL context failed: {e}"),
+    let desktop = HeadlessContext::with_api(GlApi::DesktopCore33);
+    let r = desktop.and_then(HeadlessRenderer::with_context);
+    let Some(mut r) = or_skip(r, "desktop GL context failed") else {
+        return;
     };
     eprintln!("{}", r.context().describe());
     assert!(!glow::HasContext::version(r.context().gl()).is_embedded);
     let mut cloud = scene::random_cloud(1500, 3, 1.0, 31);
-    let c = cam(Vec3::new(1.5, -1.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(1.5, -1.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     for opts in both_targets() {
         check("desktop 330 core", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
     }
@@ -289,7 +283,7 @@ fn desktop_gl_330_core_matches_reference() {
 fn same_scene_twice_is_bit_identical() {
     let Some(mut r) = headless() else { return };
     let cloud = scene::random_cloud(2000, 3, 1.0, 1);
-    let c = cam(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     for opts in both_targets() {
         r.upload(&cloud).unwrap();
         let a = r.render(&c, &opts).unwrap();
@@ -305,20 +299,49 @@ fn same_scene_twice_is_bit_identical() {
 }
 
 #[test]
-fn rgba16f_resolve_measured_against_rgba8() {
+fn a_render_does_not_depend_on_the_colour_space_of_the_one_before() {
+    // The draw switches GL_FRAMEBUFFER_SRGB per colour space and leaves it so: the next
+    // render's clear of an sRGB target must not inherit it.
+    let cloud = scene::random_cloud(500, 1, 0.8, 2);
+    let c = look_at_fov_deg(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 48, 40);
+    let bg = [0.3, 0.5, 0.7];
+    let linear = HeadlessOptions {
+        background: bg,
+        color_space: Some(ColorSpace::LinRec709Display),
+        ..Default::default()
+    };
+    let srgb = HeadlessOptions {
+        color_space: Some(ColorSpace::SrgbRec709Display),
+        ..linear
+    };
+    for api in [GlApi::Gles3, GlApi::DesktopCore33] {
+        let Some(ctx) = or_skip(HeadlessContext::with_api(api), "context") else {
+            return;
+        };
+        let mut r = HeadlessRenderer::with_context(ctx).unwrap();
+        r.upload(&cloud).unwrap();
+        let first = r.render(&c, &linear).unwrap();
+        r.render(&c, &srgb).unwrap();
+        let again = r.render(&c, &linear).unwrap();
+        assert_eq!(first.to_rgba8(), again.to_rgba8(), "{api:?}");
+    }
+}
+
+#[test]
+fn rgba16f_resolve_is_closer_to_the_reference_than_rgba8() {
     let Some(mut r) = headless() else { return };
     // Many low-opacity layers: where 8-bit blending loses most.
     let mut cloud = scene::random_cloud(3000, 0, 0.6, 21);
     for o in &mut cloud.opacities {
         *o *= 0.15;
     }
-    let c = cam(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 50.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, 50.0, 64, 64);
     let s8 = check(
         "low-alpha RGBA8",
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
     let s16 = check(
@@ -326,7 +349,7 @@ fn rgba16f_resolve_measured_against_rgba8() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions {
+        &HeadlessOptions {
             target: TargetKind::Rgba16fResolve,
             ..Default::default()
         },
@@ -360,13 +383,13 @@ fn non_finite_splats_are_skipped_like_the_reference() {
     cloud.sh[17 * 4] = [f32::NAN, 0.0, 0.0];
     cloud.sh[19 * 4 + 1] = [f32::INFINITY; 3];
     assert_eq!(cloud.len(), n);
-    let c = cam(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 64);
+    let c = look_at_fov_deg(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 64, 64);
     check(
         "non-finite",
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }
@@ -374,12 +397,12 @@ fn non_finite_splats_are_skipped_like_the_reference() {
 #[test]
 fn empty_cloud_and_partial_orders() {
     let Some(mut r) = headless() else { return };
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 32, 32);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 32, 32);
     r.upload(&SplatCloud::new(0)).unwrap();
     let img = r
         .render(
             &c,
-            &RenderOptions {
+            &HeadlessOptions {
                 background: [0.2, 0.4, 0.6],
                 ..Default::default()
             },
@@ -390,7 +413,7 @@ fn empty_cloud_and_partial_orders() {
     // An order longer than the cloud is an error, not a GPU read out of bounds.
     let cloud = scene::random_cloud(10, 0, 1.0, 2);
     r.upload(&cloud).unwrap();
-    let err = r.render_with_order(&c, &RenderOptions::default(), &[0; 11]);
+    let err = r.render_with_order(&c, &HeadlessOptions::default(), &[0; 11]);
     assert!(matches!(
         err,
         Err(HeadlessError::Gl(splatgl::gl::GlError::OrderTooLong {
@@ -402,7 +425,7 @@ fn empty_cloud_and_partial_orders() {
     let mut z = c;
     z.width = 0;
     assert!(
-        r.render(&z, &RenderOptions::default())
+        r.render(&z, &HeadlessOptions::default())
             .unwrap()
             .pixels
             .is_empty()
@@ -411,182 +434,19 @@ fn empty_cloud_and_partial_orders() {
     let mut order = Vec::new();
     splatgl::gl::sort_back_to_front(&cloud.positions[..5], c.eye(), &mut order);
     let five = r
-        .render_with_order(&c, &RenderOptions::default(), &order)
+        .render_with_order(&c, &HeadlessOptions::default(), &order)
         .unwrap();
     let mut bad = order.clone();
     bad.extend([10, u32::MAX, 1_000_000, 15, 99]);
     let with_bad = r
-        .render_with_order(&c, &RenderOptions::default(), &bad)
+        .render_with_order(&c, &HeadlessOptions::default(), &bad)
         .unwrap();
     assert_eq!(five, with_bad);
     // An empty order draws nothing.
     let img = r
-        .render_with_order(&c, &RenderOptions::default(), &[])
+        .render_with_order(&c, &HeadlessOptions::default(), &[])
         .unwrap();
     assert!(img.pixels.iter().all(|p| p[3] == 0.0));
-}
-
-#[test]
-fn shader_errors_carry_log_and_numbered_source() {
-    let Some(r) = headless() else { return };
-    let gl = r.context().gl();
-    let vs = "#version 300 es\nvoid main() {\n  gl_Position = vec4(0.0);\n}\n";
-    let fs = "#version 300 es\nprecision highp float;\nout vec4 o;\nvoid main() {\n  o = undefined_thing;\n}\n";
-    let err = splatgl::gl::program::build_program(gl, "broken", vs, fs).unwrap_err();
-    let msg = err.to_string();
-    assert!(matches!(err, splatgl::gl::GlError::Compile { .. }), "{msg}");
-    assert!(msg.contains("undefined_thing"), "{msg}");
-    assert!(msg.contains("   5 |   o = undefined_thing;"), "{msg}");
-}
-
-// ---------------------------------------------------------------------------------------------
-// Embedding API: the renderer on a host framebuffer, depth test, state left as documented.
-// ---------------------------------------------------------------------------------------------
-
-#[test]
-fn embedding_depth_test_and_documented_state() {
-    use glow::HasContext;
-    use splatgl::gl::{SplatRenderer, sort_back_to_front};
-    use splatgl::headless::HeadlessContext;
-    let ctx = match HeadlessContext::new() {
-        Ok(c) => c,
-        Err(HeadlessError::EglUnavailable(m)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
-    };
-    let gl = ctx.gl();
-    let (w, h) = (32u32, 32u32);
-    // The "host": an RGBA8 + DEPTH24 framebuffer with a viewport offset inside a larger one.
-    // SAFETY: object creation and binding on the current context; deleted at the end.
-    let (fbo, rbs) = unsafe {
-        let color = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
-        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 2 * w as i32, h as i32);
-        let depth = gl.create_renderbuffer().unwrap();
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-        gl.renderbuffer_storage(
-            glow::RENDERBUFFER,
-            glow::DEPTH_COMPONENT24,
-            2 * w as i32,
-            h as i32,
-        );
-        let fbo = gl.create_framebuffer().unwrap();
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::COLOR_ATTACHMENT0,
-            glow::RENDERBUFFER,
-            Some(color),
-        );
-        gl.framebuffer_renderbuffer(
-            glow::FRAMEBUFFER,
-            glow::DEPTH_ATTACHMENT,
-            glow::RENDERBUFFER,
-            Some(depth),
-        );
-        assert_eq!(
-            gl.check_framebuffer_status(glow::FRAMEBUFFER),
-            glow::FRAMEBUFFER_COMPLETE
-        );
-        (fbo, [color, depth])
-    };
-    let mut cloud = SplatCloud::new(0);
-    cloud.push(
-        [0.0; 3],
-        [0.3; 3],
-        [0.0, 0.0, 0.0, 1.0],
-        0.95,
-        &sh_for([1.0, 1.0, 1.0], 0),
-    );
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, w, h);
-    let mut renderer = SplatRenderer::new(gl).unwrap();
-    renderer.upload(gl, &cloud).unwrap();
-    let mut order = Vec::new();
-    sort_back_to_front(&cloud.positions, c.eye(), &mut order);
-    // Right half of the framebuffer is the host's viewport for the splats.
-    let mut centre_red = |depth_clear: f32, depth_test: bool| -> u8 {
-        // SAFETY: clears and reads one pixel of the bound framebuffer.
-        unsafe {
-            gl.viewport(0, 0, 2 * w as i32, h as i32);
-            gl.depth_mask(true);
-            gl.clear_color(0.0, 0.0, 0.0, 0.0);
-            gl.clear_depth_f32(depth_clear);
-            gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
-            gl.viewport(w as i32, 0, w as i32, h as i32);
-        }
-        renderer.settings_mut().depth_test = depth_test;
-        renderer.draw(gl, &c, &order).unwrap();
-        let mut px = [0u8; 4];
-        // SAFETY: reads one RGBA8 pixel into a 4-byte buffer.
-        unsafe {
-            gl.read_pixels(
-                (w + w / 2) as i32,
-                (h / 2) as i32,
-                1,
-                1,
-                glow::RGBA,
-                glow::UNSIGNED_BYTE,
-                glow::PixelPackData::Slice(Some(&mut px)),
-            );
-        }
-        px[0]
-    };
-    assert!(centre_red(0.0, false) > 200, "drawn without depth test");
-    assert!(centre_red(1.0, true) > 200, "host depth far: splat passes");
-    assert_eq!(
-        centre_red(0.0, true),
-        0,
-        "host geometry in front: splat hidden"
-    );
-    // The left half (outside the viewport) stays untouched.
-    let mut px = [9u8; 4];
-    // SAFETY: as above; then state queries.
-    unsafe {
-        gl.read_pixels(
-            w as i32 / 2,
-            h as i32 / 2,
-            1,
-            1,
-            glow::RGBA,
-            glow::UNSIGNED_BYTE,
-            glow::PixelPackData::Slice(Some(&mut px)),
-        );
-        assert_eq!(px, [0; 4]);
-        // State left as documented in splatgl::gl::state.
-        assert_eq!(gl.get_parameter_i32(glow::CURRENT_PROGRAM), 0);
-        assert_eq!(gl.get_parameter_i32(glow::VERTEX_ARRAY_BINDING), 0);
-        assert_eq!(gl.get_parameter_i32(glow::ARRAY_BUFFER_BINDING), 0);
-        assert_eq!(
-            gl.get_parameter_i32(glow::ACTIVE_TEXTURE),
-            glow::TEXTURE0 as i32
-        );
-        assert_eq!(gl.get_parameter_i32(glow::TEXTURE_BINDING_2D), 0);
-        assert!(gl.is_enabled(glow::BLEND));
-        assert_eq!(gl.get_parameter_i32(glow::BLEND_SRC_RGB), glow::ONE as i32);
-        assert_eq!(
-            gl.get_parameter_i32(glow::BLEND_DST_ALPHA),
-            glow::ONE_MINUS_SRC_ALPHA as i32
-        );
-        assert_eq!(gl.get_parameter_i32(glow::DEPTH_WRITEMASK), 0);
-        assert_eq!(
-            gl.get_parameter_i32(glow::DRAW_FRAMEBUFFER_BINDING),
-            fbo.0.get() as i32
-        );
-        let mut vp = [0i32; 4];
-        gl.get_parameter_i32_slice(glow::VIEWPORT, &mut vp);
-        assert_eq!(vp, [w as i32, 0, w as i32, h as i32]);
-    }
-    renderer.destroy(gl);
-    // SAFETY: deleting the host objects created above.
-    unsafe {
-        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-        gl.delete_framebuffer(fbo);
-        for rb in rbs {
-            gl.delete_renderbuffer(rb);
-        }
-    }
 }
 
 #[test]
@@ -594,18 +454,13 @@ fn one_shot_render_function_matches_the_renderer() {
     // `splatgl::headless::render` is what a CLI `--backend gl` calls.
     let cloud = scene::default_scene();
     let c = scene::default_camera(48, 36);
-    let opts = RenderOptions {
+    let opts = HeadlessOptions {
         background: [0.1, 0.1, 0.1],
         sh_degree: Some(3), // above the cloud's degree 1: clamped, like the reference
         ..Default::default()
     };
-    let img = match splatgl::headless::render(&cloud, &c, &opts) {
-        Ok(img) => img,
-        Err(HeadlessError::EglUnavailable(msg)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
+    let Some(img) = or_skip(splatgl::headless::render(&cloud, &c, &opts), "render") else {
+        return;
     };
     assert_eq!((img.width, img.height), (48, 36));
     let mut r = headless().unwrap();
@@ -621,14 +476,8 @@ fn one_shot_render_function_matches_the_renderer() {
 /// after the upload and after the draw) and within the suite's PSNR of the reference.
 #[test]
 fn real_files_render_without_gl_errors() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipping: {} not found", dir.display());
-        return;
-    };
+    let Some(paths) = real_files() else { return };
     let Some(mut r) = headless() else { return };
-    let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
-    paths.sort();
     let mut rendered = 0;
     for path in paths {
         let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
@@ -639,21 +488,15 @@ fn real_files_render_without_gl_errors() {
         r.upload(&cloud)
             .unwrap_or_else(|e| panic!("{}: upload: {e}", path.display()));
         let img = r
-            .render(&c, &RenderOptions::default())
+            .render(&c, &HeadlessOptions::default())
             .unwrap_or_else(|e| panic!("{}: render: {e}", path.display()));
         assert!(
             img.pixels.iter().any(|p| p[3] > 0.05),
             "{}: nothing drawn",
             path.display()
         );
-        let mut want = reference::render(&cloud, &c, &ref_opts(3, [0.0; 3]));
-        if cloud.meta.color_space.effective() == ColorSpace::LinRec709Display {
-            for p in &mut want.pixels {
-                for v in &mut p[..3] {
-                    *v = srgb_encode(*v);
-                }
-            }
-        }
+        let space = cloud.meta.color_space.effective();
+        let want = reference::render_display(&cloud, &c, &ref_opts(3, [0.0; 3]), space).0;
         let s = score(&img, &want);
         eprintln!(
             "{}: {} splats, PSNR {:.2} dB vs reference",
@@ -679,7 +522,7 @@ fn splats_beyond_the_far_plane_are_drawn() {
     for s in &mut cloud.scales {
         *s = s.map(|v| v * 20.0);
     }
-    let mut c = cam(
+    let mut c = look_at_fov_deg(
         Vec3::new(0.0, 0.0, 3.0),
         Vec3::new(0.0, 0.0, -40.0),
         50.0,
@@ -692,10 +535,10 @@ fn splats_beyond_the_far_plane_are_drawn() {
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
-    let img = r.render(&c, &RenderOptions::default()).unwrap();
+    let img = r.render(&c, &HeadlessOptions::default()).unwrap();
     assert!(
         img.pixels.iter().any(|p| p[3] > 0.1),
         "splats must be visible"
@@ -720,13 +563,13 @@ fn long_thin_needles() {
             &sh_for([0.9, 0.5 + 0.08 * k as f32, 0.2], 0),
         );
     }
-    let c = cam(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 8.0, 64, 48);
+    let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 8.0, 64, 48);
     check(
         "needles",
         &mut r,
         &cloud,
         &c,
-        &RenderOptions::default(),
+        &HeadlessOptions::default(),
         MAX_ERR_DENSE,
     );
 }

@@ -23,6 +23,9 @@
 //! Every step is a stable partition or a stable sort of disjoint ranges, so the output is the
 //! unique order by `(key, index)`: deterministic and independent of `T`.
 
+mod lsd;
+
+use lsd::{parallel_lsd, sort_bucket};
 use rayon::prelude::*;
 
 /// Most bits one pass handles (histogram size `2^MAX_DIGIT_BITS`).
@@ -213,40 +216,8 @@ impl RadixBuffers {
         let keys = &self.keys[..n];
         let hist = &mut self.hist[..t * STRIDE];
         let msd = |k: u32| ((k - kmin) >> low) as usize & (BUCKETS - 1);
-
-        // MSD counts per chunk, then offsets (and bucket starts).
-        hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
-            let [h0, h1, h2, h3] = &mut h[MAX_PASSES..] else {
-                unreachable!("STRIDE = MAX_PASSES + 4")
-            };
-            for table in [&mut *h0, &mut *h1, &mut *h2, &mut *h3] {
-                table.fill(0);
-            }
-            let mut quads = keys[chunk_range(c, t, n)].chunks_exact(4);
-            for q in &mut quads {
-                h0[msd(q[0])] += 1;
-                h1[msd(q[1])] += 1;
-                h2[msd(q[2])] += 1;
-                h3[msd(q[3])] += 1;
-            }
-            for &k in quads.remainder() {
-                h0[msd(k)] += 1;
-            }
-            for d in 0..BUCKETS {
-                h0[d] += h1[d] + h2[d] + h3[d];
-            }
-        });
         let starts = &mut self.starts[..=BUCKETS];
-        let mut sum = 0u32;
-        for (d, start) in starts.iter_mut().enumerate().take(BUCKETS) {
-            *start = sum;
-            for h in hist.chunks_mut(STRIDE) {
-                let count = h[MAX_PASSES][d];
-                h[MAX_PASSES][d] = sum;
-                sum += count;
-            }
-        }
-        starts[BUCKETS] = sum;
+        msd_offsets(keys, hist, starts, t, msd);
 
         // MSD scatter.
         let a = SharedMut(self.a.as_mut_ptr());
@@ -284,18 +255,7 @@ impl RadixBuffers {
         let size = |d: usize| (starts[d + 1] - starts[d]) as usize;
         let small_total: usize = (0..BUCKETS).map(size).filter(|&m| m <= big).sum();
         let groups = &mut self.groups[..=t];
-        let (mut g, mut acc) = (1, 0);
-        groups.fill(BUCKETS);
-        groups[0] = 0;
-        for d in 0..BUCKETS {
-            while g < t && acc >= small_total * g / t {
-                groups[g] = d;
-                g += 1;
-            }
-            if size(d) <= big {
-                acc += size(d);
-            }
-        }
+        group_buckets(groups, small_total, big, t, size);
         let starts = &*starts;
         let groups = &*groups;
         // Each task's scratch for the middle passes: its own slice of B (B is free until the
@@ -325,186 +285,69 @@ impl RadixBuffers {
     }
 }
 
-/// Stable LSD sort of the `tmp.len()` items at `a[s..]` by their `digits`, indices to
-/// `out[s..]`, using `tmp` as scratch and `h` for histograms.
-///
-/// # Safety
-/// `s + tmp.len()` is within `a` and `out` and no other thread accesses those ranges meanwhile.
-unsafe fn sort_bucket(
-    a: SharedMut<u64>,
-    b: &mut [u64],
-    out: SharedMut<u32>,
-    s: usize,
-    digits: &Digits,
-    h: &mut [Hist],
+/// MSD counts per chunk (`h[MAX_PASSES]` of every chunk's tables, counted over four
+/// interleaved tables), then turned into each chunk's first output position per digit, and
+/// the start of every MSD bucket (`starts[BUCKETS]` = `n`).
+fn msd_offsets(
+    keys: &[u32],
+    hist: &mut [Hist],
+    starts: &mut [u32],
+    t: usize,
+    msd: impl Fn(u32) -> usize + Sync,
 ) {
-    let m = b.len();
-    // SAFETY: the caller guarantees exclusive access to these ranges.
-    let (a, out) = unsafe {
-        (
-            std::slice::from_raw_parts_mut(a.get().add(s), m),
-            std::slice::from_raw_parts_mut(out.get().add(s), m),
-        )
-    };
-    // Below about an eighth of the table entries a comparison sort beats clearing and
-    // prefix-summing the radix tables.
-    let entries: usize = (0..digits.passes)
-        .map(|p| digits.mask[p] as usize + 1)
-        .sum();
-    if m <= TINY.max(entries / 8) {
-        // Items are distinct (the index is in the low bits): any sort is the stable one.
-        a.sort_unstable();
-        for (o, &e) in out.iter_mut().zip(a.iter()) {
-            *o = e as u32;
+    let n = keys.len();
+    hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
+        let [h0, h1, h2, h3] = &mut h[MAX_PASSES..] else {
+            unreachable!("STRIDE = MAX_PASSES + 4")
+        };
+        for table in [&mut *h0, &mut *h1, &mut *h2, &mut *h3] {
+            table.fill(0);
         }
-        return;
-    }
-    let passes = digits.passes;
-    // Only the first `mask + 1` entries of each table are used.
-    let size = |p: usize| digits.mask[p] as usize + 1;
-    for (p, table) in h[..passes].iter_mut().enumerate() {
-        table[..size(p)].fill(0);
-    }
-    if let [h0, h1, ..] = h {
-        if passes == 2 {
-            for &e in a.iter() {
-                h0[digits.digit(e, 0)] += 1;
-                h1[digits.digit(e, 1)] += 1;
-            }
-        } else {
-            for &e in a.iter() {
-                h0[digits.digit(e, 0)] += 1;
-            }
-            for p in 1..passes {
-                for &e in a.iter() {
-                    h[p][digits.digit(e, p)] += 1;
-                }
-            }
+        let mut quads = keys[chunk_range(c, t, n)].chunks_exact(4);
+        for q in &mut quads {
+            h0[msd(q[0])] += 1;
+            h1[msd(q[1])] += 1;
+            h2[msd(q[2])] += 1;
+            h3[msd(q[3])] += 1;
         }
-    }
-    let mut live = [0usize; MAX_PASSES];
-    let mut n_live = 0;
-    for p in 0..passes {
-        if !h[p][..size(p)].iter().any(|&c| c as usize == m) {
-            live[n_live] = p;
-            n_live += 1;
+        for &k in quads.remainder() {
+            h0[msd(k)] += 1;
         }
-    }
-    if n_live == 0 {
-        for (o, &e) in out.iter_mut().zip(a.iter()) {
-            *o = e as u32;
+        for d in 0..BUCKETS {
+            h0[d] += h1[d] + h2[d] + h3[d];
         }
-        return;
-    }
-    for (k, &p) in live[..n_live].iter().enumerate() {
-        let off = &mut h[p];
-        let mut sum = 0;
-        for c in off[..size(p)].iter_mut() {
-            let count = *c;
-            *c = sum;
+    });
+    let mut sum = 0u32;
+    for (d, start) in starts.iter_mut().enumerate().take(BUCKETS) {
+        *start = sum;
+        for h in hist.chunks_mut(STRIDE) {
+            let count = h[MAX_PASSES][d];
+            h[MAX_PASSES][d] = sum;
             sum += count;
         }
-        let (src, dst) = if k % 2 == 0 {
-            (&*a, &mut *b)
-        } else {
-            (&*b, &mut *a)
-        };
-        // The offsets come from counting these very items, so every position is `< m`.
-        if k + 1 == n_live {
-            for &e in src {
-                let d = digits.digit(e, p);
-                let pos = off[d] as usize;
-                off[d] += 1;
-                debug_assert!(pos < m);
-                // SAFETY: `pos < m = out.len()` (see above).
-                unsafe { *out.get_unchecked_mut(pos) = e as u32 };
-            }
-        } else {
-            for &e in src {
-                let d = digits.digit(e, p);
-                let pos = off[d] as usize;
-                off[d] += 1;
-                debug_assert!(pos < m);
-                // SAFETY: `pos < m = dst.len()` (see above).
-                unsafe { *dst.get_unchecked_mut(pos) = e };
-            }
-        }
     }
+    starts[BUCKETS] = sum;
 }
 
-/// Stable LSD sort of the items `a` by their `digits` with every pass split over `t` chunks:
-/// count per chunk, offsets, scatter (A → B → A …, the last pass writes indices to `out`).
-fn parallel_lsd(
-    a: &mut [u64],
-    b: &mut [u64],
-    out: &mut [u32],
-    hist: &mut [Hist],
+/// Splits the MSD buckets into `t` groups of about equal count of elements in small buckets
+/// (`size(d) <= big`): task `c` sorts buckets `groups[c]..groups[c + 1]`.
+fn group_buckets(
+    groups: &mut [usize],
+    small_total: usize,
+    big: usize,
     t: usize,
-    digits: &Digits,
+    size: impl Fn(usize) -> usize,
 ) {
-    let n = a.len();
-    let mut src_is_a = true;
-    let mut wrote_out = false;
-    for p in 0..digits.passes {
-        let last = p + 1 == digits.passes;
-        let src: &[u64] = if src_is_a { &*a } else { &*b };
-        hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
-            let h = &mut h[p];
-            h.fill(0);
-            for &e in &src[chunk_range(c, t, n)] {
-                h[digits.digit(e, p)] += 1;
-            }
-        });
-        let constant =
-            (0..BUCKETS).any(|d| hist.chunks(STRIDE).map(|h| h[p][d] as usize).sum::<usize>() == n);
-        if constant {
-            continue;
+    let (mut g, mut acc) = (1, 0);
+    groups.fill(BUCKETS);
+    groups[0] = 0;
+    for d in 0..BUCKETS {
+        while g < t && acc >= small_total * g / t {
+            groups[g] = d;
+            g += 1;
         }
-        let mut sum = 0u32;
-        for d in 0..BUCKETS {
-            for h in hist.chunks_mut(STRIDE) {
-                let count = h[p][d];
-                h[p][d] = sum;
-                sum += count;
-            }
-        }
-        let (src, dst): (&[u64], &mut [u64]) = if src_is_a {
-            (&*a, &mut *b)
-        } else {
-            (&*b, &mut *a)
-        };
-        let dst = SharedMut(dst.as_mut_ptr());
-        let o = SharedMut(out.as_mut_ptr());
-        let to_out = last;
-        hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
-            let off = &mut h[p];
-            for &e in &src[chunk_range(c, t, n)] {
-                let d = digits.digit(e, p);
-                let pos = off[d] as usize;
-                off[d] += 1;
-                debug_assert!(pos < n);
-                // SAFETY: as in the MSD pass, chunk `c` owns its own positions of digit `d`,
-                // and all chunks' positions partition `0..n`.
-                unsafe {
-                    if to_out {
-                        o.get().add(pos).write(e as u32);
-                    } else {
-                        dst.get().add(pos).write(e);
-                    }
-                }
-            }
-        });
-        if last {
-            wrote_out = true;
-        } else {
-            src_is_a = !src_is_a;
-        }
-    }
-    if !wrote_out {
-        // The last pass(es) had a constant digit: the current source is already sorted.
-        let src: &[u64] = if src_is_a { &*a } else { &*b };
-        for (o, &e) in out.iter_mut().zip(src) {
-            *o = e as u32;
+        if size(d) <= big {
+            acc += size(d);
         }
     }
 }

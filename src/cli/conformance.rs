@@ -1,0 +1,151 @@
+//! `splatgl conformance generate DIR` and `splatgl conformance run DIR (--images OTHER |
+//! --backend gl|reference)`.
+
+use splatgl::conformance::manifest::Manifest;
+use splatgl::conformance::render::{Backend, render_suite};
+use splatgl::conformance::{generate, report, runner};
+use splatgl::image::Image;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Subcommands.
+#[derive(clap::Subcommand, Debug)]
+pub enum Command {
+    /// Write the suite into DIR: manifest.json, assets/NAME.glb (with camera nodes) and
+    /// NAME.cameras.json, reference/NAME/CAMERA.png (8-bit sRGB) and .pfm (float).
+    /// Exit status: 0, or 2 on any error.
+    Generate {
+        /// The folder (created if needed).
+        dir: PathBuf,
+    },
+    /// Compare images with the suite's references; write report.html and report.json.
+    /// Exit status: 0 all pass, 1 some fail, 2 unusable input.
+    Run(RunArgs),
+}
+
+/// Which images to check.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BackendArg {
+    /// splatgl's GL backend (headless EGL).
+    Gl,
+    /// splatgl's CPU reference rasterizer.
+    Reference,
+}
+
+/// Arguments of `run`.
+#[derive(clap::Args, Debug)]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["images", "backend"])))]
+pub struct RunArgs {
+    /// The suite folder (with manifest.json).
+    pub dir: PathBuf,
+    /// Another renderer's images: OTHER/ASSET/CAMERA.png or .pfm, named per the manifest's
+    /// `image` (a copy of the suite's reference/ folder layout).
+    #[arg(long, value_name = "OTHER_DIR")]
+    pub images: Option<PathBuf>,
+    /// Render the suite with one of splatgl's backends instead.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Where report.html and report.json go (default DIR/report).
+    #[arg(short, long, value_name = "OUT_DIR")]
+    pub out: Option<PathBuf>,
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Runs the comparison; `Err` = unusable input (exit 2).
+fn run_cmd(a: &RunArgs) -> Result<bool, String> {
+    let m = Manifest::read(&a.dir)?;
+    let out = a.out.clone().unwrap_or_else(|| a.dir.join("report"));
+    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let (results, source) = if let Some(images) = &a.images {
+        if !images.is_dir() {
+            return Err(format!("--images {}: not a folder", images.display()));
+        }
+        let r = runner::run(&a.dir, &m, |c| {
+            runner::find_image(images, c).map(|p| Image::read(&p).map_err(|e| e.to_string()))
+        })?;
+        (r, images.display().to_string())
+    } else {
+        let backend = match a.backend {
+            Some(BackendArg::Gl) => Backend::Gl,
+            _ => Backend::Reference,
+        };
+        let imgs: HashMap<String, Image> = render_suite(&a.dir, &m, backend)?.into_iter().collect();
+        // Keep the rendered images beside the report, laid out like --images expects.
+        for (name, img) in &imgs {
+            let (ext, bytes) = match backend {
+                Backend::Gl => ("png", img.encode_png(Default::default(), false)),
+                Backend::Reference => ("pfm", Ok(img.encode_pfm())),
+            };
+            let p = out.join("images").join(format!("{name}.{ext}"));
+            std::fs::create_dir_all(p.parent().expect("has a parent"))
+                .map_err(|e| format!("{}: {e}", p.display()))?;
+            write(&p, &bytes.map_err(|e| e.to_string())?)?;
+        }
+        let r = runner::run(&a.dir, &m, |c| imgs.get(&c.image).cloned().map(Ok))?;
+        let name = match backend {
+            Backend::Gl => "splatgl --backend gl",
+            Backend::Reference => "splatgl --backend reference",
+        };
+        (r, name.to_owned())
+    };
+    let json = report::to_json(&results, &source);
+    write(
+        &out.join("report.json"),
+        &serde_json::to_vec_pretty(&json).unwrap_or_default(),
+    )?;
+    write(
+        &out.join("report.html"),
+        report::to_html(&results, &source).as_bytes(),
+    )?;
+    let s = report::summary(&results);
+    for r in results.iter().filter(|r| !r.skipped && !r.pass()) {
+        for c in r.cameras.iter().filter(|c| !c.pass) {
+            println!(
+                "FAIL {}/{}: {}",
+                r.asset.name,
+                c.camera.name,
+                c.cause.as_deref().unwrap_or("")
+            );
+        }
+    }
+    println!(
+        "{} passed, {} failed, {} skipped -> {}",
+        s.passed,
+        s.failed,
+        s.skipped,
+        out.join("report.html").display()
+    );
+    Ok(s.failed == 0)
+}
+
+/// Runs a subcommand.
+pub fn run(c: Command) -> ExitCode {
+    let r = match c {
+        Command::Generate { dir } => generate(&dir).map(|m| {
+            let cams: usize = m.assets.iter().map(|a| a.cameras.len()).sum();
+            println!(
+                "{} assets, {cams} cameras -> {}",
+                m.assets.len(),
+                dir.join("manifest.json").display()
+            );
+            true
+        }),
+        Command::Run(a) => return exit(run_cmd(&a)),
+    };
+    exit(r.map_err(|e| e.to_string()))
+}
+
+fn exit(r: Result<bool, String>) -> ExitCode {
+    match r {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

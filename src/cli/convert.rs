@@ -1,0 +1,245 @@
+//! `splatgl convert IN OUT`: any readable splat file → `.glb` / `.gltf` (RC-conformant) or
+//! `.ply` (INRIA), through [`splatgl::convert`].
+
+use splatgl::SplatCloud;
+use splatgl::cloud::ColorSpace;
+use splatgl::convert::{self, ConvertOptions, OutputFormat, Quantize, Up};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Arguments.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Input file (any format splatgl reads).
+    pub input: PathBuf,
+    /// Output file: .glb, .gltf (KHR_gaussian_splatting RC), .ply (INRIA 3DGS), .spz (Niantic)
+    /// or .splat (antimatter15).
+    pub output: PathBuf,
+    /// Store an attribute as an integer type (glTF outputs), ATTR=TYPE, comma-separated or
+    /// repeated: position=i8|i8n|u8|u8n|i16|i16n|u16|u16n (KHR_mesh_quantization with a
+    /// dequantization node), rotation=i8n|i16n, scale=u8|u8n|u16|u16n, opacity=u8n|u16n.
+    #[arg(long, value_name = "ATTR=TYPE", value_delimiter = ',')]
+    pub quantize: Vec<String>,
+    /// Keep SH degrees up to N (truncate higher ones).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(0..=3))]
+    pub sh_degree: Option<u8>,
+    /// Rotate about X by DEG degrees (after --up; order X, then Y, then Z).
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub rotate_x: f64,
+    /// Rotate about Y by DEG degrees.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub rotate_y: f64,
+    /// Rotate about Z by DEG degrees.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub rotate_z: f64,
+    /// The input's up axis, turned into glTF's +Y: y (default, unchanged), -y (y-down
+    /// captures: INRIA / COLMAP), z, -z, x, -x.
+    #[arg(
+        long,
+        default_value = "y",
+        value_name = "AXIS",
+        allow_hyphen_values = true
+    )]
+    pub up: Up,
+    /// SPZ version of a .spz output: 2 (gzip; what KHR_gaussian_splatting_compression_spz_2
+    /// pins and most readers take), 3 (gzip, smallest-three quaternions) or 4 (zstd).
+    #[arg(long, value_name = "2|3|4", value_parser = clap::value_parser!(u32).range(2..=4))]
+    pub spz_version: Option<u32>,
+    /// .glb output compressed as SPZ v2 in KHR_gaussian_splatting_compression_spz_2 (lossy:
+    /// see docs/formats.md) instead of plain accessors.
+    #[arg(long)]
+    pub spz_compress: bool,
+    /// Set colorSpace (a relabel for inputs that carry none, e.g. PLY; colours are unchanged).
+    #[arg(long, value_name = "srgb_rec709_display|lin_rec709_display", value_parser = parse_color_space)]
+    pub color_space: Option<ColorSpace>,
+    /// Overwrite OUT if it exists.
+    #[arg(short, long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub load: super::LoadArgs,
+}
+
+fn parse_color_space(s: &str) -> Result<ColorSpace, String> {
+    match ColorSpace::parse(s) {
+        splatgl::cloud::Known::Known(c) => Ok(c),
+        _ => Err(format!(
+            "expected srgb_rec709_display or lin_rec709_display, found {s:?}"
+        )),
+    }
+}
+
+/// Splats per progress step of the per-splat work.
+const CHUNK: usize = 1 << 16;
+/// Inputs at least this large show progress.
+const LARGE: usize = 200_000;
+
+/// Progress on stderr: a bar on a terminal, one line per stage otherwise.
+struct Progress {
+    on: bool,
+    tty: bool,
+}
+
+impl Progress {
+    fn stage(&self, what: &str) {
+        if self.on {
+            eprintln!("splatgl convert: {what}");
+        }
+    }
+    fn bar(&self, what: &str, done: usize, total: usize) {
+        if !(self.on && self.tty) {
+            return;
+        }
+        let w = 30;
+        let filled = (done * w).checked_div(total).unwrap_or(w);
+        eprint!(
+            "\r{what} [{}{}] {:>3}%",
+            "#".repeat(filled),
+            " ".repeat(w - filled),
+            (done * 100).checked_div(total).unwrap_or(100)
+        );
+        if done == total {
+            eprintln!();
+        }
+        let _ = std::io::stderr().flush();
+    }
+}
+
+fn options(a: &Args) -> Result<ConvertOptions, String> {
+    let mut q = Quantize::default();
+    for spec in &a.quantize {
+        q.set(spec)?;
+    }
+    let rotate_deg = [a.rotate_x, a.rotate_y, a.rotate_z];
+    if !rotate_deg.iter().all(|d| d.is_finite()) {
+        return Err("--rotate-x/-y/-z must be finite".into());
+    }
+    Ok(ConvertOptions {
+        quantize: q,
+        sh_degree: a.sh_degree,
+        up: a.up,
+        rotate_deg,
+        color_space: a.color_space,
+        spz_version: match a.spz_version {
+            Some(v) => splatgl::write::SpzVersion::try_from(v)
+                .map_err(|e| format!("--spz-version: {e}"))?,
+            None => splatgl::write::SpzVersion::V2,
+        },
+        spz_compress: a.spz_compress,
+    })
+}
+
+/// Rotates in chunks (progress per chunk).
+fn rotate(cloud: SplatCloud, o: &ConvertOptions, p: &Progress) -> Result<SplatCloud, String> {
+    let r = o.rotation();
+    if r == glam::DMat3::IDENTITY {
+        return Ok(cloud);
+    }
+    let n = cloud.len();
+    let mut out = SplatCloud::with_capacity(cloud.sh_degree, n);
+    out.meta = cloud.meta.clone();
+    for start in (0..n).step_by(CHUNK) {
+        let part = convert::slice(&cloud, start..(start + CHUNK).min(n));
+        out.append(convert::rotate(&part, r)?);
+        p.bar("rotating", (start + CHUNK).min(n), n);
+    }
+    Ok(out)
+}
+
+/// Writes the file (refusing to replace one without --force). The one place output is
+/// written, so a safer write (temp file + rename) can replace it alone.
+fn write_output(path: &Path, bytes: &[u8], force: bool) -> Result<(), String> {
+    if !force && path.exists() {
+        return Err(format!(
+            "{} exists; pass -f/--force to overwrite it",
+            path.display()
+        ));
+    }
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn go(a: &Args) -> Result<(), String> {
+    let t0 = Instant::now();
+    let format = OutputFormat::from_path(&a.output).ok_or_else(|| {
+        let exts: Vec<&str> = convert::OUTPUTS.iter().map(|(e, _)| *e).collect();
+        format!(
+            "{}: output must end in .{}",
+            a.output.display(),
+            exts.join(", .")
+        )
+    })?;
+    let o = options(a)?;
+    if o.quantize.any() && (!format.is_gltf() || o.spz_compress) {
+        return Err("--quantize applies to uncompressed .glb/.gltf outputs only".into());
+    }
+    if o.spz_compress && format != OutputFormat::Glb {
+        return Err("--spz-compress applies to .glb outputs only".into());
+    }
+    if a.spz_version.is_some() && format != OutputFormat::Spz {
+        return Err("--spz-version applies to .spz outputs only".into());
+    }
+    if !a.force && a.output.exists() {
+        return Err(format!(
+            "{} exists; pass -f/--force to overwrite it",
+            a.output.display()
+        ));
+    }
+    let scene = splatgl::load::load_path(&a.input, &a.load.options()).map_err(|e| e.to_string())?;
+    for w in scene.report.summarized_warnings() {
+        eprintln!("warning: {w}");
+    }
+    let mut cloud = scene.cloud;
+    let p = Progress {
+        on: cloud.len() >= LARGE,
+        tty: std::io::stderr().is_terminal(),
+    };
+    p.stage(&format!(
+        "read {} splats in {:.1} s",
+        cloud.len(),
+        t0.elapsed().as_secs_f64()
+    ));
+    convert::relabel(&mut cloud, &o);
+    let cloud = rotate(cloud, &o, &p)?;
+    p.stage("encoding");
+    let (bytes, notes) = convert::encode(&cloud, format, &o)?;
+    for n in notes {
+        eprintln!("note: {n}");
+    }
+    write_output(&a.output, &bytes, a.force)?;
+    eprintln!(
+        "splatgl convert: {} splats, SH degree {} -> {} ({} bytes) in {:.1} s",
+        cloud.len(),
+        cloud.sh_degree,
+        a.output.display(),
+        bytes.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Runs it. Exit status 0 on success, 2 on any error.
+pub fn run(a: Args) -> ExitCode {
+    match go(&a) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,334 @@
+//! `splatgl conformance generate DIR`: writes the assets, their cameras, our reference images
+//! and `manifest.json`, deriving each camera's tolerance and each asset's `catches`.
+
+use super::assets::{AssetSpec, CameraSpec};
+use super::manifest::{AssetEntry, CameraEntry, Manifest, Tolerance};
+use super::{Erratum, HEIGHT, WIDTH, model};
+use crate::camera::Camera;
+use crate::compare::{Comparison, compare};
+use crate::image::{Image, PngDepth};
+use crate::load::{LoadOptions, load_bytes, validate::validate_bytes};
+use crate::write::scene::{NodeTransform, PerspectiveCamera, SceneNode};
+use glam::{DMat3, DQuat, DVec3};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Why the suite could not be generated.
+#[derive(Debug, thiserror::Error)]
+pub enum GenerateError {
+    /// A file could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// An asset does not do what it was designed for (a bug in the suite).
+    #[error("asset {asset}: {message}")]
+    Design {
+        /// The asset.
+        asset: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), GenerateError> {
+    let io = |source| GenerateError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(io)?;
+    }
+    std::fs::write(path, bytes).map_err(io)
+}
+
+/// Camera axes (right, up, back) of a look-at in glTF's convention (looking down −Z).
+fn gltf_axes(c: &CameraSpec) -> DMat3 {
+    let (eye, target, up) = (
+        DVec3::from_array(c.eye),
+        DVec3::from_array(c.target),
+        DVec3::from_array(c.up),
+    );
+    let fwd = (target - eye).normalize();
+    let right = fwd.cross(up).normalize();
+    DMat3::from_cols(right, right.cross(fwd), -fwd)
+}
+
+/// The measures a camera is judged by: the comparison, and the largest ratio of a pixel's
+/// error to its bound.
+pub(crate) fn measure(img: &Image, want: &Image, bound: &[f64]) -> (Comparison, f64) {
+    let (a, b) = (clamped(img), clamped(want));
+    let c = compare(&a, &b, 0.0).expect("same size");
+    let ratio = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(bound)
+        .map(|((p, q), &bd)| {
+            let e = (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0f32, f32::max) as f64;
+            if e.is_finite() { e / bd } else { f64::INFINITY }
+        })
+        .fold(0.0, f64::max);
+    (c, ratio)
+}
+
+/// Whether `img` fails the camera: a pixel over its bound, the max error over `max_abs` or
+/// the PSNR under `min_psnr`.
+pub(crate) fn fails(img: &Image, want: &Image, bound: &[f64], t: &Tolerance) -> bool {
+    let (c, ratio) = measure(img, want, bound);
+    ratio > 1.0 || c.max_abs as f64 > t.max_abs || c.psnr < t.min_psnr
+}
+
+/// How far from its tolerance an erratum's model must land for the prediction to be robust
+/// to the renderer's own rounding: max error ×/÷ this factor, PSNR ± [`PSNR_MARGIN`] dB.
+pub const ABS_MARGIN: f64 = 1.3;
+/// See [`ABS_MARGIN`].
+pub const PSNR_MARGIN: f64 = 2.0;
+
+/// `Some(true)`: the image fails the tolerance clearly; `Some(false)`: it passes clearly;
+/// `None`: it lands within the margins (the suite must not contain such a case).
+fn verdict(img: &Image, want: &Image, bound: &[f64], t: &Tolerance) -> Option<bool> {
+    let (c, ratio) = measure(img, want, bound);
+    let r = ratio.max(c.max_abs as f64 / t.max_abs);
+    if r > ABS_MARGIN || c.psnr < t.min_psnr - PSNR_MARGIN {
+        Some(true)
+    } else if r < 1.0 / ABS_MARGIN && c.psnr > t.min_psnr + PSNR_MARGIN {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+fn margin_text(img: &Image, want: &Image, bound: &[f64], t: &Tolerance) -> String {
+    let (c, ratio) = measure(img, want, bound);
+    format!(
+        "worst pixel at {ratio:.2} × its bound, max error {:.4} vs {:.4}, PSNR {:.1} vs {:.1} dB",
+        c.max_abs, t.max_abs, c.psnr, t.min_psnr
+    )
+}
+
+/// RGB clamped to [0, 1] (what a display and an 8-bit file hold).
+pub(crate) fn clamped(img: &Image) -> Image {
+    let mut out = img.clone();
+    for p in &mut out.pixels {
+        for c in &mut p[..3] {
+            *c = c.clamp(0.0, 1.0);
+        }
+    }
+    out
+}
+
+/// The tolerance from the model's per-pixel bound: `max_abs` is the largest bound, and if
+/// every pixel's error is within its bound the MSE is at most the mean squared bound.
+fn tolerance(m: &model::ModelImage) -> Tolerance {
+    let max_abs = m.bound.iter().copied().fold(0.0, f64::max);
+    let mse = m.bound.iter().map(|b| b * b).sum::<f64>() / m.bound.len().max(1) as f64;
+    Tolerance {
+        max_abs,
+        min_psnr: 10.0 * (1.0 / mse).log10(),
+        terms: m.worst,
+    }
+}
+
+/// Every asset carries one sub-pixel white splat (σ ≈ 0.05 px) in its own primitive, placed
+/// 0.3 of the way from the first camera's target towards its eye and offset to the image's
+/// upper left: without dilation (erratum i) it vanishes, so every asset catches i clearly
+/// instead of some landing within the margin of their tolerance through the slightly
+/// changed edges of their larger splats.
+fn add_probe(doc: &mut crate::write::scene::SceneDoc, spec: &AssetSpec) {
+    let Some(c) = spec.cameras.first() else {
+        return;
+    };
+    let (eye, target) = (DVec3::from_array(c.eye), DVec3::from_array(c.target));
+    let axes = gltf_axes(c);
+    let depth = 0.7 * (target - eye).length();
+    let tan = (0.5 * c.yfov_deg.to_radians()).tan();
+    let p = eye
+        + (target - eye).normalize() * depth
+        + depth * tan * (-0.8 * WIDTH as f64 / HEIGHT as f64 * axes.x_axis + 0.8 * axes.y_axis);
+    let mut cloud = crate::SplatCloud::new(0);
+    super::assets::subpixel_probe(&mut cloud, p.as_vec3().to_array());
+    let m = doc.add_mesh(vec![super::assets::prim(cloud)]);
+    let n = doc.add_node(SceneNode {
+        name: Some("sub-pixel probe".into()),
+        mesh: Some(m),
+        ..Default::default()
+    });
+    doc.roots.push(n);
+}
+
+/// The asset's cameras as perspective camera nodes (roots, after the content).
+fn add_cameras(doc: &mut crate::write::scene::SceneDoc, spec: &AssetSpec) {
+    for c in &spec.cameras {
+        let cam = doc.add_camera(PerspectiveCamera {
+            yfov: c.yfov_deg.to_radians(),
+            aspect_ratio: Some(WIDTH as f64 / HEIGHT as f64),
+            znear: c.znear,
+            zfar: None,
+        });
+        let r = DQuat::from_mat3(&gltf_axes(c)).normalize();
+        let n = doc.add_node(SceneNode {
+            name: Some(format!("camera {}", c.name)),
+            camera: Some(cam),
+            transform: NodeTransform::Trs {
+                translation: c.eye,
+                rotation: r.to_array(),
+                scale: [1.0; 3],
+            },
+            ..Default::default()
+        });
+        doc.roots.push(n);
+    }
+}
+
+fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
+    let design = |message: String| GenerateError::Design {
+        asset: spec.name.to_owned(),
+        message,
+    };
+    let mut doc = spec.doc.clone();
+    add_probe(&mut doc, spec);
+    add_cameras(&mut doc, spec);
+    let ext = if spec.json { "gltf" } else { "glb" };
+    let file = format!("assets/{}.{ext}", spec.name);
+    let bytes = if spec.json {
+        doc.to_gltf()
+    } else {
+        doc.to_glb()
+    };
+    write(&dir.join(&file), &bytes)?;
+    let path = dir.join(&file);
+    let valid = validate_bytes(&bytes, Some(&path), &LoadOptions::default());
+    if (valid.status() == crate::load::validate::Status::Valid) != spec.rc_valid {
+        let f: Vec<String> = valid.findings.iter().map(|f| f.to_string()).collect();
+        return Err(design(format!(
+            "rc_valid = {} but splatgl validate says {:?}: {f:?}",
+            spec.rc_valid,
+            valid.status()
+        )));
+    }
+    let scene = load_bytes(&bytes, Some(&path), &LoadOptions::default())
+        .map_err(|e| design(e.to_string()))?;
+    if scene.cameras.len() != spec.cameras.len() {
+        return Err(design(format!("{} cameras loaded", scene.cameras.len())));
+    }
+    let cloud = &scene.cloud;
+    let space = cloud.meta.color_space.effective();
+    let mut cameras = Vec::new();
+    let mut json_cams = Vec::new();
+    let mut catches = std::collections::BTreeSet::new();
+    for (k, (spec_cam, g)) in spec.cameras.iter().zip(&scene.cameras).enumerate() {
+        let cam = Camera::from_gltf(g, WIDTH, HEIGHT).map_err(|e| design(e.to_string()))?;
+        let opts = crate::reference::RenderOptions::default();
+        let (reference, _) = crate::reference::render_display(cloud, &cam, &opts, space);
+        let image = format!("{}/{}", spec.name, spec_cam.name);
+        let (png, pfm) = (
+            format!("reference/{image}.png"),
+            format!("reference/{image}.pfm"),
+        );
+        let png_bytes = reference.encode_png(PngDepth::Eight, false);
+        write(
+            &dir.join(&png),
+            &png_bytes.map_err(|e| design(e.to_string()))?,
+        )?;
+        write(&dir.join(&pfm), &reference.encode_pfm())?;
+        let exact = model::render(cloud, &cam, &[]);
+        let tolerance = tolerance(&exact);
+        let bound_pfm = format!("reference/{image}.bound.pfm");
+        let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
+        for (p, b) in bound_img.pixels.iter_mut().zip(&exact.bound) {
+            p[3] = *b as f32;
+        }
+        write(&dir.join(&bound_pfm), &bound_img.encode_pfm_alpha())?;
+        // The bound as the runner reads it back (f32).
+        let bound: Vec<f64> = bound_img.pixels.iter().map(|p| p[3] as f64).collect();
+        for e in Erratum::ALL {
+            let img = model::render(cloud, &cam, &[e]).image;
+            match verdict(&img, &reference, &bound, &tolerance) {
+                Some(true) => _ = catches.insert(e),
+                Some(false) => {}
+                None => {
+                    return Err(design(format!(
+                        "camera {}: erratum {} lands within the margin of the tolerance ({})",
+                        spec_cam.name,
+                        e.letter(),
+                        margin_text(&img, &reference, &bound, &tolerance)
+                    )));
+                }
+            }
+        }
+        let c2w = DMat3::from_mat4(cam.world_to_camera.as_dmat4()).transpose();
+        json_cams.push(json!({
+            "id": k, "img_name": image, "width": WIDTH, "height": HEIGHT,
+            "position": cam.eye().as_dvec3().to_array(),
+            "rotation": [c2w.row(0).to_array(), c2w.row(1).to_array(), c2w.row(2).to_array()],
+            "fx": cam.fx, "fy": cam.fy, "cx": cam.cx, "cy": cam.cy,
+        }));
+        cameras.push(CameraEntry {
+            name: spec_cam.name.to_owned(),
+            gltf_camera: k,
+            width: WIDTH,
+            height: HEIGHT,
+            image,
+            reference_png: png,
+            reference_pfm: pfm,
+            bound_pfm,
+            tolerance,
+        });
+    }
+    if let Some(e) = spec.designed_for.iter().find(|e| !catches.contains(e)) {
+        return Err(design(format!(
+            "designed to catch erratum {} but its model passes",
+            e.letter()
+        )));
+    }
+    let cameras_json = format!("assets/{}.cameras.json", spec.name);
+    let text = serde_json::to_vec_pretty(&json_cams).unwrap_or_default();
+    write(&dir.join(&cameras_json), &text)?;
+    Ok(AssetEntry {
+        name: spec.name.to_owned(),
+        file,
+        cameras_json,
+        rule: spec.rule.to_owned(),
+        rc_section: spec.section.to_owned(),
+        failure_means: spec.failure_means.to_owned(),
+        catches: catches.into_iter().collect(),
+        optional: spec.optional,
+        rc_valid: spec.rc_valid,
+        cameras,
+    })
+}
+
+/// Writes the suite into `dir` (created if needed): `manifest.json`, `assets/NAME.glb` (or
+/// `.gltf`) with camera nodes, `assets/NAME.cameras.json`, `reference/NAME/CAMERA.png|pfm`.
+pub fn generate(dir: &Path) -> Result<Manifest, GenerateError> {
+    let specs = super::assets::all();
+    let mut assets = Vec::new();
+    let mut design = Vec::new();
+    for spec in &specs {
+        match asset(dir, spec) {
+            Ok(a) => assets.push(a),
+            Err(GenerateError::Design { asset, message }) => {
+                design.push(format!("{asset}: {message}"))
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    if !design.is_empty() {
+        return Err(GenerateError::Design {
+            asset: format!("{} asset(s)", design.len()),
+            message: design.join("; "),
+        });
+    }
+    let m = Manifest {
+        generator: format!("splatgl {}", env!("CARGO_PKG_VERSION")),
+        background: [0.0; 3],
+        assets,
+    };
+    let text = serde_json::to_vec_pretty(&m.to_json()).unwrap_or_default();
+    write(&dir.join("manifest.json"), &text)?;
+    Ok(m)
+}

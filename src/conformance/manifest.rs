@@ -1,0 +1,206 @@
+//! `manifest.json`: the suite's table of contents, read by the runner (and by other
+//! implementations' scripts: the keys are a contract, listed in `docs/conformance.md`).
+
+use super::Erratum;
+use super::model::Terms;
+use serde_json::{Value, json};
+
+/// Per-camera thresholds, derived from the asset's content ([`super::model`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerance {
+    /// Largest allowed absolute RGB error of any pixel (display values, 0..1).
+    pub max_abs: f64,
+    /// Smallest allowed PSNR (dB, peak 1).
+    pub min_psnr: f64,
+    /// The worst value of each error term over the image (what `max_abs` is made of).
+    pub terms: Terms,
+}
+
+/// One camera of an asset: a glTF camera node and a `cameras.json` entry, and one image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraEntry {
+    /// Name (the image's file stem).
+    pub name: String,
+    /// Index among the asset's perspective camera nodes (= index in its `cameras.json`).
+    pub gltf_camera: usize,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The image's path without extension, relative to an images folder: `ASSET/CAMERA`.
+    pub image: String,
+    /// Our reference, 8-bit sRGB PNG, relative to the suite folder.
+    pub reference_png: String,
+    /// Our reference, float PFM, relative to the suite folder (what the runner compares to).
+    pub reference_pfm: String,
+    /// Per-pixel error bound (grey PFM, relative to the suite folder): a pixel whose error
+    /// exceeds its bound fails the camera.
+    pub bound_pfm: String,
+    /// Pass thresholds.
+    pub tolerance: Tolerance,
+}
+
+/// One asset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AssetEntry {
+    /// Name (names the rule).
+    pub name: String,
+    /// The glTF file, relative to the suite folder.
+    pub file: String,
+    /// Its cameras as a 3DGS `cameras.json`, relative to the suite folder.
+    pub cameras_json: String,
+    /// The rule it checks.
+    pub rule: String,
+    /// RC section.
+    pub rc_section: String,
+    /// What a failure usually means.
+    pub failure_means: String,
+    /// Errata on which a renderer fails this asset (derived, see [`super::model`]).
+    pub catches: Vec<Erratum>,
+    /// Not required of RC implementations.
+    pub optional: bool,
+    /// Valid per the RC (`splatgl validate` passes it).
+    pub rc_valid: bool,
+    /// Cameras.
+    pub cameras: Vec<CameraEntry>,
+}
+
+/// The whole manifest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Manifest {
+    /// Who wrote it (`splatgl X.Y.Z`).
+    pub generator: String,
+    /// Background every image is rendered over (display RGB).
+    pub background: [f64; 3],
+    /// Assets.
+    pub assets: Vec<AssetEntry>,
+}
+
+fn terms_json(t: &Terms) -> Value {
+    json!({
+        "output_quantization": t.output, "blend_rounding": t.blend, "cutoff_edge": t.cutoff,
+        "alpha_threshold": t.threshold, "alpha_cap": t.cap, "sh_f16": t.sh_f16,
+        "overbright": t.overbright, "float": t.float,
+    })
+}
+
+impl Manifest {
+    /// The JSON text.
+    pub fn to_json(&self) -> Value {
+        let assets: Vec<Value> = self
+            .assets
+            .iter()
+            .map(|a| {
+                let cams: Vec<Value> = a
+                    .cameras
+                    .iter()
+                    .map(|c| {
+                        json!({
+                            "name": c.name, "gltf_camera": c.gltf_camera,
+                            "cameras_json_index": c.gltf_camera,
+                            "width": c.width, "height": c.height, "image": c.image,
+                            "reference_png": c.reference_png, "reference_pfm": c.reference_pfm,
+                            "bound_pfm": c.bound_pfm,
+                            "tolerance": {
+                                "max_abs": c.tolerance.max_abs, "min_psnr": c.tolerance.min_psnr,
+                                "terms": terms_json(&c.tolerance.terms),
+                            },
+                        })
+                    })
+                    .collect();
+                json!({
+                    "name": a.name, "file": a.file, "cameras_json": a.cameras_json,
+                    "rule": a.rule, "rc_section": a.rc_section, "failure_means": a.failure_means,
+                    "catches": a.catches.iter().map(|e| e.letter()).collect::<Vec<_>>(),
+                    "optional": a.optional, "rc_valid": a.rc_valid, "cameras": cams,
+                })
+            })
+            .collect();
+        json!({
+            "suite": "KHR_gaussian_splatting conformance",
+            "spec": "KHR_gaussian_splatting, Release Candidate",
+            "generator": self.generator,
+            "background": self.background,
+            "color": "display-referred RGB (sRGB-encoded for lin_rec709_display), over the background, clamped to [0, 1]",
+            "assets": assets,
+        })
+    }
+
+    /// Parses a manifest; the error names the key.
+    pub fn from_json(v: &Value) -> Result<Manifest, String> {
+        let s = |v: &Value, k: &str| -> Result<String, String> {
+            v[k].as_str()
+                .map(str::to_owned)
+                .ok_or_else(|| format!("manifest: `{k}` missing or not a string"))
+        };
+        let f = |v: &Value, k: &str| -> Result<f64, String> {
+            v[k].as_f64()
+                .ok_or_else(|| format!("manifest: `{k}` missing or not a number"))
+        };
+        let list = |v: &Value, k: &str| -> Result<Vec<Value>, String> {
+            v[k].as_array()
+                .cloned()
+                .ok_or_else(|| format!("manifest: `{k}` missing or not an array"))
+        };
+        let mut assets = Vec::new();
+        for a in list(v, "assets")? {
+            let mut cameras = Vec::new();
+            for c in list(&a, "cameras")? {
+                let t = &c["tolerance"];
+                cameras.push(CameraEntry {
+                    name: s(&c, "name")?,
+                    gltf_camera: f(&c, "gltf_camera")? as usize,
+                    width: f(&c, "width")? as u32,
+                    height: f(&c, "height")? as u32,
+                    image: s(&c, "image")?,
+                    reference_png: s(&c, "reference_png")?,
+                    reference_pfm: s(&c, "reference_pfm")?,
+                    bound_pfm: s(&c, "bound_pfm")?,
+                    tolerance: Tolerance {
+                        max_abs: f(t, "max_abs")?,
+                        min_psnr: f(t, "min_psnr")?,
+                        terms: Terms::default(),
+                    },
+                });
+            }
+            let catches = list(&a, "catches")?
+                .iter()
+                .map(|e| {
+                    e.as_str()
+                        .and_then(Erratum::from_letter)
+                        .ok_or_else(|| format!("manifest: unknown erratum {e}"))
+                })
+                .collect::<Result<_, _>>()?;
+            assets.push(AssetEntry {
+                name: s(&a, "name")?,
+                file: s(&a, "file")?,
+                cameras_json: s(&a, "cameras_json")?,
+                rule: s(&a, "rule")?,
+                rc_section: s(&a, "rc_section")?,
+                failure_means: s(&a, "failure_means")?,
+                catches,
+                optional: a["optional"].as_bool().unwrap_or(false),
+                rc_valid: a["rc_valid"].as_bool().unwrap_or(true),
+                cameras,
+            });
+        }
+        let bg = list(v, "background")?;
+        let bgv: Vec<f64> = bg.iter().filter_map(Value::as_f64).collect();
+        if bgv.len() != 3 {
+            return Err("manifest: `background` must be 3 numbers".into());
+        }
+        Ok(Manifest {
+            generator: s(v, "generator")?,
+            background: [bgv[0], bgv[1], bgv[2]],
+            assets,
+        })
+    }
+
+    /// Reads `DIR/manifest.json`.
+    pub fn read(dir: &std::path::Path) -> Result<Manifest, String> {
+        let p = dir.join("manifest.json");
+        let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+        let v: Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))?;
+        Manifest::from_json(&v)
+    }
+}

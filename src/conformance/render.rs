@@ -1,0 +1,98 @@
+//! Rendering the suite with splatgl's own backends (`conformance run --backend`), and with the
+//! GL backend's erratum switches (the erratum proof).
+
+use super::manifest::Manifest;
+use crate::camera::Camera;
+use crate::image::Image;
+use crate::load::{LoadOptions, Scene, load_path};
+use std::path::Path;
+
+/// splatgl's backends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    /// The CPU reference rasterizer (float output).
+    Reference,
+    /// OpenGL ES 3 through headless EGL (8-bit output).
+    Gl,
+}
+
+/// One asset loaded with its cameras at the manifest's image sizes.
+pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<Camera>), String> {
+    let a = &m.assets[asset];
+    let scene = load_path(dir.join(&a.file), &LoadOptions::default()).map_err(|e| e.to_string())?;
+    let cams = a
+        .cameras
+        .iter()
+        .map(|c| {
+            let g = scene
+                .cameras
+                .get(c.gltf_camera)
+                .ok_or_else(|| format!("{}: no camera {}", a.file, c.gltf_camera))?;
+            Camera::from_gltf(g, c.width, c.height).map_err(|e| e.to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((scene, cams))
+}
+
+/// Every camera's image, `(image path, image)` in manifest order.
+pub type Images = Vec<(String, Image)>;
+
+/// Renders the suite with `backend` (errata off).
+pub fn render_suite(dir: &Path, m: &Manifest, backend: Backend) -> Result<Images, String> {
+    match backend {
+        Backend::Reference => {
+            let mut out = Vec::new();
+            for (i, a) in m.assets.iter().enumerate() {
+                let (scene, cams) = load_asset(dir, m, i)?;
+                let space = scene.cloud.meta.color_space.effective();
+                for (c, cam) in a.cameras.iter().zip(&cams) {
+                    let opts = crate::reference::RenderOptions {
+                        background: m.background.map(|v| v as f32),
+                        ..Default::default()
+                    };
+                    let img = crate::reference::render_display(&scene.cloud, cam, &opts, space).0;
+                    out.push((c.image.clone(), img));
+                }
+            }
+            Ok(out)
+        }
+        #[cfg(feature = "gl")]
+        Backend::Gl => render_suite_gl(dir, m, crate::gl::Errata::default(), false),
+        #[cfg(not(feature = "gl"))]
+        Backend::Gl => Err("this splatgl was built without the `gl` feature".into()),
+    }
+}
+
+/// Renders the suite with the GL backend and `errata` switched in; `front_to_back` draws in
+/// the reversed (appendix, erratum g) order.
+#[cfg(feature = "gl")]
+pub fn render_suite_gl(
+    dir: &Path,
+    m: &Manifest,
+    errata: crate::gl::Errata,
+    front_to_back: bool,
+) -> Result<Images, String> {
+    use crate::headless::{HeadlessOptions, HeadlessRenderer};
+    let mut r = HeadlessRenderer::with_errata(errata).map_err(|e| e.to_string())?;
+    let opts = HeadlessOptions {
+        background: m.background.map(|v| v as f32),
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    for (i, a) in m.assets.iter().enumerate() {
+        let (scene, cams) = load_asset(dir, m, i)?;
+        r.upload(&scene.cloud).map_err(|e| e.to_string())?;
+        for (c, cam) in a.cameras.iter().zip(&cams) {
+            let img = if front_to_back {
+                let mut order = Vec::new();
+                crate::gl::sort_back_to_front(&scene.cloud.positions, cam.eye(), &mut order);
+                order.reverse();
+                r.render_with_order(cam, &opts, &order)
+            } else {
+                r.render(cam, &opts)
+            };
+            out.push((c.image.clone(), img.map_err(|e| e.to_string())?));
+        }
+    }
+    Ok(out)
+}

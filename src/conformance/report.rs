@@ -1,0 +1,157 @@
+//! `report.html` (self-contained: thumbnails embedded as data URIs, so the folder can be
+//! zipped and shared) and `report.json`.
+
+use super::runner::AssetResult;
+use crate::compare::diff_image;
+use crate::image::{Image, PngDepth};
+use base64::Engine;
+use serde_json::{Value, json};
+
+/// Counts over a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Summary {
+    /// Assets that passed.
+    pub passed: usize,
+    /// Assets that failed (optional ones included when their images were given).
+    pub failed: usize,
+    /// Optional assets without images.
+    pub skipped: usize,
+}
+
+/// Counts the results.
+pub fn summary(results: &[AssetResult]) -> Summary {
+    let mut s = Summary::default();
+    for r in results {
+        if r.skipped {
+            s.skipped += 1;
+        } else if r.pass() {
+            s.passed += 1;
+        } else {
+            s.failed += 1;
+        }
+    }
+    s
+}
+
+fn num(v: Option<f64>) -> Value {
+    match v {
+        Some(x) if x.is_finite() => json!(x),
+        _ => Value::Null,
+    }
+}
+
+/// `report.json`: `assets` (per asset `name`, `rule`, `pass`, `psnr`, `max_abs`, `skipped`,
+/// `catches`, `cameras` with the same per camera plus the tolerance and `cause`), `passed`,
+/// `failed`, `skipped` (counts), `source`.
+pub fn to_json(results: &[AssetResult], source: &str) -> Value {
+    let s = summary(results);
+    let assets: Vec<Value> = results
+        .iter()
+        .map(|r| {
+            let cams: Vec<Value> = r
+                .cameras
+                .iter()
+                .map(|c| {
+                    json!({
+                        "name": c.camera.name, "image": c.camera.image, "pass": c.pass,
+                        "psnr": num(c.comparison.map(|x| x.psnr)),
+                        "max_abs": num(c.comparison.map(|x| x.max_abs as f64)),
+                        "tolerance": {"max_abs": c.camera.tolerance.max_abs,
+                                      "min_psnr": c.camera.tolerance.min_psnr},
+                        "cause": c.cause,
+                    })
+                })
+                .collect();
+            json!({
+                "name": r.asset.name, "rule": r.asset.rule, "rc_section": r.asset.rc_section,
+                "pass": !r.skipped && r.pass(), "skipped": r.skipped, "optional": r.asset.optional,
+                "psnr": num(r.psnr()), "max_abs": num(r.max_abs()),
+                "catches": r.asset.catches.iter().map(|e| e.letter()).collect::<Vec<_>>(),
+                "cameras": cams,
+            })
+        })
+        .collect();
+    json!({
+        "source": source,
+        "passed": s.passed,
+        "failed": s.failed,
+        "skipped": s.skipped,
+        "assets": assets,
+    })
+}
+
+fn data_uri(img: &Image) -> String {
+    let png = img.encode_png(PngDepth::Eight, false).unwrap_or_default();
+    format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(png)
+    )
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// `report.html`: one table row (`tr.result`) per camera.
+pub fn to_html(results: &[AssetResult], source: &str) -> String {
+    let s = summary(results);
+    let mut rows = String::new();
+    for r in results {
+        for c in &r.cameras {
+            let (status, class) = match (r.skipped, c.pass) {
+                (true, _) => ("skipped", "skip"),
+                (false, true) => ("pass", "pass"),
+                (false, false) => ("FAIL", "fail"),
+            };
+            let img = |i: &Image| format!("<img src=\"{}\" alt=\"\">", data_uri(i));
+            let actual = c.actual.as_ref().map_or("—".into(), img);
+            let diff = c
+                .actual
+                .as_ref()
+                .and_then(|a| diff_image(a, &c.expected, c.camera.tolerance.max_abs as f32).ok())
+                .map_or("—".into(), |d| img(&d));
+            let f = |v: Option<f64>, p: usize| v.map_or("—".into(), |x| format!("{x:.p$}"));
+            let t = &c.camera.tolerance;
+            rows += &format!(
+                "<tr class=\"result {class}\"><td><b>{}</b><br>{}<br><small>{}</small></td>\
+                 <td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
+                 <td>{} dB<br><small>≥ {:.1}</small></td><td>{}<br><small>≤ {:.4}</small></td>\
+                 <td class=\"{class}\">{status}</td><td>{}</td></tr>\n",
+                esc(&r.asset.name),
+                esc(&c.camera.name),
+                esc(&r.asset.rule),
+                esc(&r.asset.rc_section),
+                img(&c.expected),
+                actual,
+                diff,
+                f(c.comparison.map(|x| x.psnr), 1),
+                t.min_psnr,
+                f(c.comparison.map(|x| x.max_abs as f64), 4),
+                t.max_abs,
+                esc(c.cause.as_deref().unwrap_or("")),
+            );
+        }
+    }
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>KHR_gaussian_splatting conformance report</title><style>\
+         body{{font-family:sans-serif;margin:1em}} table{{border-collapse:collapse}}\
+         td,th{{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:13px}}\
+         td small{{color:#555}} img{{image-rendering:pixelated;width:128px}}\
+         .pass{{color:#060}} .fail{{color:#b00;font-weight:bold}} .skip{{color:#777}}\
+         </style></head><body>\n<h1>KHR_gaussian_splatting conformance report</h1>\n\
+         <p id=\"summary\">{} passed, {} failed, {} skipped — images: {}</p>\n\
+         <p>Expected: splatgl's reference; diff: per-pixel error, white at the tolerance.</p>\n\
+         <table id=\"results\"><thead><tr><th>asset / camera / rule</th><th>RC section</th>\
+         <th>expected</th><th>actual</th><th>diff</th><th>PSNR</th><th>max error</th>\
+         <th>result</th><th>likely cause</th></tr></thead><tbody>\n{rows}</tbody></table>\
+         </body></html>\n",
+        s.passed,
+        s.failed,
+        s.skipped,
+        esc(source)
+    )
+}

@@ -1,0 +1,257 @@
+//! [`HeadlessRenderer`]: a [`HeadlessContext`] with a [`SplatRenderer`], the uploaded cloud's
+//! draw order and cached framebuffers, rendering to [`Image`]s.
+
+use super::{HeadlessContext, HeadlessError};
+use crate::camera::Camera;
+use crate::cloud::{ColorSpace, SplatCloud};
+use crate::gl::{
+    ColorFormat, DistanceSorter, DrawSettings, Errata, GlError, OffscreenTarget, ReadbackTarget,
+    SplatRenderer,
+};
+use crate::image::Image;
+use glow::HasContext;
+
+/// Which framebuffer the splats are blended in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TargetKind {
+    /// Blend directly in an 8-bit framebuffer: `RGBA8` for `srgb_rec709_display`,
+    /// `SRGB8_ALPHA8` for `lin_rec709_display` (GL decodes, blends linear, re-encodes).
+    #[default]
+    Rgba8,
+    /// Blend in an `RGBA16F` [`OffscreenTarget`], then resolve (sRGB-encoding linear clouds)
+    /// into an `RGBA8` framebuffer.
+    Rgba16fResolve,
+}
+
+/// Options of one headless render (the GL counterpart of
+/// [`reference::RenderOptions`](crate::reference::RenderOptions)).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HeadlessOptions {
+    /// Framebuffer to blend in.
+    pub target: TargetKind,
+    /// Background colour as it appears in the output image (display-referred values). For
+    /// `lin_rec709_display` it is sRGB-decoded before blending, so it comes out unchanged.
+    pub background: [f32; 3],
+    /// SH degree to evaluate; `None` = the cloud's.
+    pub sh_degree: Option<u8>,
+    /// Colour space override; `None` = the cloud's `meta.color_space` (unknown → default).
+    pub color_space: Option<ColorSpace>,
+}
+
+/// A headless context with a [`SplatRenderer`], an uploaded cloud and cached framebuffers.
+///
+/// The sorter works on the positions of the cloud given to [`HeadlessRenderer::upload`], the
+/// only way to upload: the renderer is reachable read-only ([`HeadlessRenderer::renderer`]),
+/// so the order can never be computed for another cloud than the one drawn. Each render
+/// passes its own [`DrawSettings`]; the renderer's settings are never changed.
+///
+/// It owns its context, so dropping it deletes every GL object (no `destroy` needed).
+#[derive(Debug)]
+pub struct HeadlessRenderer {
+    renderer: SplatRenderer,
+    target: Option<ReadbackTarget>,
+    offscreen: Option<OffscreenTarget>,
+    /// Means of the uploaded cloud, for the sorter.
+    positions: Vec<[f32; 3]>,
+    sorter: DistanceSorter,
+    order: Vec<u32>,
+    // Declared last: dropped after the GL objects above are deleted in `Drop`.
+    ctx: HeadlessContext,
+}
+
+impl HeadlessRenderer {
+    /// A new GLES 3 context with a renderer (no cloud yet).
+    pub fn new() -> Result<Self, HeadlessError> {
+        Self::with_context(HeadlessContext::new()?)
+    }
+
+    /// A renderer on `ctx` (e.g. `HeadlessContext::with_api(GlApi::DesktopCore33)?`).
+    pub fn with_context(ctx: HeadlessContext) -> Result<Self, HeadlessError> {
+        Self::with_context_and_errata(ctx, Errata::default())
+    }
+
+    /// Like [`HeadlessRenderer::new`] with Appendix A errata switched in. **Erratum tests
+    /// only** (hidden from the documented API).
+    #[doc(hidden)]
+    pub fn with_errata(errata: Errata) -> Result<Self, HeadlessError> {
+        Self::with_context_and_errata(HeadlessContext::new()?, errata)
+    }
+
+    fn with_context_and_errata(
+        ctx: HeadlessContext,
+        errata: Errata,
+    ) -> Result<Self, HeadlessError> {
+        ctx.make_current()?;
+        let renderer = SplatRenderer::with_errata(ctx.gl(), errata)?;
+        Ok(HeadlessRenderer {
+            renderer,
+            target: None,
+            offscreen: None,
+            positions: Vec::new(),
+            sorter: DistanceSorter::default(),
+            order: Vec::new(),
+            ctx,
+        })
+    }
+
+    /// The context.
+    pub fn context(&self) -> &HeadlessContext {
+        &self.ctx
+    }
+
+    /// The renderer (read-only: uploads go through [`HeadlessRenderer::upload`]).
+    pub fn renderer(&self) -> &SplatRenderer {
+        &self.renderer
+    }
+
+    /// Uploads a cloud (replacing the previous one; on failure the previous one stays).
+    pub fn upload(&mut self, cloud: &SplatCloud) -> Result<(), HeadlessError> {
+        self.ctx.make_current()?;
+        self.renderer.upload(self.ctx.gl(), cloud)?;
+        self.positions.clear();
+        self.positions.extend_from_slice(&cloud.positions);
+        Ok(())
+    }
+
+    /// Renders the uploaded cloud, sorted back to front for `camera`.
+    pub fn render(
+        &mut self,
+        camera: &Camera,
+        opts: &HeadlessOptions,
+    ) -> Result<Image, HeadlessError> {
+        let mut order = std::mem::take(&mut self.order);
+        self.sorter.sort(&self.positions, camera.eye(), &mut order);
+        let result = self.render_with_order(camera, opts, &order);
+        self.order = order;
+        result
+    }
+
+    /// Renders the uploaded cloud in the given order (first index drawn first).
+    pub fn render_with_order(
+        &mut self,
+        camera: &Camera,
+        opts: &HeadlessOptions,
+        order: &[u32],
+    ) -> Result<Image, HeadlessError> {
+        self.ctx.make_current()?;
+        let space = opts.color_space.unwrap_or(self.renderer.color_space());
+        let linear = space == ColorSpace::LinRec709Display;
+        let (w, h) = (camera.width, camera.height);
+        if w == 0 || h == 0 {
+            return Ok(Image::filled(w, h, [0.0; 4])); // no pixels (a 0-sized FBO is incomplete)
+        }
+        let srgb_fbo = linear && opts.target == TargetKind::Rgba8;
+        self.prepare_targets(w, h, srgb_fbo, opts.target)?;
+        let bg = if linear {
+            opts.background
+                .map(|c| crate::profile::srgb_decode(c as f64) as f32)
+        } else {
+            opts.background
+        };
+        let settings = DrawSettings {
+            sh_degree: opts.sh_degree,
+            depth_test: false,
+            color_space: Some(space),
+            ..DrawSettings::default()
+        };
+        let gl = self.ctx.gl();
+        let target = self.target.as_ref().expect("prepared above");
+        // Where GL_FRAMEBUFFER_SRGB can be switched (desktop GL, ES with
+        // EXT_sRGB_write_control) the sRGB target encodes only with it on: the clear needs it
+        // as the draw does (which sets it itself, from `color_space`, and leaves it so).
+        let srgb_switch = !gl.version().is_embedded
+            || gl
+                .supported_extensions()
+                .contains("GL_EXT_sRGB_write_control");
+        target.bind(gl)?;
+        // SAFETY: a capability switch and a clear of our own framebuffer, bound just above.
+        unsafe {
+            if srgb_switch && srgb_fbo {
+                gl.enable(glow::FRAMEBUFFER_SRGB);
+            }
+            gl.clear_color(bg[0], bg[1], bg[2], 0.0);
+            gl.clear(glow::COLOR_BUFFER_BIT);
+        }
+        let (renderer, offscreen) = (&mut self.renderer, &mut self.offscreen);
+        let drawn = (|| {
+            renderer.set_order(gl, order)?;
+            match opts.target {
+                TargetKind::Rgba8 => renderer.draw_current_with(gl, camera, &settings),
+                TargetKind::Rgba16fResolve => {
+                    let offscreen = offscreen.as_mut().expect("prepared above");
+                    offscreen.begin(gl, [bg[0], bg[1], bg[2], 0.0])?;
+                    renderer.draw_current_with(gl, camera, &settings)?;
+                    offscreen.resolve(gl, linear)
+                }
+            }
+        })();
+        let image = drawn
+            .and_then(|()| crate::gl::check_error(gl, "rendering"))
+            .and_then(|()| target.read_image(gl));
+        // SAFETY: unbinding our framebuffer.
+        unsafe { gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
+        Ok(image?)
+    }
+
+    /// (Re)creates the 8-bit target (sRGB or not) and, for `Rgba16fResolve`, the float target,
+    /// when the size or format changed.
+    fn prepare_targets(
+        &mut self,
+        w: u32,
+        h: u32,
+        srgb: bool,
+        kind: TargetKind,
+    ) -> Result<(), GlError> {
+        let gl = self.ctx.gl();
+        let format = if srgb {
+            ColorFormat::Srgb8Alpha8
+        } else {
+            ColorFormat::Rgba8
+        };
+        if self
+            .target
+            .as_ref()
+            .is_none_or(|t| (t.size(), t.format()) != ((w, h), format))
+        {
+            if let Some(mut t) = self.target.take() {
+                t.destroy(gl);
+            }
+            self.target = Some(ReadbackTarget::new(gl, w, h, format, None)?);
+        }
+        if kind == TargetKind::Rgba16fResolve
+            && self.offscreen.as_ref().is_none_or(|t| t.size() != (w, h))
+        {
+            if let Some(mut t) = self.offscreen.take() {
+                t.destroy(gl);
+            }
+            self.offscreen = Some(OffscreenTarget::new(gl, w, h)?);
+        }
+        Ok(())
+    }
+
+    /// Blocks until the GL has finished all commands (for timing).
+    pub fn finish(&self) {
+        // SAFETY: glFinish has no preconditions.
+        unsafe { self.ctx.gl().finish() }
+    }
+}
+
+impl Drop for HeadlessRenderer {
+    fn drop(&mut self) {
+        if self.ctx.make_current().is_err() {
+            // The objects go with the context (destroyed right after this).
+            self.renderer.abandon();
+            self.target.iter_mut().for_each(ReadbackTarget::abandon);
+            self.offscreen.iter_mut().for_each(OffscreenTarget::abandon);
+            return;
+        }
+        let gl = self.ctx.gl();
+        self.renderer.destroy(gl);
+        if let Some(t) = &mut self.target {
+            t.destroy(gl);
+        }
+        if let Some(t) = &mut self.offscreen {
+            t.destroy(gl);
+        }
+    }
+}

@@ -1,0 +1,140 @@
+//! The rendering profile's numbers, in one place: every constant both backends use, and the
+//! GPU data layout the GL backend and its shaders share.
+//!
+//! One section per section of `docs/rendering-profile.md` (its §8 tables them all). The CPU reference
+//! ([`crate::reference`]) reads these constants directly; the GLSL in `glsl/` receives each
+//! one as a generated `#define` (the GL backend's program assembly), so no value is written
+//! twice. A unit test of the GL backend fails if a define disagrees with its constant or if a
+//! shader spells one of these values as a literal.
+//!
+//! The spherical-harmonics basis constants (`SH_C0` … `SH_C3`) live with the basis in
+//! [`crate::sh`] and reach the shaders the same way.
+
+use crate::cloud::sh_coeff_count;
+
+// ---------------------------------------------------------------------------------------------
+// §1 Lighting: colour from SH
+// ---------------------------------------------------------------------------------------------
+
+/// Bias added to the SH sum to get the colour: `c = Σ SH·Y + 0.5` (RC §Lighting).
+/// [`crate::sh::dc_from_color`] and [`crate::sh::color_from_dc`] convert with it.
+pub const SH_DC_BIAS: f64 = 0.5;
+
+// ---------------------------------------------------------------------------------------------
+// §1 Display of lin_rec709_display: the sRGB transfer function (IEC 61966-2-1)
+// ---------------------------------------------------------------------------------------------
+
+/// Linear values up to this are encoded by the linear segment.
+pub const SRGB_ENCODE_THRESHOLD: f64 = 0.003_130_8;
+/// Encoded values up to this are decoded by the linear segment.
+pub const SRGB_DECODE_THRESHOLD: f64 = 0.040_45;
+/// Slope of the linear segment.
+pub const SRGB_LINEAR_SLOPE: f64 = 12.92;
+/// Scale of the power segment: `SCALE · v^(1/GAMMA) − OFFSET`.
+pub const SRGB_SCALE: f64 = 1.055;
+/// Offset of the power segment.
+pub const SRGB_OFFSET: f64 = 0.055;
+/// Exponent of the power segment.
+pub const SRGB_GAMMA: f64 = 2.4;
+
+/// sRGB encoding (linear → display). Negative input gives 0; input above 1 follows the curve.
+pub fn srgb_encode(v: f64) -> f64 {
+    if v <= 0.0 {
+        0.0
+    } else if v <= SRGB_ENCODE_THRESHOLD {
+        SRGB_LINEAR_SLOPE * v
+    } else {
+        SRGB_SCALE * v.powf(1.0 / SRGB_GAMMA) - SRGB_OFFSET
+    }
+}
+
+/// sRGB decoding (display → linear).
+pub fn srgb_decode(v: f64) -> f64 {
+    if v <= SRGB_DECODE_THRESHOLD {
+        v / SRGB_LINEAR_SLOPE
+    } else {
+        ((v + SRGB_OFFSET) / SRGB_SCALE).powf(SRGB_GAMMA)
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// §2 Camera model
+// ---------------------------------------------------------------------------------------------
+
+/// x/z and y/z inside the Jacobian J are clamped to ±`JACOBIAN_CLAMP`·tan(half fov) (3DGS
+/// `computeCov2D`); the mean itself is projected unclamped.
+pub const JACOBIAN_CLAMP: f64 = 1.3;
+
+// ---------------------------------------------------------------------------------------------
+// §3 Per-pixel rule
+// ---------------------------------------------------------------------------------------------
+
+/// Added to the diagonal of Σ' (px²) before inversion: the 3DGS low-pass / dilation.
+pub const DILATION_PX2: f64 = 0.3;
+/// Mahalanobis² cut-off, the RC's 3σ: a pixel contributes while dᵀΣ'⁻¹d ≤ 9.
+pub const CUTOFF_M2: f32 = 9.0;
+/// Cap on a splat's per-pixel α (3DGS `min(0.99, …)`).
+pub const ALPHA_MAX: f32 = 0.99;
+/// Contributions with α below this are skipped (3DGS `alpha < 1/255`).
+pub const ALPHA_MIN: f32 = 1.0 / 255.0;
+/// Splats whose camera-space depth is ≤ max(this, camera near) are culled (3DGS `in_frustum`),
+/// in scene units. `reference::RenderOptions::near_cull` overrides it for the reference.
+pub const NEAR_CULL: f64 = 0.2;
+
+// ---------------------------------------------------------------------------------------------
+// §8 GPU data layout (the GL backend's textures; docs/gl-backend.md "Data layout")
+// ---------------------------------------------------------------------------------------------
+
+/// `RGBA32F` texels per splat in the geometry texture.
+pub const GEOM_TEXELS: usize = 3;
+/// Geometry texel holding (position.xyz, opacity).
+pub const GEOM_TEXEL_POSITION_OPACITY: usize = 0;
+/// Geometry texel holding the rotation quaternion (x, y, z, w).
+pub const GEOM_TEXEL_ROTATION: usize = 1;
+/// Geometry texel holding (scale.xyz, 0).
+pub const GEOM_TEXEL_SCALE: usize = 2;
+
+/// `RGBA16F` texels per splat holding the SH coefficients of degrees `0..=degree`: the
+/// (d+1)² RGB triples packed tightly, coefficient k's channel c at float `3k + c`, so
+/// ⌈3·(d+1)²/4⌉ texels (1, 3, 7, 12 for degree 0–3).
+pub const fn sh_texels(degree: u8) -> usize {
+    (3 * sh_coeff_count(degree)).div_ceil(4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_roundtrip_and_known_points() {
+        for i in 0..=100 {
+            let v = i as f64 / 100.0;
+            assert!((srgb_decode(srgb_encode(v)) - v).abs() < 1e-12);
+        }
+        assert!((srgb_encode(0.5) - 0.735_356_983_052_449_4).abs() < 1e-12);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn srgb_segments_meet() {
+        // The two segments of each direction agree at the threshold (IEC 61966-2-1's values).
+        let t = SRGB_ENCODE_THRESHOLD;
+        let power = SRGB_SCALE * t.powf(1.0 / SRGB_GAMMA) - SRGB_OFFSET;
+        assert!((SRGB_LINEAR_SLOPE * t - power).abs() < 1e-6);
+        assert!((srgb_decode(SRGB_DECODE_THRESHOLD) - t).abs() < 1e-6);
+    }
+
+    #[test]
+    fn layout_sizes() {
+        assert_eq!([0, 1, 2, 3].map(sh_texels), [1, 3, 7, 12]);
+        // Each geometry texel has its own slot inside the splat's GEOM_TEXELS.
+        let mut texels = [
+            GEOM_TEXEL_POSITION_OPACITY,
+            GEOM_TEXEL_ROTATION,
+            GEOM_TEXEL_SCALE,
+        ];
+        texels.sort();
+        assert_eq!(texels, [0, 1, 2].map(|i: usize| i.min(GEOM_TEXELS)));
+        assert_eq!(texels.len(), GEOM_TEXELS);
+    }
+}

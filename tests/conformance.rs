@@ -1,0 +1,427 @@
+//! The conformance suite: generation, both backends passing it, the erratum proof (the GL
+//! backend's erratum switches fail exactly the assets whose derived `catches` name them), the
+//! runner's exit codes and causes, the Khronos glTF-Validator on every asset, and the HTML
+//! report in headless Chromium.
+
+use splatgl::conformance::manifest::Manifest;
+use splatgl::conformance::{Erratum, generate, model, render, runner};
+use splatgl::image::Image;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+fn splatgl(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
+        .args(args)
+        .output()
+        .expect("runs");
+    let text =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    (out.status.code().unwrap_or(-1), text)
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("splatgl-conf-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The suite, generated once per test binary.
+fn suite() -> &'static (PathBuf, Manifest) {
+    static S: OnceLock<(PathBuf, Manifest)> = OnceLock::new();
+    S.get_or_init(|| {
+        let d = tmp("suite");
+        let m = generate(&d).expect("suite generates");
+        (d, m)
+    })
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn gl_available() -> bool {
+    match splatgl::headless::HeadlessContext::new() {
+        Ok(_) => true,
+        Err(e) => {
+            eprintln!("SKIPPED GL part: {e}");
+            false
+        }
+    }
+}
+
+#[test]
+fn generated_suite_covers_every_erratum_and_writes_its_files() {
+    let (d, m) = suite();
+    assert!(m.assets.len() >= 30, "{} assets", m.assets.len());
+    for e in Erratum::ALL {
+        assert!(
+            m.assets.iter().any(|a| a.catches.contains(&e)),
+            "no asset catches erratum {}",
+            e.letter()
+        );
+    }
+    for a in &m.assets {
+        assert!(d.join(&a.file).is_file() && d.join(&a.cameras_json).is_file());
+        for c in &a.cameras {
+            assert!(d.join(&c.reference_png).is_file() && d.join(&c.reference_pfm).is_file());
+            assert!(
+                c.tolerance.max_abs > 0.0 && c.tolerance.max_abs < 0.1,
+                "{}",
+                a.name
+            );
+            assert!(
+                c.tolerance.min_psnr > 35.0,
+                "{}: {}",
+                a.name,
+                c.tolerance.min_psnr
+            );
+        }
+    }
+    let again = Manifest::read(d).unwrap();
+    assert_eq!(again.assets.len(), m.assets.len());
+    assert_eq!(again.assets[3].catches, m.assets[3].catches);
+}
+
+#[test]
+fn model_without_errata_reproduces_the_reference() {
+    let (d, m) = suite();
+    let mut worst = 0.0f32;
+    for (i, a) in m.assets.iter().enumerate() {
+        let (scene, cams) = render::load_asset(d, m, i).unwrap();
+        for (c, cam) in a.cameras.iter().zip(&cams) {
+            let want = Image::read(d.join(&c.reference_pfm)).unwrap();
+            let got = model::render(&scene.cloud, cam, &[]).image;
+            let mut want = want;
+            for p in &mut want.pixels {
+                p[..3].iter_mut().for_each(|v| *v = v.clamp(0.0, 1.0));
+            }
+            let cmp = splatgl::compare::compare(&got, &want, 0.0).unwrap();
+            worst = worst.max(cmp.max_abs);
+            assert!(cmp.max_abs < 2e-4, "{}/{}: {}", a.name, c.name, cmp.max_abs);
+        }
+    }
+    eprintln!("model vs reference: max {worst:e}");
+}
+
+#[test]
+fn both_backends_pass_the_suite() {
+    let (d, m) = suite();
+    let backends: &[&str] = if gl_available() {
+        &["reference", "gl"]
+    } else {
+        &["reference"]
+    };
+    for b in backends {
+        let out = tmp(&format!("run-{b}"));
+        let (code, text) = splatgl(&["conformance", "run", s(d), "--backend", b, "-o", s(&out)]);
+        assert_eq!(code, 0, "--backend {b}: {text}");
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        assert_eq!(r["passed"], m.assets.len(), "{b}");
+        assert_eq!(r["failed"], 0);
+        let a0 = &r["assets"][0];
+        // PSNR is null (infinite) when the images are identical.
+        assert!(a0["pass"].as_bool().unwrap() && a0["max_abs"].is_number());
+        assert!(a0["psnr"].is_number() || a0["max_abs"] == 0.0);
+        eprintln!("--backend {b}: {}", text.trim());
+    }
+}
+
+#[test]
+fn erratum_proof_gl_fails_exactly_the_assets_that_catch_it() {
+    let (d, m) = suite();
+    if !gl_available() {
+        return;
+    }
+    let mut table = Vec::new();
+    for e in Erratum::ALL {
+        let imgs: std::collections::HashMap<String, Image> =
+            render::render_suite_gl(d, m, e.gl_errata(), e == Erratum::G)
+                .unwrap()
+                .into_iter()
+                .collect();
+        let results = runner::run(d, m, |c| imgs.get(&c.image).cloned().map(Ok)).unwrap();
+        let failed: BTreeSet<&str> = results
+            .iter()
+            .filter(|r| !r.pass())
+            .map(|r| r.asset.name.as_str())
+            .collect();
+        let expected: BTreeSet<&str> = m
+            .assets
+            .iter()
+            .filter(|a| a.catches.contains(&e))
+            .map(|a| a.name.as_str())
+            .collect();
+        table.push(format!(
+            "{}: {} of {} fail",
+            e.letter(),
+            failed.len(),
+            m.assets.len()
+        ));
+        assert_eq!(
+            failed,
+            expected,
+            "erratum {}: GL fail set (left) vs derived `catches` (right)",
+            e.letter()
+        );
+        // The designated assets say which erratum they saw.
+        for r in results.iter().filter(|r| !r.pass()) {
+            assert!(r.cameras.iter().any(|c| c.cause.is_some()));
+        }
+    }
+    eprintln!("{}", table.join("\n"));
+}
+
+/// The Khronos glTF-Validator (filtered only for the extension it predates) and
+/// `splatgl validate` on every asset: RC-valid ones pass, the legacy one is flagged.
+#[test]
+fn every_asset_passes_the_khronos_validator_and_splatgl_validate() {
+    let (d, m) = suite();
+    let pkg = Path::new(env!("CARGO_MANIFEST_DIR")).join(".npm-tools/node_modules/gltf-validator");
+    let khronos = pkg.exists() && Command::new("node").arg("--version").output().is_ok();
+    if !khronos {
+        eprintln!(
+            "SKIPPED glTF-Validator: {} or node missing (.ci/run installs them)",
+            pkg.display()
+        );
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gltf_validate.mjs");
+    for a in &m.assets {
+        let file = d.join(&a.file);
+        let (code, text) = splatgl(&["validate", s(&file)]);
+        assert_eq!(code, if a.rc_valid { 0 } else { 1 }, "{}: {text}", a.name);
+        if khronos {
+            let out = Command::new("node")
+                .arg(&script)
+                .arg(&file)
+                .output()
+                .unwrap();
+            let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_eq!(
+                r["issues"]["numErrors"], 0,
+                "{}: {:#}",
+                a.name, r["issues"]["messages"]
+            );
+            assert_eq!(out.status.code(), Some(0));
+            assert!(r["issues"]["filteredPredatingExtension"].as_u64().unwrap() > 0);
+        }
+    }
+}
+
+#[test]
+fn cameras_json_describes_the_same_views_as_the_camera_nodes() {
+    let (d, m) = suite();
+    for (i, a) in m.assets.iter().enumerate() {
+        let (_, cams) = render::load_asset(d, m, i).unwrap();
+        let list = splatgl::camera::load_cameras_json(d.join(&a.cameras_json)).unwrap();
+        for (c, e) in cams.iter().zip(&list) {
+            let j = splatgl::camera::Camera::from_3dgs(e).unwrap();
+            // A point 2 in front of the glTF camera, off the axis.
+            let p = c
+                .world_to_camera
+                .inverse()
+                .transform_point3(glam::Vec3::new(0.3, -0.2, 2.0));
+            let (u1, _) = c.project(p).unwrap();
+            let (u2, _) = j.project(p).unwrap();
+            assert!((u1 - u2).length() < 1e-3, "{}: {u1} vs {u2}", a.name);
+        }
+    }
+}
+
+/// The runner: exit codes, images given as PNG in the reference layout, and causes.
+#[test]
+fn runner_exit_codes_layouts_and_likely_causes() {
+    let (d, m) = suite();
+    let (code, text) = splatgl(&["conformance", "run", s(d), "--images", "/nonexistent"]);
+    assert_eq!(code, 2, "{text}");
+    let empty = tmp("empty");
+    let (code, _) = splatgl(&["conformance", "run", s(&empty), "--backend", "reference"]);
+    assert_eq!(code, 2, "no manifest");
+    // Our own 8-bit references, laid out as reference/ is: every asset passes.
+    let (code, text) = splatgl(&[
+        "conformance",
+        "run",
+        s(d),
+        "--images",
+        s(&d.join("reference")),
+        "-o",
+        s(&tmp("png")),
+    ]);
+    assert_eq!(code, 0, "{text}");
+    // A copy with one image flipped, one missing and the legacy (optional) asset absent.
+    let other = tmp("other");
+    for a in &m.assets {
+        for c in &a.cameras {
+            if a.optional || (a.name == "sh_degree_1" && c.name == "back") {
+                continue;
+            }
+            let mut img = Image::read(d.join(&c.reference_png)).unwrap();
+            if a.name == "orientation_cube_corners" && c.name == "front" {
+                let w = img.width as usize;
+                let rows: Vec<_> = img.pixels.chunks(w).rev().flatten().copied().collect();
+                img.pixels = rows;
+            }
+            let p = other.join(format!("{}.png", c.image));
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            img.write_png(&p, Default::default(), false).unwrap();
+        }
+    }
+    let out = tmp("other-report");
+    let (code, text) = splatgl(&[
+        "conformance",
+        "run",
+        s(d),
+        "--images",
+        s(&other),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code, 1, "{text}");
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let optional = m.assets.iter().filter(|a| a.optional).count();
+    assert_eq!(r["failed"], 2);
+    assert_eq!(r["skipped"], optional);
+    assert_eq!(r["passed"], m.assets.len() - 2 - optional);
+    let find = |name: &str| {
+        r["assets"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|a| a["name"] == name)
+            .unwrap()
+            .clone()
+    };
+    let cube = find("orientation_cube_corners");
+    assert!(
+        cube["cameras"][0]["cause"]
+            .as_str()
+            .unwrap()
+            .contains("upside down"),
+        "{cube:#}"
+    );
+    let sh1 = find("sh_degree_1");
+    assert!(
+        sh1["cameras"][1]["cause"]
+            .as_str()
+            .unwrap()
+            .contains("no image"),
+        "{sh1:#}"
+    );
+    assert!(sh1["psnr"].is_null());
+}
+
+/// A renderer that sorts by view depth fails the sort asset; one that ignores colorSpace
+/// fails one of the colour-space assets (the assets are sensitive to what they check).
+#[test]
+fn sort_and_color_space_assets_fail_renderers_that_get_them_wrong() {
+    let (d, m) = suite();
+    let idx = |n: &str| m.assets.iter().position(|a| a.name == n).unwrap();
+    let check =
+        |name: &str, render: &dyn Fn(&splatgl::SplatCloud, &splatgl::camera::Camera) -> Image| {
+            let i = idx(name);
+            let (scene, cams) = render::load_asset(d, m, i).unwrap();
+            let imgs: Vec<Image> = cams.iter().map(|c| render(&scene.cloud, c)).collect();
+            let mut k = 0;
+            let r = runner::run(d, m, |c| {
+                (c.image.starts_with(&format!("{name}/"))).then(|| {
+                    k += 1;
+                    Ok(imgs[k - 1].clone())
+                })
+            })
+            .unwrap();
+            assert!(!r[i].pass(), "{name} should fail");
+        };
+    use splatgl::reference::{RenderOptions, SortMode, render_display};
+    check("sort_distance_not_depth", &|cl, c| {
+        let o = RenderOptions {
+            sort: SortMode::ViewDepth,
+            ..Default::default()
+        };
+        render_display(cl, c, &o, cl.meta.color_space.effective()).0
+    });
+    check("color_space_linear", &|cl, c| {
+        render_display(
+            cl,
+            c,
+            &RenderOptions::default(),
+            splatgl::cloud::ColorSpace::SrgbRec709Display,
+        )
+        .0
+    });
+}
+
+/// The HTML report opens in headless Chromium: the title and one table row per camera.
+#[test]
+fn html_report_renders_in_headless_chromium() {
+    let (d, m) = suite();
+    let out = tmp("html");
+    let (code, text) = splatgl(&[
+        "conformance",
+        "run",
+        s(d),
+        "--backend",
+        "reference",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{text}");
+    let Some(chromium) = ["chromium", "chromium-browser"]
+        .into_iter()
+        .find(|b| Command::new(b).arg("--version").output().is_ok())
+    else {
+        eprintln!("SKIPPED: chromium is not installed (.ci/run installs it)");
+        return;
+    };
+    let page = format!("file://{}", out.join("report.html").display());
+    let profile = tmp("chromium-profile");
+    let args = |extra: &[String]| {
+        let mut v: Vec<String> = [
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+        ]
+        .map(String::from)
+        .to_vec();
+        v.push(format!("--user-data-dir={}", profile.display()));
+        v.extend_from_slice(extra);
+        v.push(page.clone());
+        v
+    };
+    let dom = Command::new(chromium)
+        .args(args(&["--dump-dom".into()]))
+        .output()
+        .unwrap();
+    let html = String::from_utf8_lossy(&dom.stdout);
+    assert!(
+        html.contains("<title>KHR_gaussian_splatting conformance report</title>"),
+        "{html:.300}"
+    );
+    let cams: usize = m.assets.iter().map(|a| a.cameras.len()).sum();
+    assert_eq!(html.matches("<tr class=\"result").count(), cams);
+    let shot = out.join("shot.png");
+    let st = Command::new(chromium)
+        .args(args(&[
+            format!("--screenshot={}", shot.display()),
+            "--window-size=1200,900".into(),
+        ]))
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let img = Image::read(&shot).unwrap();
+    assert_eq!((img.width, img.height), (1200, 900));
+    // Not blank: the page drew text and thumbnails.
+    let first = img.pixels[0];
+    assert!(img.pixels.iter().any(|p| p != &first));
+}
