@@ -4,11 +4,19 @@
 //! Small synthetic files covering what the tests cover — every PLY variant (binary little and
 //! big endian, ASCII, colours instead of SH, lists before `vertex`, PlayCanvas compressed with
 //! SH), glTF/GLB with SH degrees 0–3, every component type the RC allows, stride, sparse
-//! accessors, COLOR_0 and node matrices, cameras.json — plus the real files under 64 KiB.
+//! accessors, COLOR_0 and node matrices, SPZ-compressed GLB, cameras.json, SPZ v2–v4 with SH
+//! 0–3, `.splat`, `.ksplat` of levels 0–2, SOG bundles and a bare meta.json — plus the real
+//! files under 64 KiB.
 use splatgl::SplatCloud;
 use splatgl::scene::random_cloud;
 use splatgl::write::{Comp, GltfWriteOptions, to_glb, to_gltf, to_inria_ply};
+use splatgl::write::{SpzVersion, SpzWriteOptions, to_glb_spz, to_splat, to_spz_with};
 use std::path::Path;
+
+/// The tests' independent `.ksplat` and SOG encoders (splatgl writes neither).
+#[path = "../tests/common/packed.rs"]
+#[allow(dead_code)]
+mod packed;
 
 fn put(dir: &Path, target: &str, name: &str, bytes: &[u8]) {
     let d = dir.join(target);
@@ -143,6 +151,49 @@ fn gltf_seeds(dir: &Path) {
     }
 }
 
+fn packed_seeds(dir: &Path) {
+    for degree in 0..=3u8 {
+        let c = random_cloud(4, degree, 2.0, 40 + degree as u64);
+        for version in [SpzVersion::V2, SpzVersion::V3, SpzVersion::V4] {
+            let o = SpzWriteOptions {
+                version,
+                ..Default::default()
+            };
+            let name = format!("v{}_sh{degree}.spz", version.number());
+            put(dir, "spz", &name, &to_spz_with(&c, &o).expect("spz"));
+        }
+        put(
+            dir,
+            "glb",
+            &format!("spz_sh{degree}.glb"),
+            &to_glb_spz(&c).expect("glb"),
+        );
+        for level in 0..=2u16 {
+            let k = packed::ksplat(&c, level, 3, 5.0);
+            put(dir, "ksplat", &format!("l{level}_sh{degree}.ksplat"), &k);
+        }
+        put(
+            dir,
+            "sog",
+            &format!("sh{degree}.sog"),
+            &packed::sog_bundle(&c),
+        );
+    }
+    put(
+        dir,
+        "splat",
+        "four.splat",
+        &to_splat(&random_cloud(4, 0, 2.0, 50)),
+    );
+    let files = packed::sog_files(&random_cloud(4, 1, 2.0, 51));
+    put(dir, "sog", "meta.json", &files.last().expect("meta").1);
+    put(dir, "sog", "v1.sog", &{
+        let f = packed::sog_files_v1(&random_cloud(4, 1, 2.0, 52));
+        let m: Vec<(&str, &[u8])> = f.iter().map(|(n, b)| (n.as_str(), b.as_slice())).collect();
+        packed::zip_stored(&m)
+    });
+}
+
 fn cameras_seeds(dir: &Path) {
     let one = r#"{"id": 0, "img_name": "a", "width": 64, "height": 48, "position": [0.5, -1, 3],
         "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "fx": 50.5, "fy": 51}"#;
@@ -178,7 +229,6 @@ fn real_seeds(dir: &Path, real: &Path) {
             Some("ply") => "ply",
             Some("gltf") => "gltf_json",
             Some("glb") => "glb",
-            // Targets of the readers still to come take their seeds by their extension.
             Some(ext @ ("spz" | "splat" | "ksplat" | "sog")) => ext,
             _ => continue,
         };
@@ -203,6 +253,7 @@ fn main() {
     ply_seeds(dir);
     gltf_seeds(dir);
     cameras_seeds(dir);
+    packed_seeds(dir);
     // The structure-aware target decodes any bytes; a few fixed ones start it off.
     for (i, seed) in [&[0u8; 16][..], &[7; 64], &(0..=255).collect::<Vec<u8>>()]
         .iter()

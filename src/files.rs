@@ -105,22 +105,40 @@ pub fn read_bounded(path: &Path, limit: u64, what: &str) -> io::Result<Vec<u8>> 
     read_at_most(f, limit, what)
 }
 
-/// The containment rule for files a document names (glTF buffer URIs, later image URIs, files
-/// beside a SOG `meta.json`): `uri` is percent-decoded and joined to `base` (the document's
-/// folder); both are canonicalised (`..` resolved, symlinks followed) and the file must lie
-/// inside `base`. Absolute paths, `..` escapes and symlinks pointing outside are refused with a
-/// message naming the URI and the rule, unless `allow_outside`. Returns the canonical path.
+/// The containment rule for files a document names by URI (glTF buffer URIs, later image
+/// URIs): `uri` is percent-decoded, then [`contained_path`] applies.
 pub(crate) fn contained(base: &Path, uri: &str, allow_outside: bool) -> Result<PathBuf, String> {
     let decoded = percent_decode(uri);
-    let rel = Path::new(&decoded);
-    let how = "external files must lie inside the glTF file's folder (allow with --allow-outside-paths / LoadOptions::allow_outside_paths)";
+    contained_named(base, Path::new(&decoded), uri, allow_outside)
+}
+
+/// The containment rule for a file name taken as written (the textures beside a SOG
+/// `meta.json`): `rel` is joined to `base` (the document's folder); both are canonicalised
+/// (`..` resolved, symlinks followed) and the file must lie inside `base`. Absolute paths, `..`
+/// escapes and symlinks pointing outside are refused with a message naming the file and the
+/// rule, unless `allow_outside`. Returns the canonical path.
+pub(crate) fn contained_path(
+    base: &Path,
+    rel: &Path,
+    allow_outside: bool,
+) -> Result<PathBuf, String> {
+    contained_named(base, rel, &rel.to_string_lossy(), allow_outside)
+}
+
+fn contained_named(
+    base: &Path,
+    rel: &Path,
+    name: &str,
+    allow_outside: bool,
+) -> Result<PathBuf, String> {
+    let how = "files a document names must lie inside its folder (allow with --allow-outside-paths / LoadOptions::allow_outside_paths)";
     if rel.is_absolute() && !allow_outside {
-        return Err(format!("URI {uri:?} is an absolute path; {how}"));
+        return Err(format!("URI {name:?} is an absolute path; {how}"));
     }
     let joined = base.join(rel);
     let file = joined
         .canonicalize()
-        .map_err(|e| format!("external buffer {}: {e}", joined.display()))?;
+        .map_err(|e| format!("{}: {e}", joined.display()))?;
     if allow_outside {
         return Ok(file);
     }
@@ -129,7 +147,7 @@ pub(crate) fn contained(base: &Path, uri: &str, allow_outside: bool) -> Result<P
         .map_err(|e| format!("asset folder {}: {e}", base.display()))?;
     if !file.starts_with(&root) {
         return Err(format!(
-            "URI {uri:?} resolves to {}, outside the asset's folder {}; {how}",
+            "URI {name:?} resolves to {}, outside the asset's folder {}; {how}",
             file.display(),
             root.display()
         ));

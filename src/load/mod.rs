@@ -277,9 +277,12 @@ pub(crate) enum ReadError {
 impl ReadError {
     fn at(self, path: PathBuf) -> LoadError {
         match self {
-            ReadError::Ply(ply::PlyError::Limit(source)) | ReadError::Limit(source) => {
-                LoadError::Limit { path, source }
-            }
+            ReadError::Ply(ply::PlyError::Limit(source))
+            | ReadError::Spz(spz::SpzError::Limit(source))
+            | ReadError::Splat(splat::SplatError::Limit(source))
+            | ReadError::Ksplat(ksplat::KsplatError::Limit(source))
+            | ReadError::Sog(sog::SogError::Limit(source))
+            | ReadError::Limit(source) => LoadError::Limit { path, source },
             ReadError::Ply(source) => LoadError::Ply { path, source },
             ReadError::Gltf(source) => LoadError::Gltf { path, source },
             ReadError::Unusable(finding) => LoadError::Unusable { path, finding },
@@ -319,11 +322,22 @@ pub(crate) fn read(
     let (mut cloud, cameras) = match format {
         Format::Ply => (ply::read(bytes, opts, report)?, Vec::new()),
         Format::Gltf | Format::Glb => gltf::read(bytes, format, path, opts, report)?,
-        Format::Spz => (spz::read(bytes, opts.spz_axes, report)?, Vec::new()),
-        Format::Splat => (splat::read(bytes, report)?, Vec::new()),
-        Format::Ksplat => (ksplat::read(bytes, report)?, Vec::new()),
-        Format::Sog => (sog::read(bytes, path, report)?, Vec::new()),
+        Format::Spz => (spz::read(bytes, opts, report)?, Vec::new()),
+        Format::Splat => (splat::read(bytes, opts, report)?, Vec::new()),
+        Format::Ksplat => (ksplat::read(bytes, opts, report)?, Vec::new()),
+        Format::Sog => (sog::read(bytes, path, opts, report)?, Vec::new()),
     };
+    finish(&mut cloud, opts, report)?;
+    Ok((cloud, cameras))
+}
+
+/// The checks at the exit of every reader: the splat limit, and the numeric hygiene pass (bad
+/// splats dropped with a warning, or in strict mode the first one is the error).
+pub(crate) fn finish(
+    cloud: &mut SplatCloud,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<(), ReadError> {
     opts.limits
         .check_splats(cloud.len() as u64, "the loaded cloud")?;
     let site = hygiene::Site {
@@ -333,9 +347,9 @@ pub(crate) fn read(
         strict: opts.strict,
         origin: None,
     };
-    hygiene::clean(&mut cloud, &site, &mut report.findings).map_err(ReadError::Unusable)?;
+    hygiene::clean(cloud, &site, &mut report.findings).map_err(ReadError::Unusable)?;
     debug_assert!(cloud.validate().is_ok(), "{:?}", cloud.validate());
-    Ok((cloud, cameras))
+    Ok(())
 }
 
 /// A quaternion whose norm is 1 within this (4 f32 ulps at 1) is kept as stored: renormalising
