@@ -280,7 +280,49 @@ fn devices_fifos_directories_and_sockets_are_errors_at_once() {
         assert!(code == 2 && out.contains(kind), "{out}");
         let (code, out) = splatgl(&["compare", p.to_str().unwrap(), p.to_str().unwrap()]);
         assert!(code == 2 && out.contains(kind), "{out}");
+        let out_glb = d.join("out.glb");
+        let (code, out) = splatgl(&["convert", p.to_str().unwrap(), out_glb.to_str().unwrap()]);
+        assert!(code == 2 && out.contains(kind), "{out}");
+        assert!(!out_glb.exists());
     }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn conformance_inputs_are_regular_files_inside_the_suite() {
+    let d = dir("suite");
+    // A FIFO as manifest.json: an error at once, not a blocked read.
+    let fifo = d.join("fifo");
+    std::fs::create_dir_all(&fifo).unwrap();
+    let c = std::ffi::CString::new(fifo.join("manifest.json").to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    let f = fifo.to_str().unwrap().to_owned();
+    let (code, out) = within_a_second("conformance run", move || {
+        splatgl(&["conformance", "run", &f, "--backend", "reference"])
+    });
+    assert!(code == 2 && out.contains("FIFO"), "{out}");
+    // A manifest naming an asset outside its folder.
+    let suite = d.join("escape");
+    std::fs::create_dir_all(&suite).unwrap();
+    splatgl::write::save(&random_cloud(3, 0, 5.0, 5), &d.join("outside.glb"), &[]).unwrap();
+    let manifest = serde_json::json!({
+        "generator": "test", "background": [0, 0, 0],
+        "assets": [{"name": "a", "file": "../outside.glb", "cameras_json": "a.json",
+            "rule": "r", "rc_section": "s", "failure_means": "f", "catches": [],
+            "cameras": []}]
+    });
+    std::fs::write(suite.join("manifest.json"), manifest.to_string()).unwrap();
+    let (code, out) = splatgl(&[
+        "conformance",
+        "run",
+        suite.to_str().unwrap(),
+        "--backend",
+        "reference",
+    ]);
+    assert!(
+        code == 2 && out.contains("../outside.glb") && out.contains("outside the asset's folder"),
+        "{out}"
+    );
     std::fs::remove_dir_all(&d).ok();
 }
 
