@@ -33,11 +33,12 @@ pub fn budget_for(input_len: usize, limits: &Limits) -> u64 {
         .min(limits.max_decompressed_bytes)
 }
 
-/// Bytes a cloud of `n` splats of SH degree `degree` takes while being built (its arrays and
-/// the per-splat flags of [`finish_cloud`]); loaders charge it to the budget with the
-/// decompressed data before allocating.
+/// Bytes a cloud of `n` splats of SH degree `degree` takes while being built: its arrays, and
+/// at most 24 more per splat for the numeric hygiene pass that drops bad splats (the list of
+/// bad ones, 16 bytes each, then their indices, 8 each, or the kept splats' original indices,
+/// 4 each); loaders charge it to the budget with the decompressed data before allocating.
 pub fn cloud_bytes(n: u64, degree: u8) -> u64 {
-    n.saturating_mul(12 + 12 + 16 + 4 + 1 + 12 * sh_coeff_count(degree) as u64)
+    n.saturating_mul(12 + 12 + 16 + 4 + 24 + 12 * sh_coeff_count(degree) as u64)
 }
 
 /// Why a bounded decompression failed.
@@ -202,7 +203,7 @@ pub struct SplatMut<'a> {
     pub position: &'a mut [f32; 3],
     /// Linear scale.
     pub scale: &'a mut [f32; 3],
-    /// Quaternion `[x, y, z, w]` (normalised later by [`finish_cloud`]).
+    /// Quaternion `[x, y, z, w]` (normalised when the reader finishes the cloud).
     pub rotation: &'a mut [f32; 4],
     /// Linear opacity.
     pub opacity: &'a mut f32,
