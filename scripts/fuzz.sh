@@ -20,7 +20,7 @@ if [ "$which" != all ]; then
   [[ " ${targets[*]} " == *" $which "* ]] || { echo "unknown target $which (${targets[*]})" >&2; exit 2; }
   targets=("$which")
 fi
-command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
+command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --version 0.13.2 --locked
 if rustup toolchain list 2>/dev/null | grep -q '^nightly'; then
   fuzz=(cargo +nightly fuzz)
 else

@@ -6,6 +6,18 @@
 //! checked again on the open handle (the path may have been swapped in between), and its size
 //! is compared with the caller's limit before a byte is read. The read itself stops one byte past
 //! the limit, so a file that grows while being read cannot exceed it either.
+//!
+//! The API, which readers and their tests rely on:
+//! - [`open_regular`]`(path, what) -> (File, size)`: the checks alone, for readers that stream
+//!   or read part of a file (external glTF buffers read up to `byteLength`);
+//! - [`read_bounded`]`(path, limit, what) -> Vec<u8>`: the whole file, at most `limit` bytes;
+//! - `contained(base, uri, allow_outside)` / `contained_path(base, rel, allow_outside)`
+//!   (crate-internal): the containment rule for files a document names, returning the
+//!   canonical path to open with the two above.
+//!
+//! Errors are `io::Error`s whose message names `what` and the rule or limit; callers add the
+//! path. A memory-mapped variant belongs beside [`read_bounded`] with the same contract
+//! ([`open_regular`] first, then the size against the limit before mapping).
 
 use std::fs::File;
 use std::io::{self, Read};
