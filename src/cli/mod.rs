@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod camera_args;
 mod compare;
 mod conformance;
 mod convert;
