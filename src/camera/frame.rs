@@ -188,6 +188,18 @@ impl Camera {
         Some(cam)
     }
 
+    /// The distance to focus on `point`: its depth along the view axis, or (when it is not in
+    /// front of the camera) its distance, at least 1. The viewer's pivot distance and the
+    /// target distance of a printed `--look-at`.
+    pub fn focus_distance_to(&self, point: Vec3) -> f32 {
+        let z = self.to_camera(point).z;
+        if z > 1e-3 {
+            z
+        } else {
+            (point - self.eye()).length().max(1.0)
+        }
+    }
+
     /// This camera as `--look-at` values: its eye, the point `distance` in front of it on the
     /// optical axis as target, its image "up" (−y of the OpenCV axes) and its vertical field of
     /// view. See [`LookAt`] for when this is exact.

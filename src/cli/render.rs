@@ -1,8 +1,7 @@
 //! `splatgl render`: one image of a scene (or of the bundled default scene).
 
 use super::camera_args::{camera_json_line, floats, look_at_line};
-use glam::Vec3;
-use splatgl::camera::{Camera, Extent, SceneView};
+use splatgl::camera::{Camera, SceneView};
 use splatgl::image::{Image, PngDepth};
 use splatgl::load::Scene;
 use splatgl::reference::{RenderOptions, SortMode};
@@ -78,26 +77,11 @@ pub struct Args {
 }
 
 /// The view (see [`splatgl::camera::ViewOptions::camera`]) and the distance to print its
-/// target at: the --look-at target, else the content's centre along the view.
+/// target at.
 fn camera(a: &Args, scene: SceneView<'_>) -> Result<(Camera, f32), String> {
     let opts = a.cam.options()?;
     let cam = opts.camera(scene, (640, 480)).map_err(|e| e.to_string())?;
-    let distance = match (&opts.look_at, Extent::of_cloud(scene.cloud)) {
-        (Some(l), _) => (l.target - l.eye).length(),
-        (None, Some(e)) => focus_distance(&cam, e.centre()),
-        (None, None) => 1.0,
-    };
-    Ok((cam, distance))
-}
-
-/// Distance along the view axis to `point` (or to it, when it is behind the camera).
-pub fn focus_distance(cam: &Camera, point: Vec3) -> f32 {
-    let z = cam.to_camera(point).z;
-    if z > 1e-3 {
-        z
-    } else {
-        (point - cam.eye()).length().max(1.0)
-    }
+    Ok((cam, opts.focus_distance(&cam, scene.cloud)))
 }
 
 fn write(img: &Image, a: &Args) -> Result<(), String> {
