@@ -506,6 +506,14 @@ fn async_sorter_delivers_newest_order() {
     let want = Sorter::new().sort_by_distance(&positions, eyes[9]).to_vec();
     assert_eq!(frame.order(), want.as_slice());
     assert_eq!(frame.request(), Some(SortRequest::distance(eyes[9])));
+    let g = asorter.request(SortRequest::distance(eyes[0]));
+    // `current` keeps the order taken last, even once a newer one has finished.
+    let newer = asorter.wait_for(g).unwrap().generation();
+    assert_eq!(newer, g);
+    assert_eq!(asorter.current().unwrap().generation(), g);
+    asorter.request(SortRequest::distance(eyes[1]));
+    std::thread::sleep(std::time::Duration::from_millis(50));
+    assert_eq!(asorter.current().unwrap().generation(), g);
     // Round trips keep working with recycled buffers.
     for &eye in &eyes[..4] {
         let g = asorter.request(SortRequest::distance(eye));

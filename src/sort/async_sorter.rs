@@ -242,6 +242,13 @@ impl AsyncSorter {
         self.front.as_ref()
     }
 
+    /// The order the last [`latest`](Self::latest) or [`wait_for`](Self::wait_for) returned,
+    /// without switching to a newer one (so a caller can check an order and then draw that
+    /// same order).
+    pub fn current(&self) -> Option<&SortedFrame> {
+        self.front.as_ref()
+    }
+
     /// Blocks until the order of request `generation` (or a newer one) finished, then returns
     /// the newest order, for renders that must be deterministic. `None` if the worker stopped
     /// first (it panicked) or `generation` was never issued.

@@ -313,8 +313,10 @@ impl App {
                 }
             }
             WindowEvent::CursorMoved { position, .. } => {
-                self.controls
-                    .cursor_moved(glam::Vec2::new(position.x as f32, position.y as f32));
+                // In image pixels (the window's × --resolution-scale), like the camera.
+                let k = self.opts.resolution_scale;
+                let p = glam::Vec2::new(position.x as f32, position.y as f32) * k;
+                self.controls.cursor_moved(p);
                 self.request_redraw();
             }
             WindowEvent::MouseInput { state, button, .. } => {

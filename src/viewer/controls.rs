@@ -83,7 +83,7 @@ impl Default for Controls {
 }
 
 impl Controls {
-    /// The cursor moved to `pos` (physical pixels).
+    /// The cursor moved to `pos` (image pixels: physical × --resolution-scale).
     pub fn cursor_moved(&mut self, pos: Vec2) {
         let d = pos - self.cursor;
         self.cursor = pos;

@@ -109,14 +109,17 @@ impl Targets {
             }
         }
         let desktop_srgb = srgb && !gl.version().is_embedded;
-        // SAFETY: capability switches and a clear of the framebuffer bound just above.
+        // SAFETY: capability switches and a clear of the framebuffer bound just above (the
+        // float path's resolve replaces every pixel, so only the 8-bit path clears it).
         unsafe {
             gl.disable(glow::SCISSOR_TEST);
             if desktop_srgb {
                 gl.enable(glow::FRAMEBUFFER_SRGB);
             }
-            gl.clear_color(bg[0], bg[1], bg[2], 1.0);
-            gl.clear(glow::COLOR_BUFFER_BIT);
+            if !float {
+                gl.clear_color(bg[0], bg[1], bg[2], 1.0);
+                gl.clear(glow::COLOR_BUFFER_BIT);
+            }
         }
         let drawn = match self.float.as_mut().filter(|_| float) {
             Some(t) => t.begin(gl, [bg[0], bg[1], bg[2], 0.0]).and_then(|()| {

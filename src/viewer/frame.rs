@@ -119,6 +119,14 @@ impl App {
             renderer.set_order(gl, order.order())?;
             shown.uploaded = Some(order.generation());
         }
+        // Prefetch, before drawing so the sort overlaps the draw: sort for where the camera
+        // will be next frame (linear prediction), so the next frame finds a close order.
+        let next = match self.prev_eye {
+            Some(p) if moving => eye + (eye - p),
+            _ => eye,
+        };
+        shown.orders.request(next);
+        self.prev_eye = Some(eye);
         let bg = self.opts.background;
         self.targets
             .draw(gl, renderer, &cam, &self.settings, bg, window)?;
@@ -130,14 +138,6 @@ impl App {
                 Err(e) => eprintln!("error: screenshot {}: {e}", path.display()),
             }
         }
-        // Prefetch: sort for where the camera will be next frame (linear prediction), so the
-        // next frame finds an order close to its eye without waiting.
-        let next = match self.prev_eye {
-            Some(p) if moving => eye + (eye - p),
-            _ => eye,
-        };
-        shown.orders.request(next);
-        self.prev_eye = Some(eye);
         win.swap().map_err(ViewerError::Window)?;
         self.frames_shown += 1;
         self.animating = moving || matches!(fresh, Freshness::Stale { .. });
