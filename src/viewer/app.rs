@@ -93,9 +93,10 @@ pub(super) fn run(opts: ViewerOptions) -> Result<(), ViewerError> {
     event_loop.set_control_flow(ControlFlow::Wait);
     let mut app = App {
         load_opts: Arc::new(opts.load),
+        // (Struct update: DrawSettings may gain fields, e.g. state restoring.)
         settings: DrawSettings {
             sh_degree: Some(opts.sh_degree),
-            depth_test: false,
+            ..DrawSettings::default()
         },
         opts: ViewerOptions {
             load: Default::default(),
@@ -125,6 +126,7 @@ pub(super) fn run(opts: ViewerOptions) -> Result<(), ViewerError> {
         dialog_open: Arc::new(AtomicBool::new(false)),
         result: Ok(()),
     };
+    app.settings.depth_test = false; // the viewer has no depth buffer to test against
     app.targets.force_rgba8 = app.opts.target == super::TargetChoice::Rgba8;
     event_loop
         .run_app(&mut app)

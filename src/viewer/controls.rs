@@ -11,6 +11,10 @@ use super::rig::Rig;
 const INERTIA_TAU: f32 = 0.15;
 /// A drag that paused this long before the release leaves no inertia (s).
 const RELEASE_PAUSE: f32 = 0.06;
+/// Time over which the drag rate is averaged for the release velocity (s).
+const SPIN_AVERAGING: f32 = 0.05;
+/// Fastest inertial turn (rad/s).
+const MAX_SPIN: f32 = 2.0 * std::f32::consts::PI;
 /// Wheel zoom per notch (closer).
 const ZOOM_STEP: f32 = 0.85;
 /// Roll speed (rad/s) of Q/E.
@@ -163,7 +167,15 @@ impl Controls {
         // (A drag is applied even when the button was released before this frame.)
         let turn = if drag != Vec2::ZERO {
             let t = Vec2::new(-drag.x, drag.y) * per_px;
-            self.spin = if self.inertia { t / dt } else { Vec2::ZERO };
+            // The release velocity: the drag's rate averaged over the last ~50 ms (one big
+            // jump in a short frame must not fling the camera around), at most MAX_SPIN.
+            let a = 1.0 - (-dt / SPIN_AVERAGING).exp();
+            let spin = self.spin + (t / dt - self.spin) * a;
+            self.spin = if self.inertia {
+                spin.clamp_length_max(MAX_SPIN)
+            } else {
+                Vec2::ZERO
+            };
             t
         } else if self.left || !self.inertia {
             self.spin = Vec2::ZERO; // held still, or no inertia
@@ -218,5 +230,57 @@ impl Controls {
             }
         }
         keys_move || self.spin != Vec2::ZERO || self.velocity != Vec3::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+
+    fn rig() -> Rig {
+        let cam = Camera::look_at(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y, 0.9, 320, 240);
+        Rig::from_camera(&cam, Vec3::new(0.0, 1.0, 5.0).length(), Vec3::Y)
+    }
+
+    fn wrap(a: f32) -> f32 {
+        (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
+    }
+
+    /// One 30 px jump in a 1 ms frame, then release: the drag turns by exactly its pixels,
+    /// inertia continues in the same direction but by at most `MAX_SPIN · τ`, and nothing
+    /// without inertia.
+    #[test]
+    fn inertia_continues_a_drag_within_bounds() {
+        for inertia in [true, false] {
+            let (mut c, mut r) = (Controls::default(), rig());
+            c.inertia = inertia;
+            let (a0, _) = r.azimuth_distance();
+            c.cursor_moved(Vec2::new(100.0, 100.0));
+            c.button(MouseButton::Left, ElementState::Pressed);
+            c.cursor_moved(Vec2::new(130.0, 100.0));
+            c.update(&mut r, 0.001, (320, 240));
+            c.button(MouseButton::Left, ElementState::Released);
+            let (a1, _) = r.azimuth_distance();
+            let drag = wrap(a1 - a0);
+            assert!(
+                (drag + 30.0 * std::f32::consts::PI / 240.0).abs() < 1e-4,
+                "{drag}"
+            );
+            let mut still = true;
+            for _ in 0..300 {
+                still = !c.update(&mut r, 0.01, (320, 240));
+            }
+            let extra = wrap(r.azimuth_distance().0 - a1);
+            assert!(still, "inertia stops");
+            if inertia {
+                assert!(
+                    extra < 0.0 && -extra <= MAX_SPIN * INERTIA_TAU * 1.01,
+                    "{extra}"
+                );
+            } else {
+                assert_eq!(extra, 0.0);
+            }
+        }
     }
 }

@@ -159,7 +159,14 @@ impl Targets {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
             }
         }
-        crate::gl::check_error(gl, "drawing a viewer frame")
+        // SAFETY: glGetError has no preconditions (once per frame, after the frame's calls).
+        match unsafe { gl.get_error() } {
+            glow::NO_ERROR => Ok(()),
+            code => Err(GlError::Gl {
+                code,
+                during: "drawing a viewer frame",
+            }),
+        }
     }
 
     /// Deletes the targets (context current).
