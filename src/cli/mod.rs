@@ -4,12 +4,15 @@ use clap::{Parser, Subcommand};
 use splatgl::load::Limits;
 use std::process::ExitCode;
 
+mod camera_args;
 mod compare;
 mod conformance;
 mod convert;
 mod info;
 mod render;
 mod validate;
+#[cfg(feature = "viewer")]
+mod view;
 
 /// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
 /// INRIA PLY, Niantic SPZ, .splat, .ksplat, PlayCanvas SOG).
@@ -43,6 +46,10 @@ enum Command {
     /// Convert a splat file to glTF (.glb/.gltf, KHR_gaussian_splatting RC) or INRIA PLY.
     /// Exit status: 0, or 2 on any error.
     Convert(convert::Args),
+    /// Open a window and fly through a scene (without a scene: the bundled default scene).
+    /// H or F1 in the window prints the controls. Exit status: 0, or 2 on errors.
+    #[cfg(feature = "viewer")]
+    View(view::Args),
     /// The KHR_gaussian_splatting conformance suite: generate it, or run it on images.
     #[command(subcommand)]
     Conformance(conformance::Command),
@@ -63,9 +70,20 @@ pub struct FileArgs {
     pub load: LoadArgs,
 }
 
-/// Loader options shared by every command that reads a scene.
+/// Loader options shared by every command that reads a scene: [`LoadCommonArgs`] and
+/// `--max-splats`.
 #[derive(clap::Args, Debug, Clone, Copy)]
 pub struct LoadArgs {
+    #[command(flatten)]
+    pub common: LoadCommonArgs,
+    /// Most splats a scene may hold.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT_MAX_SPLATS)]
+    pub max_splats: u64,
+}
+
+/// The loader options but `--max-splats` (which `view` spells as its drawing budget).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct LoadCommonArgs {
     /// How glTF SCALE values are read: auto (signed types or negatives mean the review
     /// draft's log space), linear (RC) or log.
     #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
@@ -83,9 +101,6 @@ pub struct LoadArgs {
     /// symlinks pointing out). Only for files you trust.
     #[arg(long)]
     pub allow_outside_paths: bool,
-    /// Most splats a scene may hold.
-    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT_MAX_SPLATS)]
-    pub max_splats: u64,
     /// Most bytes read from files for one scene (scene file and external buffers; also
     /// cameras.json). Plain bytes or with a K, M or G suffix (powers of 1024).
     #[arg(long, value_name = "BYTES", default_value = "4G", value_parser = parse_bytes)]
@@ -109,6 +124,13 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
 impl LoadArgs {
     /// The library's options.
     pub fn options(&self) -> splatgl::load::LoadOptions {
+        self.common.options(self.max_splats)
+    }
+}
+
+impl LoadCommonArgs {
+    /// The library's options, with `max_splats` as the splat limit.
+    pub fn options(&self, max_splats: u64) -> splatgl::load::LoadOptions {
         splatgl::load::LoadOptions {
             scale_space: self.scale_space,
             spz_axes: self.spz_axes,
@@ -116,7 +138,7 @@ impl LoadArgs {
             allow_outside_paths: self.allow_outside_paths,
             resolver: None,
             limits: Limits {
-                max_splats: self.max_splats,
+                max_splats,
                 max_bytes: self.max_bytes,
                 ..Limits::default()
             },
@@ -134,5 +156,7 @@ pub fn run() -> ExitCode {
         Command::Compare(a) => compare::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Conformance(c) => conformance::run(c),
+        #[cfg(feature = "viewer")]
+        Command::View(a) => view::run(a),
     }
 }
