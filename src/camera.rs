@@ -31,7 +31,9 @@ mod frame;
 mod json;
 pub use choose::{LookAtSpec, SceneView, ViewOptions};
 pub use frame::{Extent, LookAt, UpAxis};
-pub use json::{CamerasJsonEntry, load_cameras_json, parse_cameras_json};
+pub use json::{
+    CamerasJsonEntry, load_cameras_json, load_cameras_json_limited, parse_cameras_json,
+};
 
 /// Why a camera could not be built.
 #[derive(Debug, thiserror::Error)]

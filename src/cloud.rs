@@ -15,8 +15,15 @@
 //!   degree, m = −l..+l — exactly the order of the `KHR_gaussian_splatting:SH_DEGREE_l_COEF_n`
 //!   attributes. Coefficient 0 is the DC term (`SH_DEGREE_0_COEF_0`); the colour is
 //!   `Σ SH·Y + 0.5`, clamped at 0, with the Condon–Shortley phase in the basis (see [`crate::sh`]).
+//!
+//! Loaders guarantee more than the conventions: every value finite, scales with a finite
+//! square, ‖q‖ within [`UNIT_QUAT_TOLERANCE`] of 1, opacity in `[0, 1]`.
+//! [`SplatCloud::validate`] checks exactly that.
 
 use bytemuck::{Pod, Zeroable};
+
+mod check;
+pub use check::{Field, UNIT_QUAT_TOLERANCE, Violation};
 
 /// Number of RGB coefficients per splat for SH degree `degree` (1, 4, 9, 16 for 0..=3).
 pub const fn sh_coeff_count(degree: u8) -> usize {

@@ -20,6 +20,7 @@ pub mod convert;
 // not part of the documented API (`SplatCloud::covariance` is the user-facing form).
 #[doc(hidden)]
 pub mod covariance;
+pub mod files;
 #[cfg(feature = "gl")]
 pub mod gl;
 #[cfg(feature = "gl")]

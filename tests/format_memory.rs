@@ -96,7 +96,7 @@ fn hostile_packed_files_stay_within_the_budget() {
 
     for (name, bytes, needle) in &cases {
         let peak = peak_of(bytes, name, needle);
-        let limit = budget_for(bytes.len()) as usize;
+        let limit = budget_for(bytes.len(), &Default::default()) as usize;
         eprintln!(
             "{name}: {} input bytes, peak heap {peak} bytes, budget {limit}",
             bytes.len()

@@ -18,11 +18,20 @@ use splatgl::write::{SpzWriteOptions, to_splat, to_spz_with};
 use std::io::{Read, Write};
 use std::path::Path;
 
+/// The load error in strict mode (without it, splats with unusable values are dropped: see
+/// `tests/hygiene.rs`).
 #[track_caller]
 fn err_of(bytes: &[u8], name: &str) -> String {
-    match load_bytes(bytes, Some(Path::new(name)), &LoadOptions::default()) {
+    match load_bytes(bytes, Some(Path::new(name)), &strict()) {
         Ok(l) => panic!("{name}: expected an error, loaded {} splats", l.cloud.len()),
         Err(e) => e.to_string(),
+    }
+}
+
+fn strict() -> LoadOptions {
+    LoadOptions {
+        strict: true,
+        ..LoadOptions::default()
     }
 }
 
@@ -79,7 +88,20 @@ fn malformed_ply_files_give_precise_errors() {
                 b.extend(std::iter::repeat_n(0u8, 1000));
                 b
             },
-            &["1099511627776 rows", "only 1000 bytes"],
+            &["1099511627776 splats exceed limits.max_splats"],
+        ),
+        (
+            {
+                let mut h = String::new();
+                h += "element vertex 1000000\n";
+                for p in ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"] {
+                    h += &format!("property float {p}\n");
+                }
+                let mut b = ply_header(&h);
+                b.extend(std::iter::repeat_n(0u8, 1000));
+                b
+            },
+            &["1000000 rows", "only 1000 bytes"],
         ),
         ({ let mut b = good_ply(); b.truncate(b.len() - 10); b }, &["header claims 4 rows"]),
         (
@@ -545,15 +567,24 @@ fn external_buffer_must_be_a_regular_file() {
     let bytes = gltf_with(|d, _| d["buffers"][0]["uri"] = json!("/dev/zero"));
     let p = dir.join("z.gltf");
     std::fs::write(&p, &bytes).unwrap();
+    // Outside the folder: refused by the containment rule; allowed, it is still a device.
     let e = splatgl::load::load_path(&p, &LoadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("not a regular file"), "{e}");
+    assert!(e.contains("absolute path"), "{e}");
+    let outside = LoadOptions {
+        allow_outside_paths: true,
+        ..LoadOptions::default()
+    };
+    let e = splatgl::load::load_path(&p, &outside)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("character device"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
-fn log_scale_and_node_matrix_overflows_are_errors() {
+fn log_scale_and_node_matrix_overflows_drop_the_splats() {
     let bytes = gltf_with(|d, b| {
         let a = d["meshes"][0]["primitives"][0]["attributes"]["KHR_gaussian_splatting:SCALE"]
             .as_u64()
@@ -563,11 +594,38 @@ fn log_scale_and_node_matrix_overflows_are_errors() {
         b[o..o + 4].copy_from_slice(&(-1.0f32).to_le_bytes()); // makes it log space
         b[o + 4..o + 8].copy_from_slice(&100.0f32.to_le_bytes());
     });
-    assert!(err_of(&bytes, "h.gltf").contains("overflows"));
+    // The overflowing splat is dropped and named; in strict mode the load fails.
+    let l = load_bytes(&bytes, Some(Path::new("h.gltf")), &LoadOptions::default()).unwrap();
+    assert_eq!(l.cloud.len(), 7);
+    let w = l.report.warning_lines().join("\n");
+    assert!(w.contains("SCALE\"] [index 0]: invalid per KHR_gaussian_splatting RC / glTF 2.0: exp(log-space scale) overflows f32; 1 splat dropped"), "{w}");
+    assert!(err_of(&bytes, "h.gltf").contains("overflow"));
     let huge = gltf_with(|d, _| {
         d["nodes"][0]["matrix"] = json!([1e38, 0, 0, 0, 0, 1e38, 0, 0, 0, 0, 1e38, 0, 0, 0, 0, 1])
     });
-    assert!(err_of(&huge, "h.gltf").contains("non-finite"));
+    let l = load_bytes(&huge, Some(Path::new("h.gltf")), &LoadOptions::default()).unwrap();
+    assert!(l.cloud.is_empty() && l.cloud.validate().is_ok());
+    let w = l.report.warning_lines().join("\n");
+    // Each splat goes with the first field that broke (positions of 1e38 × 5 overflow f32).
+    let dropped: usize = l
+        .report
+        .findings
+        .iter()
+        .filter(|f| f.path == "nodes[0]" && f.message.contains("under this node's transform"))
+        .map(|f| {
+            f.message
+                .split(" splat")
+                .next()
+                .unwrap()
+                .rsplit(' ')
+                .next()
+                .unwrap()
+                .parse::<usize>()
+                .unwrap()
+        })
+        .sum();
+    assert_eq!(dropped, 8, "{w}");
+    assert!(err_of(&huge, "h.gltf").contains("strict mode"));
 }
 
 #[test]
@@ -763,11 +821,15 @@ fn splat_and_ksplat_corpus() {
     b[32..36].copy_from_slice(&f32::NAN.to_le_bytes());
     let l = load_bytes(&b, Some(Path::new("a.splat")), &LoadOptions::default()).unwrap();
     assert_eq!(l.cloud.len(), 4);
+    let w = l.report.warning_lines().join("\n");
     assert!(
-        l.report
-            .warning_lines()
-            .iter()
-            .any(|w| w.contains("1 splats dropped"))
+        w.contains("records [index 1]: 1 splat dropped: position is not finite"),
+        "{w}"
+    );
+    expect(
+        &b,
+        "a.splat",
+        &["position is not finite (strict mode)", "index 1"],
     );
 
     let k = packed::ksplat(&random_cloud(300, 1, 5.0, 3), 1, 128, 25.0);
@@ -892,31 +954,165 @@ fn sog_corpus() {
 
 #[test]
 fn unbundled_sog_rejects_paths_outside_its_folder() {
-    let dir = std::env::temp_dir().join(format!("splatgl-sogbad-{}", std::process::id()));
+    let root = std::env::temp_dir().join(format!("splatgl-sogbad-{}", std::process::id()));
+    let dir = root.join("asset");
     std::fs::create_dir_all(&dir).unwrap();
     let files = packed::sog_files(&random_cloud(20, 0, 5.0, 4));
     for (n, b) in &files {
         std::fs::write(dir.join(n), b).unwrap();
+        std::fs::write(root.join(n), b).unwrap();
     }
     let meta = String::from_utf8(files.last().unwrap().1.clone()).unwrap();
-    let bad = meta.replace("\"quats.webp\"", "\"../quats.webp\"");
     let p = dir.join("meta.json");
+    let name = p.to_str().unwrap();
+    let bad = meta.replace("\"quats.webp\"", "\"../quats.webp\"");
     expect(
         bad.as_bytes(),
-        p.to_str().unwrap(),
-        &["'../quats.webp': not a plain relative file name"],
+        name,
+        &[
+            "'../quats.webp'",
+            "outside the asset's folder",
+            "--allow-outside-paths",
+        ],
     );
-    let gone = meta.replace("\"quats.webp\"", "\"nothere.webp\"");
+    let abs = root.join("quats.webp");
+    let absolute = meta.replace("\"quats.webp\"", &format!("{:?}", abs.to_str().unwrap()));
+    expect(absolute.as_bytes(), name, &["is an absolute path"]);
+    // A symlink inside the folder that points out is followed before the check.
+    std::os::unix::fs::symlink(&abs, dir.join("link.webp")).unwrap();
+    let linked = meta.replace("\"quats.webp\"", "\"link.webp\"");
     expect(
-        gone.as_bytes(),
-        p.to_str().unwrap(),
-        &["'nothere.webp' is missing"],
+        linked.as_bytes(),
+        name,
+        &["'link.webp'", "outside the asset's folder"],
     );
+    // With the opt-in all three load.
+    let outside = LoadOptions {
+        allow_outside_paths: true,
+        ..LoadOptions::default()
+    };
+    for m in [&bad, &absolute, &linked] {
+        let l = load_bytes(m.as_bytes(), Some(&p), &outside).unwrap();
+        assert_eq!(l.cloud.len(), 20);
+    }
+    let gone = meta.replace("\"quats.webp\"", "\"nothere.webp\"");
+    expect(gone.as_bytes(), name, &["'nothere.webp' is missing"]);
+    // Only regular files, within --max-bytes (all textures together).
+    let fifo = dir.join("fifo.webp");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let piped = meta.replace("\"quats.webp\"", "\"fifo.webp\"");
+    let t = std::time::Instant::now();
+    expect(piped.as_bytes(), name, &["'fifo.webp'", "FIFO"]);
+    assert!(t.elapsed().as_secs_f64() < 1.0);
+    let small = LoadOptions {
+        limits: splatgl::load::Limits {
+            max_bytes: 200,
+            ..Default::default()
+        },
+        ..LoadOptions::default()
+    };
+    let e = load_bytes(meta.as_bytes(), Some(&p), &small)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("limit of") || e.contains("max_bytes"), "{e}");
     let e = load_bytes(meta.as_bytes(), None, &LoadOptions::default())
         .unwrap_err()
         .to_string();
     assert!(e.contains("needs its path"), "{e}");
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn unbundled_sog_textures_come_from_the_resolver_when_there_is_one() {
+    let files = packed::sog_files(&random_cloud(20, 0, 5.0, 4));
+    let meta = files.last().unwrap().1.clone();
+    let served: std::collections::HashMap<String, Vec<u8>> = files.iter().cloned().collect();
+    let opts = LoadOptions {
+        resolver: Some(std::sync::Arc::new(move |name: &str| {
+            served
+                .get(name)
+                .cloned()
+                .ok_or_else(|| format!("no {name}"))
+        })),
+        ..LoadOptions::default()
+    };
+    let l = load_bytes(&meta, None, &opts).unwrap();
+    assert_eq!(l.cloud.len(), 20);
+    let other = String::from_utf8(meta)
+        .unwrap()
+        .replace("\"quats.webp\"", "\"q.webp\"");
+    let e = load_bytes(other.as_bytes(), None, &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'q.webp': resolver: no q.webp"), "{e}");
+}
+
+#[test]
+fn packed_formats_obey_max_splats_max_decompressed_bytes_and_json_depth() {
+    let c = random_cloud(50, 1, 5.0, 9);
+    let cases: Vec<(&str, Vec<u8>, bool)> = vec![
+        (
+            "a.spz",
+            to_spz_with(&c, &SpzWriteOptions::default()).unwrap(),
+            true,
+        ),
+        ("a.splat", to_splat(&c), false),
+        ("a.ksplat", packed::ksplat(&c, 1, 16, 25.0), false),
+        ("a.sog", packed::sog_bundle(&c), true),
+        ("a.glb", splatgl::write::to_glb_spz(&c).unwrap(), true),
+    ];
+    for (name, bytes, compressed) in &cases {
+        let fewer = LoadOptions {
+            limits: splatgl::load::Limits {
+                max_splats: 49,
+                ..Default::default()
+            },
+            ..LoadOptions::default()
+        };
+        let e = load_bytes(bytes, Some(Path::new(name)), &fewer)
+            .map(|l| format!("loaded {}", l.cloud.len()))
+            .unwrap_or_else(|e| e.to_string());
+        assert!(
+            e.contains("50 splats exceed limits.max_splats = 49"),
+            "{name}: {e}"
+        );
+        // The embedder's cap on decompressed bytes is the budget when it is the smaller one.
+        let tight = LoadOptions {
+            limits: splatgl::load::Limits {
+                max_decompressed_bytes: 1000,
+                ..Default::default()
+            },
+            ..LoadOptions::default()
+        };
+        let r = load_bytes(bytes, Some(Path::new(name)), &tight);
+        match (compressed, r) {
+            (true, Err(e)) => {
+                let e = e.to_string();
+                assert!(
+                    e.contains("1000") && e.contains("limits.max_decompressed_bytes"),
+                    "{name}: {e}"
+                );
+            }
+            (false, Ok(l)) => assert_eq!(l.cloud.len(), 50, "{name}"),
+            (_, r) => panic!("{name}: {:?}", r.map(|l| l.cloud.len())),
+        }
+    }
+    // SOG meta.json is depth-checked before it is parsed.
+    let deep = sog_members(&|f| {
+        let m = f.last_mut().unwrap();
+        let text = String::from_utf8(m.1.clone()).unwrap();
+        let nest = format!("{}{}", "[".repeat(100), "]".repeat(100));
+        m.1 = text
+            .replacen('{', &format!("{{\"x\":{nest},"), 1)
+            .into_bytes();
+    });
+    expect(&deep, "a.sog", &["meta.json", "max_json_depth = 64"]);
 }
 
 // ---------- glTF with SPZ compression ----------

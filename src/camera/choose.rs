@@ -5,9 +5,10 @@ use glam::Vec3;
 use std::path::PathBuf;
 
 use super::frame::UpAxis;
-use super::{Camera, CameraError, CamerasJsonEntry, GltfPerspective, load_cameras_json};
+use super::{Camera, CameraError, CamerasJsonEntry, GltfPerspective, load_cameras_json_limited};
 use crate::cloud::SplatCloud;
 use crate::load::Format;
+use crate::load::Limits;
 
 /// What a view is chosen for: the cloud, the format it was read from (`None`: the bundled
 /// default scene) and the glTF camera nodes of its file.
@@ -53,6 +54,8 @@ pub struct ViewOptions {
     pub width: Option<u32>,
     /// Image height (`--height`).
     pub height: Option<u32>,
+    /// What `cameras_json` is read under (`max_bytes`, `max_json_depth`; the scene's limits).
+    pub limits: Limits,
 }
 
 impl Default for ViewOptions {
@@ -66,6 +69,7 @@ impl Default for ViewOptions {
             up: None,
             width: None,
             height: None,
+            limits: Limits::default(),
         }
     }
 }
@@ -94,7 +98,7 @@ impl ViewOptions {
     /// The entries of `cameras_json` (empty without one).
     pub fn cameras_json_entries(&self) -> Result<Vec<CamerasJsonEntry>, CameraError> {
         match &self.cameras_json {
-            Some(path) => load_cameras_json(path),
+            Some(path) => load_cameras_json_limited(path, &self.limits),
             None => Ok(Vec::new()),
         }
     }
@@ -124,7 +128,7 @@ impl ViewOptions {
             )));
         }
         if let Some(path) = &self.cameras_json {
-            let list = load_cameras_json(path)?;
+            let list = load_cameras_json_limited(path, &self.limits)?;
             let e = list.get(self.view).ok_or_else(|| {
                 unavailable(format!(
                     "--view {}: {} has {} views",

@@ -2,6 +2,7 @@
 //! `{id, img_name, width, height, position[3], rotation[3][3], fx, fy}` with optional `cx`, `cy`.
 
 use super::CameraError;
+use crate::load::{Limits, check_json_depth};
 use serde_json::Value;
 
 /// One view of a `cameras.json`, values as written (f64).
@@ -101,8 +102,14 @@ fn entry(i: usize, v: &Value) -> Result<CamerasJsonEntry, CameraError> {
 }
 
 /// Parses the text of a `cameras.json`. Every entry must be well-formed; errors name the entry
-/// and key.
+/// and key. Nesting is bounded by the default [`Limits::max_json_depth`].
 pub fn parse_cameras_json(text: &str) -> Result<Vec<CamerasJsonEntry>, CameraError> {
+    parse_limited(text, &Limits::default())
+}
+
+fn parse_limited(text: &str, limits: &Limits) -> Result<Vec<CamerasJsonEntry>, CameraError> {
+    check_json_depth(text.as_bytes(), limits.max_json_depth)
+        .map_err(|m| invalid(String::new(), m))?;
     let v: Value = serde_json::from_str(text)?;
     let list = v
         .as_array()
@@ -110,16 +117,32 @@ pub fn parse_cameras_json(text: &str) -> Result<Vec<CamerasJsonEntry>, CameraErr
     list.iter().enumerate().map(|(i, e)| entry(i, e)).collect()
 }
 
-/// Reads and parses a `cameras.json` file.
+/// Reads and parses a `cameras.json` file with the default [`Limits`].
 pub fn load_cameras_json(
     path: impl AsRef<std::path::Path>,
 ) -> Result<Vec<CamerasJsonEntry>, CameraError> {
+    load_cameras_json_limited(path, &Limits::default())
+}
+
+/// Reads and parses a `cameras.json` file: a regular file of at most `limits.max_bytes`, nested
+/// at most `limits.max_json_depth` deep.
+pub fn load_cameras_json_limited(
+    path: impl AsRef<std::path::Path>,
+    limits: &Limits,
+) -> Result<Vec<CamerasJsonEntry>, CameraError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| CameraError::Io {
+    let io = |source| CameraError::Io {
         path: path.to_owned(),
         source,
+    };
+    let bytes = crate::files::read_bounded(path, limits.max_bytes, "cameras.json").map_err(io)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        io(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("cameras.json is not UTF-8 ({e})"),
+        ))
     })?;
-    parse_cameras_json(&text)
+    parse_limited(&text, limits)
 }
 
 impl super::Camera {

@@ -104,6 +104,7 @@ impl CameraArgs {
             },
             width: self.width,
             height: self.height,
+            limits: Default::default(),
         })
     }
 }

@@ -37,6 +37,8 @@ fn go(a: &Args) -> Result<bool, String> {
     let ib = Image::read(&a.b).map_err(|e| e.to_string())?;
     let c = compare(&ia, &ib, a.threshold).map_err(|e| e.to_string())?;
     if let Some(path) = &a.diff {
+        splatgl::write::refuse_overwriting_inputs(path, &[&a.a, &a.b])
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         let d = diff_image(&ia, &ib, a.diff_scale).map_err(|e| e.to_string())?;
         d.write_png(path, PngDepth::Eight, false)
             .map_err(|e| e.to_string())?;

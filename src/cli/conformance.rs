@@ -51,13 +51,16 @@ pub struct RunArgs {
     pub out: Option<PathBuf>,
 }
 
-fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+/// Writes an output atomically (temporary file renamed into place), never over `inputs`.
+fn write(path: &Path, inputs: &[&Path], bytes: &[u8]) -> Result<(), String> {
+    splatgl::write::write_bytes_atomic(path, inputs, bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// Runs the comparison; `Err` = unusable input (exit 2).
 fn run_cmd(a: &RunArgs) -> Result<bool, String> {
     let m = Manifest::read(&a.dir)?;
+    let manifest = a.dir.join("manifest.json");
     let out = a.out.clone().unwrap_or_else(|| a.dir.join("report"));
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let (results, source) = if let Some(images) = &a.images {
@@ -83,7 +86,12 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
             let p = out.join("images").join(format!("{name}.{ext}"));
             std::fs::create_dir_all(p.parent().expect("has a parent"))
                 .map_err(|e| format!("{}: {e}", p.display()))?;
-            write(&p, &bytes.map_err(|e| e.to_string())?)?;
+            let reference = a.dir.join("reference").join(format!("{name}.{ext}"));
+            write(
+                &p,
+                &[&manifest, &reference],
+                &bytes.map_err(|e| e.to_string())?,
+            )?;
         }
         let r = runner::run(&a.dir, &m, |c| imgs.get(&c.image).cloned().map(Ok))?;
         let name = match backend {
@@ -95,10 +103,12 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
     let json = report::to_json(&results, &source);
     write(
         &out.join("report.json"),
+        &[&manifest],
         &serde_json::to_vec_pretty(&json).unwrap_or_default(),
     )?;
     write(
         &out.join("report.html"),
+        &[&manifest],
         report::to_html(&results, &source).as_bytes(),
     )?;
     let s = report::summary(&results);

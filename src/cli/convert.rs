@@ -162,16 +162,27 @@ fn rotate(cloud: SplatCloud, o: &ConvertOptions, p: &Progress) -> Result<SplatCl
     Ok(out)
 }
 
-/// Writes the file (refusing to replace one without --force). The one place output is
-/// written, so a safer write (temp file + rename) can replace it alone.
-fn write_output(path: &Path, bytes: &[u8], force: bool) -> Result<(), String> {
+/// Refuses an output that exists without --force, and one that is the input (same file by
+/// any name) even with it.
+fn check_output(path: &Path, input: &Path, force: bool) -> Result<(), String> {
+    splatgl::write::refuse_overwriting_inputs(path, &[input])
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     if !force && path.exists() {
         return Err(format!(
             "{} exists; pass -f/--force to overwrite it",
             path.display()
         ));
     }
-    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+    Ok(())
+}
+
+/// Writes the file: checked again ([`check_output`]), then written atomically (a temporary
+/// file in the same folder renamed into place, so a failed or interrupted write leaves the
+/// previous file as it was).
+fn write_output(path: &Path, input: &Path, bytes: &[u8], force: bool) -> Result<(), String> {
+    check_output(path, input, force)?;
+    splatgl::write::write_bytes_atomic(path, &[input], bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn go(a: &Args) -> Result<(), String> {
@@ -194,12 +205,7 @@ fn go(a: &Args) -> Result<(), String> {
     if a.spz_version.is_some() && format != OutputFormat::Spz {
         return Err("--spz-version applies to .spz outputs only".into());
     }
-    if !a.force && a.output.exists() {
-        return Err(format!(
-            "{} exists; pass -f/--force to overwrite it",
-            a.output.display()
-        ));
-    }
+    check_output(&a.output, &a.input, a.force)?;
     let scene = splatgl::load::load_path(&a.input, &a.load.options()).map_err(|e| e.to_string())?;
     for w in scene.report.summarized_warnings() {
         eprintln!("warning: {w}");
@@ -221,7 +227,7 @@ fn go(a: &Args) -> Result<(), String> {
     for n in notes {
         eprintln!("note: {n}");
     }
-    write_output(&a.output, &bytes, a.force)?;
+    write_output(&a.output, &a.input, &bytes, a.force)?;
     eprintln!(
         "splatgl convert: {} splats, SH degree {} -> {} ({} bytes) in {:.1} s",
         cloud.len(),

@@ -7,7 +7,7 @@ pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, c
     kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
     non_unit_quaternions, memory_bytes, warnings; for quantized containers also container, \
     container_version, compression, gltf_extension, quantization[{attribute, bits, encoding}], \
-    lossy, antialiased — null otherwise)";
+    lossy, antialiased — null otherwise; with -v also limits)";
 
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
 pub fn run(a: super::FileArgs) -> ExitCode {
@@ -42,6 +42,14 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     if let Some(obj) = info.as_object_mut() {
         obj.extend(splatgl::load::Details::json_keys(details));
     }
+    let limits = opts.limits.entries();
+    if a.verbose {
+        let map: serde_json::Map<_, _> = limits
+            .iter()
+            .map(|&(k, v)| (k.to_owned(), serde_json::json!(v)))
+            .collect();
+        info["limits"] = serde_json::Value::Object(map);
+    }
     if a.json {
         println!("{info:#}");
         return ExitCode::SUCCESS;
@@ -69,6 +77,12 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     );
     if let Some(d) = details {
         print_details(d);
+    }
+    if a.verbose {
+        println!("limits:");
+        for (k, v) in limits {
+            println!("  {k:<24}{v}");
+        }
     }
     for w in r.summarized_warnings() {
         println!("warning: {w}");

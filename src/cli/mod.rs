@@ -1,6 +1,7 @@
 //! Command-line interface: one file per subcommand.
 
 use clap::{Parser, Subcommand};
+use splatgl::load::Limits;
 use std::process::ExitCode;
 
 mod camera_args;
@@ -34,6 +35,7 @@ enum Command {
     #[command(mut_arg("file", |a| a.help(
         "The file to check (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json)"
     )))]
+    #[command(mut_arg("verbose", |a| a.hide(true)))]
     Validate(FileArgs),
     /// Render an image (without a scene: the bundled default scene).
     /// Exit status: 0, or 2 on any error (message on stderr).
@@ -61,13 +63,27 @@ pub struct FileArgs {
     /// Print JSON (each command lists its keys).
     #[arg(long)]
     pub json: bool,
+    /// Also print the loader's limits (`limits` in JSON).
+    #[arg(short, long)]
+    pub verbose: bool,
     #[command(flatten)]
     pub load: LoadArgs,
 }
 
-/// Loader options shared by every command that reads a scene.
+/// Loader options shared by every command that reads a scene: [`LoadCommonArgs`] and
+/// `--max-splats`.
 #[derive(clap::Args, Debug, Clone, Copy)]
 pub struct LoadArgs {
+    #[command(flatten)]
+    pub common: LoadCommonArgs,
+    /// Most splats a scene may hold.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT_MAX_SPLATS)]
+    pub max_splats: u64,
+}
+
+/// The loader options but `--max-splats` (which `view` spells as its drawing budget).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct LoadCommonArgs {
     /// How glTF SCALE values are read: auto (signed types or negatives mean the review
     /// draft's log space), linear (RC) or log.
     #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
@@ -78,14 +94,54 @@ pub struct LoadArgs {
     /// else rub for KHR_gaussian_splatting_compression_spz_2 and raw for the legacy extension).
     #[arg(long, default_value = "auto", value_name = "auto|rub|raw")]
     pub spz_axes: splatgl::load::spz::SpzAxes,
+    /// Fail on a splat with a non-finite or overflowing value instead of dropping it.
+    #[arg(long)]
+    pub strict: bool,
+    /// Let external glTF buffers lie outside the asset's folder (absolute paths, `..`,
+    /// symlinks pointing out). Only for files you trust.
+    #[arg(long)]
+    pub allow_outside_paths: bool,
+    /// Most bytes read from files for one scene (scene file and external buffers; also
+    /// cameras.json). Plain bytes or with a K, M or G suffix (powers of 1024).
+    #[arg(long, value_name = "BYTES", default_value = "4G", value_parser = parse_bytes)]
+    pub max_bytes: u64,
+}
+
+/// `123`, `64K`, `512M`, `4G` (binary multiples).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let (num, shift) = match s.char_indices().last() {
+        Some((i, 'k' | 'K')) => (&s[..i], 10),
+        Some((i, 'm' | 'M')) => (&s[..i], 20),
+        Some((i, 'g' | 'G')) => (&s[..i], 30),
+        _ => (s, 0),
+    };
+    num.parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1 << shift))
+        .ok_or_else(|| format!("expected a byte count like 1048576, 64K, 512M or 4G, found {s:?}"))
 }
 
 impl LoadArgs {
     /// The library's options.
     pub fn options(&self) -> splatgl::load::LoadOptions {
+        self.common.options(self.max_splats)
+    }
+}
+
+impl LoadCommonArgs {
+    /// The library's options, with `max_splats` as the splat limit.
+    pub fn options(&self, max_splats: u64) -> splatgl::load::LoadOptions {
         splatgl::load::LoadOptions {
             scale_space: self.scale_space,
             spz_axes: self.spz_axes,
+            strict: self.strict,
+            allow_outside_paths: self.allow_outside_paths,
+            resolver: None,
+            limits: Limits {
+                max_splats,
+                max_bytes: self.max_bytes,
+                ..Limits::default()
+            },
         }
     }
 }

@@ -80,7 +80,10 @@ pub struct Args {
 /// The view (see [`splatgl::camera::ViewOptions::camera`]) and the distance to print its
 /// target at.
 fn camera(a: &Args, scene: SceneView<'_>) -> Result<(Camera, f32), String> {
-    let opts = a.cam.options()?;
+    let opts = splatgl::camera::ViewOptions {
+        limits: a.load.options().limits,
+        ..a.cam.options()?
+    };
     let cam = opts.camera(scene, (640, 480)).map_err(|e| e.to_string())?;
     Ok((cam, opts.focus_distance(&cam, scene.cloud)))
 }
@@ -113,8 +116,30 @@ fn write(img: &Image, a: &Args) -> Result<(), String> {
     r.map_err(|e| e.to_string())
 }
 
+/// Refuses outputs that would replace an input (the scene or the cameras.json), before any
+/// work is done.
+fn check_outputs(a: &Args) -> Result<(), String> {
+    let inputs: Vec<&Path> = a
+        .scene
+        .iter()
+        .chain(&a.cam.camera)
+        .map(PathBuf::as_path)
+        .collect();
+    let alpha = a.output.with_extension("alpha.pfm");
+    let mut outputs = vec![a.output.as_path()];
+    if a.alpha {
+        outputs.push(&alpha);
+    }
+    for out in outputs {
+        splatgl::write::refuse_overwriting_inputs(out, &inputs)
+            .map_err(|e| format!("{}: {e}", out.display()))?;
+    }
+    Ok(())
+}
+
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
+    check_outputs(a)?;
     let (cloud, format, cameras) = match &a.scene {
         Some(p) => {
             let s = load(p, a.load.options())?;

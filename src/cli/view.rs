@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use super::camera_args::{CameraArgs, floats};
 use super::render::TargetArg;
+use splatgl::camera::ViewOptions;
 
 /// `--stale-bound`.
 fn stale_bound(s: &str) -> Result<splatgl::viewer::StaleBound, String> {
@@ -47,7 +48,8 @@ pub struct Args {
     #[arg(long, default_value = "1", value_parser = scale, value_name = "S")]
     pub resolution_scale: f32,
     /// Draw at most N splats: those with the largest opacity × (two largest scales), in
-    /// file order (deterministic).
+    /// file order (deterministic). Files may hold up to max(N, 33,554,432) splats (the
+    /// loader's limit, which `info`, `render` and `convert` set with their --max-splats).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub max_splats: Option<u64>,
     /// Every frame waits for the sort of its own camera (screenshots, tests).
@@ -79,15 +81,22 @@ pub struct Args {
     #[arg(long, hide = true, value_name = "FILE")]
     pub test_drop: Option<PathBuf>,
     #[command(flatten)]
-    pub load: super::LoadArgs,
+    pub load: super::LoadCommonArgs,
 }
 
 fn go(a: Args) -> Result<(), String> {
     let bg = floats(&a.background, "--background", &[3])?;
+    let default = splatgl::load::Limits::DEFAULT_MAX_SPLATS;
+    let load = a
+        .load
+        .options(a.max_splats.map_or(default, |n| n.max(default)));
     let opts = splatgl::viewer::ViewerOptions {
         file: a.scene,
-        view: a.cam.options()?,
-        load: a.load.options(),
+        view: ViewOptions {
+            limits: load.limits,
+            ..a.cam.options()?
+        },
+        load,
         fullscreen: a.fullscreen,
         vsync: !a.no_vsync,
         resolution_scale: a.resolution_scale,

@@ -34,6 +34,8 @@ pub enum GenerateError {
     },
 }
 
+/// Writes one file of the suite atomically (`write::write_bytes_atomic`: a failed or
+/// interrupted write leaves the previous suite's file as it was).
 fn write(path: &Path, bytes: &[u8]) -> Result<(), GenerateError> {
     let io = |source| GenerateError::Io {
         path: path.to_owned(),
@@ -42,7 +44,7 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), GenerateError> {
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(io)?;
     }
-    std::fs::write(path, bytes).map_err(io)
+    crate::write::write_bytes_atomic(path, &[], bytes).map_err(io)
 }
 
 /// Camera axes (right, up, back) of a look-at in glTF's convention (looking down −Z).

@@ -196,11 +196,24 @@ impl Manifest {
         })
     }
 
-    /// Reads `DIR/manifest.json`.
+    /// Reads `DIR/manifest.json`: a regular file within the default `max_bytes`, nested at
+    /// most `max_json_depth` deep (like every file splatgl reads).
     pub fn read(dir: &std::path::Path) -> Result<Manifest, String> {
         let p = dir.join("manifest.json");
-        let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-        let v: Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))?;
+        let limits = crate::load::Limits::default();
+        let err = |e: &dyn std::fmt::Display| format!("{}: {e}", p.display());
+        let text = crate::files::read_bounded(&p, limits.max_bytes, "the manifest")
+            .map_err(|e| err(&e))?;
+        crate::load::check_json_depth(&text, limits.max_json_depth).map_err(|e| err(&e))?;
+        let v: Value = serde_json::from_slice(&text).map_err(|e| err(&e))?;
         Manifest::from_json(&v)
     }
+}
+
+/// A file the manifest names (`file`, `reference_pfm`, `bound_pfm`, an `image` under
+/// `--images`), resolved inside `dir` by the containment rule every document's files follow
+/// (`..`, absolute paths and symlinks out of the folder are refused; the file must exist).
+pub fn suite_path(dir: &std::path::Path, rel: &str) -> Result<std::path::PathBuf, String> {
+    crate::files::contained_path(dir, std::path::Path::new(rel), false)
+        .map_err(|e| format!("{rel}: {e}"))
 }

@@ -19,7 +19,8 @@ pub enum Backend {
 /// One asset loaded with its cameras at the manifest's image sizes.
 pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<Camera>), String> {
     let a = &m.assets[asset];
-    let scene = load_path(dir.join(&a.file), &LoadOptions::default()).map_err(|e| e.to_string())?;
+    let file = super::manifest::suite_path(dir, &a.file)?;
+    let scene = load_path(file, &LoadOptions::default()).map_err(|e| e.to_string())?;
     let cams = a
         .cameras
         .iter()

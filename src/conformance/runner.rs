@@ -2,7 +2,7 @@
 //! naming the likely cause of known failure patterns.
 
 use super::generate::{clamped, fails, measure};
-use super::manifest::{AssetEntry, CameraEntry, Manifest};
+use super::manifest::{AssetEntry, CameraEntry, Manifest, suite_path};
 use super::{Erratum, model, render};
 use crate::compare::{Comparison, compare};
 use crate::image::Image;
@@ -57,11 +57,12 @@ impl AssetResult {
     }
 }
 
-/// Where another renderer's image for `c` is: `IMAGES/ASSET/CAMERA.pfm`, else `.png`.
+/// Where another renderer's image for `c` is: `IMAGES/ASSET/CAMERA.pfm`, else `.png` (inside
+/// `images`: see [`suite_path`]).
 pub fn find_image(images: &Path, c: &CameraEntry) -> Option<std::path::PathBuf> {
     ["pfm", "png"]
         .iter()
-        .map(|e| images.join(format!("{}.{e}", c.image)))
+        .filter_map(|e| suite_path(images, &format!("{}.{e}", c.image)).ok())
         .find(|p| p.is_file())
 }
 
@@ -141,9 +142,10 @@ pub fn run(
         let mut cams = Vec::new();
         let mut missing = 0;
         for (ci, c) in a.cameras.iter().enumerate() {
-            let want = Image::read(dir.join(&c.reference_pfm)).map_err(|e| e.to_string())?;
+            let want =
+                Image::read(suite_path(dir, &c.reference_pfm)?).map_err(|e| e.to_string())?;
             let want = clamped(&want);
-            let bound: Vec<f64> = Image::read(dir.join(&c.bound_pfm))
+            let bound: Vec<f64> = Image::read(suite_path(dir, &c.bound_pfm)?)
                 .map_err(|e| e.to_string())?
                 .pixels
                 .iter()

@@ -6,6 +6,7 @@
 //! depths are expanded) and both PFM endiannesses; images without alpha read as A = 1.
 
 use super::Image;
+use crate::write::write_bytes_atomic;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -232,10 +233,18 @@ impl Image {
         })
     }
 
-    /// Reads a PNG or PFM file (by magic bytes).
+    /// Reads a PNG or PFM file (by magic bytes): a regular file of at most
+    /// [`Limits::DEFAULT_MAX_BYTES`](crate::load::Limits::DEFAULT_MAX_BYTES).
     pub fn read(path: impl AsRef<Path>) -> Result<Image, ImageError> {
+        Image::read_limited(path, crate::load::Limits::DEFAULT_MAX_BYTES)
+    }
+
+    /// Reads a PNG or PFM file (by magic bytes): a regular file of at most `max_bytes`
+    /// (checked before reading; FIFOs, devices and directories are errors at once).
+    pub fn read_limited(path: impl AsRef<Path>, max_bytes: u64) -> Result<Image, ImageError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(io_err(path))?;
+        let bytes =
+            crate::files::read_bounded(path, max_bytes, "the image").map_err(io_err(path))?;
         if bytes.starts_with(b"\x89PNG") {
             Image::decode_png(&bytes)
         } else if bytes.starts_with(b"PF") || bytes.starts_with(b"Pf") {
@@ -245,7 +254,8 @@ impl Image {
         }
     }
 
-    /// Writes a PNG file.
+    /// Writes a PNG file (atomically: a failed write keeps the previous file, see
+    /// [`crate::write::write_atomic`]).
     pub fn write_png(
         &self,
         path: impl AsRef<Path>,
@@ -253,19 +263,20 @@ impl Image {
         alpha: bool,
     ) -> Result<(), ImageError> {
         let path = path.as_ref();
-        std::fs::write(path, self.encode_png(depth, alpha)?).map_err(io_err(path))
+        let bytes = self.encode_png(depth, alpha)?;
+        write_bytes_atomic(path, &[], &bytes).map_err(io_err(path))
     }
 
-    /// Writes the RGB channels to a PFM file.
+    /// Writes the RGB channels to a PFM file (atomically).
     pub fn write_pfm(&self, path: impl AsRef<Path>) -> Result<(), ImageError> {
         let path = path.as_ref();
-        std::fs::write(path, self.encode_pfm()).map_err(io_err(path))
+        write_bytes_atomic(path, &[], &self.encode_pfm()).map_err(io_err(path))
     }
 
-    /// Writes the alpha channel to a grey PFM file.
+    /// Writes the alpha channel to a grey PFM file (atomically).
     pub fn write_pfm_alpha(&self, path: impl AsRef<Path>) -> Result<(), ImageError> {
         let path = path.as_ref();
-        std::fs::write(path, self.encode_pfm_alpha()).map_err(io_err(path))
+        write_bytes_atomic(path, &[], &self.encode_pfm_alpha()).map_err(io_err(path))
     }
 }
 

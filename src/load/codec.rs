@@ -2,12 +2,17 @@
 //! bounded gzip / raw-deflate / zstd decoding, half floats, the SH sign table for axis flips,
 //! the parallel cloud builder and the pass that drops splats a renderer cannot use.
 //!
-//! **Budget rule** (one for every compressed format): for a file of `L` bytes, the data it
-//! decompresses or decodes to plus the cloud built from it take at most [`BUDGET_BASE`] +
-//! [`BUDGET_PER_INPUT_BYTE`] × `L` bytes (16 MiB + 64 × L). Sizes claimed by headers are checked
-//! against it before anything is allocated, and decompression stops as soon as it would pass
-//! it, so a gzip bomb or a header that lies about its count costs at most that much memory.
+//! **Budget rule** (one for every compressed format): for an input of `L` bytes, the data it
+//! decompresses or decodes to plus the cloud built from it take at most the smaller of
+//! [`BUDGET_BASE`] + [`BUDGET_PER_INPUT_BYTE`] × `L` bytes (16 MiB + 64 × L) and
+//! [`Limits::max_decompressed_bytes`] (4 GiB by default, the embedder's cap) — [`budget_for`].
+//! Sizes claimed by headers are checked against it (and splat counts against
+//! [`Limits::max_splats`]) before anything is allocated, and decompression stops as soon as it
+//! would pass it, so a gzip bomb or a header that lies about its count costs at most that much
+//! memory. The input is the file (SPZ, SOG bundle), the meta.json and textures of an unbundled
+//! SOG together, or one glTF SPZ payload.
 
+use super::{Finding, Limits, Severity};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 use rayon::prelude::*;
 use std::io::Read;
@@ -16,17 +21,24 @@ use std::io::Read;
 pub const BUDGET_BASE: u64 = 16 << 20;
 /// Budget granted per input byte.
 pub const BUDGET_PER_INPUT_BYTE: u64 = 64;
+/// How [`budget_for`] is computed, for error messages.
+pub const BUDGET_RULE: &str =
+    "the smaller of 16 MiB + 64 × input size and limits.max_decompressed_bytes";
 
-/// The decompression budget for an input of `input_len` bytes.
-pub fn budget_for(input_len: usize) -> u64 {
-    BUDGET_BASE + BUDGET_PER_INPUT_BYTE * input_len as u64
+/// The decompression budget for an input of `input_len` bytes under `limits` (module docs):
+/// `min(16 MiB + 64 × input_len, limits.max_decompressed_bytes)`.
+pub fn budget_for(input_len: usize, limits: &Limits) -> u64 {
+    BUDGET_BASE
+        .saturating_add(BUDGET_PER_INPUT_BYTE.saturating_mul(input_len as u64))
+        .min(limits.max_decompressed_bytes)
 }
 
-/// Bytes a cloud of `n` splats of SH degree `degree` takes while being built (its arrays and
-/// the per-splat flags of [`finish_cloud`]); loaders charge it to the budget with the
-/// decompressed data before allocating.
+/// Bytes a cloud of `n` splats of SH degree `degree` takes while being built: its arrays, and
+/// at most 24 more per splat for the numeric hygiene pass that drops bad splats (the list of
+/// bad ones, 16 bytes each, then their indices, 8 each, or the kept splats' original indices,
+/// 4 each); loaders charge it to the budget with the decompressed data before allocating.
 pub fn cloud_bytes(n: u64, degree: u8) -> u64 {
-    n.saturating_mul(12 + 12 + 16 + 4 + 1 + 12 * sh_coeff_count(degree) as u64)
+    n.saturating_mul(12 + 12 + 16 + 4 + 24 + 12 * sh_coeff_count(degree) as u64)
 }
 
 /// Why a bounded decompression failed.
@@ -36,7 +48,7 @@ pub enum InflateError {
     #[error("{0}")]
     Corrupt(String),
     /// It would decompress to more than the budget allows.
-    #[error("decompresses to more than the budget of {limit} bytes (16 MiB + 64 × input size)")]
+    #[error("decompresses to more than the budget of {limit} bytes ({BUDGET_RULE})")]
     OverBudget {
         /// The limit that was hit.
         limit: u64,
@@ -191,7 +203,7 @@ pub struct SplatMut<'a> {
     pub position: &'a mut [f32; 3],
     /// Linear scale.
     pub scale: &'a mut [f32; 3],
-    /// Quaternion `[x, y, z, w]` (normalised later by [`finish_cloud`]).
+    /// Quaternion `[x, y, z, w]` (normalised when the reader finishes the cloud).
     pub rotation: &'a mut [f32; 4],
     /// Linear opacity.
     pub opacity: &'a mut f32,
@@ -236,51 +248,37 @@ pub fn build_cloud<E: Send>(
     Ok(c)
 }
 
-/// Normalises every quaternion and drops the splats a renderer cannot use: any non-finite
-/// value, a negative scale, an opacity outside [0, 1] or a zero quaternion. Returns how many
-/// were dropped and the first such index (in the input order).
-pub fn finish_cloud(c: &mut SplatCloud) -> (usize, Option<usize>) {
-    let k = c.coeffs_per_splat();
-    let ok: Vec<bool> = (0..c.len())
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|i| {
-            let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
-            finite(&c.positions[i])
-                && finite(&c.scales[i])
-                && c.scales[i].iter().all(|s| *s >= 0.0)
-                && (0.0..=1.0).contains(&c.opacities[i])
-                && c.sh[i * k..(i + 1) * k].iter().all(|t| finite(t))
-                && super::normalize_quat(c.rotations[i]).is_some()
-        })
-        .collect();
+/// Normalises every quaternion (zero and non-finite ones are left as they are) and, when
+/// `drop_at` names a finding path, drops the splats that break the loader contract through the
+/// numeric hygiene pass (`hygiene.rs`: any non-finite value, a negative scale or one whose
+/// square overflows, an opacity outside [0, 1], a zero quaternion), with a warning per field
+/// naming the count and the first index. With `None` the bad splats stay for the caller's pass:
+/// in strict mode (the load fails naming the splat) and inside glTF (the primitive's pass names
+/// the JSON path).
+pub(crate) fn finish_cloud(c: &mut SplatCloud, drop_at: Option<&str>, findings: &mut Vec<Finding>) {
     c.rotations.par_iter_mut().for_each(|q| {
         if let Some((n, _)) = super::normalize_quat(*q) {
             *q = n;
         }
     });
-    let dropped = ok.iter().filter(|b| !**b).count();
-    if dropped == 0 {
-        return (0, None);
-    }
-    let first = ok.iter().position(|b| !*b);
-    let mut j = 0;
-    for (i, &keep) in ok.iter().enumerate() {
-        if keep {
-            c.positions[j] = c.positions[i];
-            c.scales[j] = c.scales[i];
-            c.rotations[j] = c.rotations[i];
-            c.opacities[j] = c.opacities[i];
-            c.sh.copy_within(i * k..(i + 1) * k, j * k);
-            j += 1;
-        }
-    }
-    c.positions.truncate(j);
-    c.scales.truncate(j);
-    c.rotations.truncate(j);
-    c.opacities.truncate(j);
-    c.sh.truncate(j * k);
-    (dropped, first)
+    let Some(path) = drop_at else {
+        return;
+    };
+    let site = super::hygiene::Site {
+        path,
+        what: "",
+        severity: Severity::Warning,
+        strict: false,
+        origin: None,
+    };
+    // Not strict: the pass drops and reports, it never fails.
+    super::hygiene::clean(c, &site, findings).ok();
+}
+
+/// Where a packed reader's [`finish_cloud`] drops bad splats: at `path`, unless the load is
+/// strict (then the exit pass of `load::read` fails on the first one).
+pub(crate) fn drop_site<'a>(path: &'a str, opts: &super::LoadOptions) -> Option<&'a str> {
+    (!opts.strict).then_some(path)
 }
 
 /// Little-endian readers over a byte slice whose bounds the caller has checked.

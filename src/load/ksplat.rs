@@ -14,7 +14,7 @@
 //! f16 / u8 in [min, max] for levels 0 / 1 / 2. PLY axes.
 
 use super::codec::{self, build_cloud, f16_to_f32, finish_cloud};
-use super::{Details, Finding, LoadReport, ScaleSeen};
+use super::{Details, Finding, LimitExceeded, LoadOptions, LoadReport, ScaleSeen};
 use crate::cloud::SplatCloud;
 
 /// Size of the main header.
@@ -56,6 +56,9 @@ pub enum KsplatError {
         /// What, with expected vs found.
         message: String,
     },
+    /// The splat count exceeds [`crate::load::Limits::max_splats`].
+    #[error(transparent)]
+    Limit(#[from] LimitExceeded),
 }
 
 /// One section, resolved.
@@ -208,7 +211,11 @@ impl Section {
 }
 
 /// Reads a `.ksplat` file from memory into `report` (findings, details, linear scales).
-pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, KsplatError> {
+pub(crate) fn read(
+    bytes: &[u8],
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<SplatCloud, KsplatError> {
     let findings = &mut report.findings;
     let (secs, end) = sections(bytes)?;
     let level = codec::u16_at(bytes, 20);
@@ -222,6 +229,7 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
         ));
     }
     let n: usize = secs.iter().map(|s| s.count).sum();
+    opts.limits.check_splats(n as u64, "the sections")?;
     let stated = codec::u32_at(bytes, 16) as usize;
     if stated != n {
         findings.push(Finding::warning(
@@ -287,16 +295,7 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
         Ok(())
     });
     let Ok(mut cloud) = cloud;
-    let (dropped, first) = finish_cloud(&mut cloud);
-    if let Some(i) = first {
-        findings.push(
-            Finding::warning(
-                "splats",
-                format!("{dropped} splats with unusable values dropped"),
-            )
-            .at(i as u64),
-        );
-    }
+    finish_cloud(&mut cloud, codec::drop_site("splats", opts), findings);
     if secs.iter().any(|s| s.degree < degree) {
         findings.push(Finding::warning(
             "sections",

@@ -9,14 +9,22 @@
 //!
 //! Every failure is a [`LoadError`] naming the file, the element, the index and what was
 //! expected. No input panics, and sizes claimed by headers are checked against the bytes that
-//! are really there before anything is allocated.
+//! are really there, and against [`Limits`], before anything is allocated.
+//!
+//! Files are read only when they are regular files within [`Limits::max_bytes`]
+//! ([`crate::files`]); external glTF buffers only inside the asset's folder (unless
+//! [`LoadOptions::allow_outside_paths`]) or through [`LoadOptions::resolver`]. No splat with a
+//! non-finite or overflowing value leaves a loader (`hygiene.rs`): such splats are dropped with
+//! a finding, or fail the load in [`LoadOptions::strict`] mode.
 
 pub mod codec;
 mod details;
 mod finding;
 mod format;
 pub mod gltf;
+pub(crate) mod hygiene;
 pub mod ksplat;
+mod limits;
 pub mod ply;
 mod report;
 pub mod sog;
@@ -27,11 +35,13 @@ pub mod validate;
 pub use details::{AttributeBits, Details};
 pub use finding::{Finding, Severity};
 pub use format::{Format, detect_format};
+pub use limits::{LimitExceeded, Limits, check_json_depth};
 pub use report::{LoadReport, ScaleSeen};
 
 use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// How `KHR_gaussian_splatting:SCALE` values are to be read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -58,13 +68,44 @@ impl std::str::FromStr for ScaleSpace {
     }
 }
 
+/// Serves the bytes of an external glTF buffer named by its URI (as written in the file, not
+/// percent-decoded), like the `gltf` crate's data-source closure. An `Err` message becomes the
+/// finding of that buffer.
+pub type Resolver = Arc<dyn Fn(&str) -> Result<Vec<u8>, String> + Send + Sync>;
+
 /// Options for all loaders.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Clone, Default)]
 pub struct LoadOptions {
     /// How glTF SCALE values are read (PLY scales are always log, as INRIA writes them).
     pub scale_space: ScaleSpace,
     /// Which axes SPZ payloads are taken to be in (files and glTF SPZ compression).
     pub spz_axes: spz::SpzAxes,
+    /// A splat with a non-finite or overflowing value fails the load (a [`LoadError`] naming
+    /// the field, the element and the index) instead of being dropped with a warning.
+    pub strict: bool,
+    /// Let external buffer URIs leave the asset's folder (absolute paths, `..`, symlinks
+    /// pointing outside). Off by default: a file from the internet must not make splatgl read
+    /// the rest of the disk.
+    pub allow_outside_paths: bool,
+    /// Serves external (non-`data:`) glTF buffers instead of the file system; with it, no file
+    /// is opened for buffers and `load_bytes` needs no path. The embedder's resolver is its own
+    /// policy: the containment rule does not apply to it, the byte limits do.
+    pub resolver: Option<Resolver>,
+    /// Resource limits.
+    pub limits: Limits,
+}
+
+impl std::fmt::Debug for LoadOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LoadOptions")
+            .field("scale_space", &self.scale_space)
+            .field("spz_axes", &self.spz_axes)
+            .field("strict", &self.strict)
+            .field("allow_outside_paths", &self.allow_outside_paths)
+            .field("resolver", &self.resolver.as_ref().map(|_| "Fn(&str)"))
+            .field("limits", &self.limits)
+            .finish()
+    }
 }
 
 /// A loaded file: the splats, the cameras it defines, and what the loader noticed.
@@ -113,6 +154,22 @@ pub enum LoadError {
         /// What.
         source: gltf::GltfError,
     },
+    /// A [`Limits`] bound was exceeded.
+    #[error("{path}: {source}")]
+    Limit {
+        /// The file.
+        path: PathBuf,
+        /// Which limit, by how much.
+        source: LimitExceeded,
+    },
+    /// In strict mode: a splat with a non-finite or overflowing value.
+    #[error("{path}: {finding}")]
+    Unusable {
+        /// The file.
+        path: PathBuf,
+        /// Where, which field, which index.
+        finding: Finding,
+    },
     /// An SPZ problem.
     #[error("{path}: SPZ: {source}")]
     Spz {
@@ -150,15 +207,24 @@ pub enum LoadError {
 /// Loads a file of any supported format.
 pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, LoadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let bytes = read_scene_file(path, opts)?;
     load_bytes(&bytes, Some(path), opts)
 }
 
+/// Reads a scene file: a regular file within `limits.max_bytes`.
+pub(crate) fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<Vec<u8>, LoadError> {
+    crate::files::read_bounded(path, opts.limits.max_bytes, "the scene file").map_err(|source| {
+        LoadError::Io {
+            path: path.to_owned(),
+            source,
+        }
+    })
+}
+
 /// Loads from memory. `path` names the file in errors, helps detect the format, and resolves
-/// external glTF buffers (without it, only GLB and data-URI buffers can be read).
+/// external glTF buffers (without it, only GLB and data-URI buffers can be read, or those
+/// [`LoadOptions::resolver`] serves). External buffers read from files count against
+/// `limits.max_bytes`; `bytes` themselves do not.
 pub fn load_bytes(
     bytes: &[u8],
     path: Option<&Path>,
@@ -195,6 +261,10 @@ pub(crate) enum ReadError {
     #[error(transparent)]
     Gltf(#[from] gltf::GltfError),
     #[error(transparent)]
+    Limit(#[from] LimitExceeded),
+    #[error("{0}")]
+    Unusable(Finding),
+    #[error(transparent)]
     Spz(#[from] spz::SpzError),
     #[error(transparent)]
     Splat(#[from] splat::SplatError),
@@ -207,8 +277,15 @@ pub(crate) enum ReadError {
 impl ReadError {
     fn at(self, path: PathBuf) -> LoadError {
         match self {
+            ReadError::Ply(ply::PlyError::Limit(source))
+            | ReadError::Spz(spz::SpzError::Limit(source))
+            | ReadError::Splat(splat::SplatError::Limit(source))
+            | ReadError::Ksplat(ksplat::KsplatError::Limit(source))
+            | ReadError::Sog(sog::SogError::Limit(source))
+            | ReadError::Limit(source) => LoadError::Limit { path, source },
             ReadError::Ply(source) => LoadError::Ply { path, source },
             ReadError::Gltf(source) => LoadError::Gltf { path, source },
+            ReadError::Unusable(finding) => LoadError::Unusable { path, finding },
             ReadError::Spz(source) => LoadError::Spz { path, source },
             ReadError::Splat(source) => LoadError::Splat { path, source },
             ReadError::Ksplat(source) => LoadError::Ksplat { path, source },
@@ -220,6 +297,8 @@ impl ReadError {
         match self {
             ReadError::Ply(e) => matches!(e, ply::PlyError::Header { .. }),
             ReadError::Gltf(e) => matches!(e, gltf::GltfError::Container(_)),
+            // A limit or a strict-mode splat: the file was read, its data is refused.
+            ReadError::Limit(_) | ReadError::Unusable(_) => false,
             // The packed formats have no structure to report findings on once they fail.
             _ => true,
         }
@@ -230,7 +309,9 @@ impl ReadError {
 /// quaternions) and returns the cloud and the cameras the file defines.
 ///
 /// A new format is a [`Format`] variant (with its magic bytes and extensions), a reader here,
-/// and a [`ReadError`] / [`LoadError`] variant for the reader's error type.
+/// and a [`ReadError`] / [`LoadError`] variant for the reader's error type. Readers check
+/// `opts.limits` before allocating (`check_splats`, `check_decompressed`); the splat limit and
+/// the numeric hygiene pass below apply to every format whatever its reader does.
 pub(crate) fn read(
     format: Format,
     bytes: &[u8],
@@ -238,14 +319,37 @@ pub(crate) fn read(
     opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Result<(SplatCloud, Vec<GltfPerspective>), ReadError> {
-    Ok(match format {
-        Format::Ply => (ply::read(bytes, report)?, Vec::new()),
+    let (mut cloud, cameras) = match format {
+        Format::Ply => (ply::read(bytes, opts, report)?, Vec::new()),
         Format::Gltf | Format::Glb => gltf::read(bytes, format, path, opts, report)?,
-        Format::Spz => (spz::read(bytes, opts.spz_axes, report)?, Vec::new()),
-        Format::Splat => (splat::read(bytes, report)?, Vec::new()),
-        Format::Ksplat => (ksplat::read(bytes, report)?, Vec::new()),
-        Format::Sog => (sog::read(bytes, path, report)?, Vec::new()),
-    })
+        Format::Spz => (spz::read(bytes, opts, report)?, Vec::new()),
+        Format::Splat => (splat::read(bytes, opts, report)?, Vec::new()),
+        Format::Ksplat => (ksplat::read(bytes, opts, report)?, Vec::new()),
+        Format::Sog => (sog::read(bytes, path, opts, report)?, Vec::new()),
+    };
+    finish(&mut cloud, opts, report)?;
+    Ok((cloud, cameras))
+}
+
+/// The checks at the exit of every reader: the splat limit, and the numeric hygiene pass (bad
+/// splats dropped with a warning, or in strict mode the first one is the error).
+pub(crate) fn finish(
+    cloud: &mut SplatCloud,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<(), ReadError> {
+    opts.limits
+        .check_splats(cloud.len() as u64, "the loaded cloud")?;
+    let site = hygiene::Site {
+        path: "",
+        what: "",
+        severity: Severity::Warning,
+        strict: opts.strict,
+        origin: None,
+    };
+    hygiene::clean(cloud, &site, &mut report.findings).map_err(ReadError::Unusable)?;
+    debug_assert!(cloud.validate().is_ok(), "{:?}", cloud.validate());
+    Ok(())
 }
 
 /// A quaternion whose norm is 1 within this (4 f32 ulps at 1) is kept as stored: renormalising

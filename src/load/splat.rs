@@ -3,7 +3,7 @@
 //! in the order w, x, y, z, each `(b − 128)/128`. Little endian, PLY axes, no SH.
 
 use super::codec::{self, build_cloud, finish_cloud};
-use super::{Details, Finding, LoadReport, ScaleSeen};
+use super::{Details, LimitExceeded, LoadOptions, LoadReport, ScaleSeen};
 use crate::cloud::SplatCloud;
 use crate::sh::dc_from_color;
 
@@ -25,6 +25,9 @@ pub enum SplatError {
         /// Bytes of the partial record.
         rest: usize,
     },
+    /// The record count exceeds [`crate::load::Limits::max_splats`].
+    #[error(transparent)]
+    Limit(#[from] LimitExceeded),
 }
 
 /// Whether `bytes` is plausibly a `.splat` file (for content detection when nothing else
@@ -45,7 +48,11 @@ pub(crate) fn looks_like(bytes: &[u8]) -> bool {
 }
 
 /// Reads a `.splat` file from memory into `report` (findings, details, linear scales).
-pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, SplatError> {
+pub(crate) fn read(
+    bytes: &[u8],
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<SplatCloud, SplatError> {
     if !bytes.len().is_multiple_of(RECORD) {
         return Err(SplatError::Truncated {
             len: bytes.len(),
@@ -54,6 +61,7 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
         });
     }
     let n = bytes.len() / RECORD;
+    opts.limits.check_splats(n as u64, "records")?;
     let cloud = build_cloud::<std::convert::Infallible>(n, 0, |i, s| {
         let r = &bytes[i * RECORD..(i + 1) * RECORD];
         *s.position = std::array::from_fn(|a| codec::f32_at(r, 4 * a));
@@ -65,18 +73,11 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
         Ok(())
     });
     let Ok(mut cloud) = cloud;
-    let (dropped, first) = finish_cloud(&mut cloud);
-    if let Some(i) = first {
-        report.findings.push(
-            Finding::warning(
-                "records",
-                format!(
-                    "{dropped} splats dropped: non-finite or negative scale or position, or a zero quaternion"
-                ),
-            )
-            .at(i as u64),
-        );
-    }
+    finish_cloud(
+        &mut cloud,
+        codec::drop_site("records", opts),
+        &mut report.findings,
+    );
     let mut d = Details::new("splat", "none");
     d.bits("position", 32, "f32");
     d.bits("scale", 32, "f32, linear");

@@ -78,9 +78,9 @@ impl Report {
     }
 }
 
-/// Validates a file on disk.
+/// Validates a file on disk (a regular file within `limits.max_bytes`, like `load_path`).
 pub fn validate_path(path: &Path, opts: &LoadOptions) -> Report {
-    match std::fs::read(path) {
+    match crate::files::read_bounded(path, opts.limits.max_bytes, "the file") {
         Ok(bytes) => validate_bytes(&bytes, Some(path), opts),
         Err(e) => Report {
             format: None,

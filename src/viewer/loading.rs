@@ -102,7 +102,7 @@ fn load(
     let (cloud, format, cameras, warnings) = match &path {
         None => (crate::scene::default_scene(), None, Vec::new(), Vec::new()),
         Some(p) => {
-            let bytes = read_with_progress(id, p, send)?;
+            let bytes = read_with_progress(id, p, opts.limits.max_bytes, send)?;
             send(LoadEvent::Decoding { id });
             let scene = load_bytes(&bytes, Some(p), opts).map_err(|e| e.to_string())?;
             let warnings = scene.report.summarized_warnings();
@@ -135,13 +135,28 @@ fn load(
     }))
 }
 
-/// Reads a file in 1 MiB chunks, reporting progress at most every 100 ms.
-fn read_with_progress(id: u64, p: &Path, send: &impl Fn(LoadEvent)) -> Result<Vec<u8>, String> {
+/// Reads a file in 1 MiB chunks, reporting progress at most every 100 ms: a regular file of at
+/// most `max_bytes` (`files::open_regular`: FIFOs, devices and directories fail at once; the
+/// size is checked before reading, and again while reading).
+fn read_with_progress(
+    id: u64,
+    p: &Path,
+    max_bytes: u64,
+    send: &impl Fn(LoadEvent),
+) -> Result<Vec<u8>, String> {
     let err = |e: std::io::Error| format!("{}: {e}", p.display());
-    let mut f = std::fs::File::open(p).map_err(err)?;
-    let total = f.metadata().map_err(err)?.len();
-    // The size is a hint only (special files report 0); the vector grows as needed.
-    let mut bytes = Vec::with_capacity(total.min(1 << 32) as usize);
+    let (f, total) = crate::files::open_regular(p, "the scene file").map_err(err)?;
+    let too_large = |size: u64| {
+        format!(
+            "{}: the scene file is {size} bytes, more than the limit of {max_bytes} bytes (limits.max_bytes, --max-bytes)",
+            p.display()
+        )
+    };
+    if total > max_bytes {
+        return Err(too_large(total));
+    }
+    let mut f = f.take(max_bytes.saturating_add(1));
+    let mut bytes = Vec::with_capacity(total as usize);
     let mut chunk = vec![0u8; 1 << 20];
     let mut last = Instant::now();
     loop {
@@ -152,6 +167,9 @@ fn read_with_progress(id: u64, p: &Path, send: &impl Fn(LoadEvent)) -> Result<Ve
             Err(e) => return Err(err(e)),
         };
         bytes.extend_from_slice(&chunk[..n]);
+        if bytes.len() as u64 > max_bytes {
+            return Err(too_large(bytes.len() as u64));
+        }
         if last.elapsed() >= Duration::from_millis(100) {
             last = Instant::now();
             let done = bytes.len() as u64;
@@ -163,4 +181,33 @@ fn read_with_progress(id: u64, p: &Path, send: &impl Fn(LoadEvent)) -> Result<Ve
         }
     }
     Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn special_files_and_oversized_files_fail_at_once() {
+        let quiet = |_: LoadEvent| {};
+        let t0 = Instant::now();
+        let e = read_with_progress(0, Path::new("/dev/zero"), 1 << 30, &quiet).unwrap_err();
+        assert!(e.contains("character device"), "{e}");
+        let d = std::env::temp_dir().join(format!("splatgl-viewer-load-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let e = read_with_progress(0, &d, 1 << 30, &quiet).unwrap_err();
+        assert!(e.contains("directory"), "{e}");
+        let fifo = d.join("fifo.ply");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let e = read_with_progress(0, &fifo, 1 << 30, &quiet).unwrap_err();
+        assert!(e.contains("FIFO"), "{e}");
+        assert!(t0.elapsed() < Duration::from_secs(1));
+        let f = d.join("s.ply");
+        std::fs::write(&f, [0u8; 100]).unwrap();
+        assert_eq!(read_with_progress(0, &f, 100, &quiet).unwrap().len(), 100);
+        let e = read_with_progress(0, &f, 99, &quiet).unwrap_err();
+        assert!(e.contains("more than the limit of 99 bytes"), "{e}");
+        std::fs::remove_dir_all(&d).ok();
+    }
 }

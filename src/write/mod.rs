@@ -10,11 +10,16 @@
 //! OPACITY as a sparse accessor, so the tests can round-trip every decoding path of the loader;
 //! those two options are hidden from these docs. [`scene`] writes documents with several
 //! nodes, meshes, primitives and cameras (the conformance suite's assets).
+//!
+//! Every file splatgl writes goes through [`write_atomic`]: a temporary file in the same
+//! folder, renamed into place when complete, so a failed write never loses the previous file.
 
+mod atomic;
 mod comp;
 mod ply;
 pub mod quantize;
 pub mod scene;
+pub use atomic::{refuse_overwriting_inputs, write_atomic, write_bytes_atomic};
 pub use comp::Comp;
 pub use ply::to_inria_ply;
 mod glb_spz;
@@ -339,4 +344,33 @@ pub(crate) fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&bin);
     out
+}
+
+/// Saves `cloud` by the extension of `path`: `.ply` (INRIA binary), `.glb`, or `.gltf` (one
+/// embedded data-URI buffer), with default [`GltfWriteOptions`]. The file is written atomically
+/// ([`write_atomic`]); `inputs` are files it must not replace.
+pub fn save(
+    cloud: &SplatCloud,
+    path: &std::path::Path,
+    inputs: &[&std::path::Path],
+) -> std::io::Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let bytes = match ext.as_deref() {
+        Some("ply") => to_inria_ply(cloud),
+        Some("glb") => to_glb(cloud, &GltfWriteOptions::default()),
+        Some("gltf") => to_gltf(cloud, &GltfWriteOptions::default()),
+        _ => {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "{}: expected a .ply, .glb or .gltf file name",
+                    path.display()
+                ),
+            ));
+        }
+    };
+    write_bytes_atomic(path, inputs, &bytes)
 }

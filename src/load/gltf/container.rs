@@ -1,10 +1,9 @@
 //! Container level: GLB / JSON, the `KHR_gaussian_splatting:*` semantic work-around for the
-//! `gltf` crate, schema validation, and buffer resolution (GLB BIN, data URIs, files).
+//! `gltf` crate, schema validation; buffers are resolved by `buffers.rs` beside this file.
 
 use super::GltfError;
-use crate::load::Format;
 use crate::load::finding::Finding;
-use base64::Engine;
+use crate::load::{Format, LoadOptions, check_json_depth};
 use gltf::json::validation::Validate;
 use serde_json::Value;
 use std::path::Path;
@@ -46,6 +45,7 @@ pub fn parse(
     bytes: &[u8],
     format: Format,
     path: Option<&Path>,
+    opts: &LoadOptions,
     findings: &mut Vec<Finding>,
 ) -> Result<Parsed, GltfError> {
     let (json_bytes, bin): (&[u8], Option<Vec<u8>>) = match format {
@@ -55,6 +55,7 @@ pub fn parse(
         }
         _ => (bytes, None),
     };
+    check_json_depth(json_bytes, opts.limits.max_json_depth).map_err(container)?;
     let json: Value =
         serde_json::from_slice(json_bytes).map_err(|e| container(format!("JSON: {e}")))?;
     if !json.is_object() {
@@ -72,7 +73,8 @@ pub fn parse(
         return Ok(parsed);
     };
     let doc = gltf::Document::from_json_without_validation(root);
-    (parsed.buffers, parsed.external_bytes) = resolve_buffers(&doc, bin, path, findings);
+    (parsed.buffers, parsed.external_bytes) =
+        super::buffers::resolve(&doc, bin, path, opts, findings);
     parsed.doc = Some(doc);
     Ok(parsed)
 }
@@ -315,107 +317,6 @@ fn node_graph_problem(root: &gltf::json::Root) -> Option<Finding> {
         }
     }
     None
-}
-
-fn resolve_buffers(
-    doc: &gltf::Document,
-    mut bin: Option<Vec<u8>>,
-    path: Option<&Path>,
-    findings: &mut Vec<Finding>,
-) -> (Vec<Vec<u8>>, u64) {
-    let mut out = Vec::new();
-    let mut external = 0u64;
-    for buf in doc.buffers() {
-        let jp = format!("buffers[{}]", buf.index());
-        let data = match buf.source() {
-            gltf::buffer::Source::Bin => match bin.take() {
-                Some(b) => Ok(b),
-                None => Err("refers to the GLB BIN chunk, which is missing (or used twice)".into()),
-            },
-            gltf::buffer::Source::Uri(uri) => {
-                let r = read_uri(uri, path, buf.length());
-                if let (Ok(d), false) = (&r, uri.starts_with("data:")) {
-                    external += d.len() as u64;
-                }
-                r
-            }
-        };
-        match data {
-            Ok(d) if d.len() < buf.length() => {
-                findings.push(Finding::fatal(
-                    jp,
-                    format!(
-                        "byteLength is {} but only {} bytes are present",
-                        buf.length(),
-                        d.len()
-                    ),
-                ));
-                out.push(Vec::new());
-            }
-            Ok(mut d) => {
-                d.truncate(buf.length());
-                out.push(d);
-            }
-            Err(msg) => {
-                findings.push(Finding::fatal(jp, msg));
-                out.push(Vec::new());
-            }
-        }
-    }
-    (out, external)
-}
-
-/// Reads a buffer URI: a base64 data URI, or a relative file read up to `len` bytes (a regular
-/// file only, so `/dev/zero` or a FIFO cannot make the read endless).
-fn read_uri(uri: &str, path: Option<&Path>, len: usize) -> Result<Vec<u8>, String> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let (_, payload) = rest
-            .split_once(";base64,")
-            .ok_or("data URI is not base64 (expected 'data:...;base64,')")?;
-        return base64::engine::general_purpose::STANDARD
-            .decode(payload)
-            .map_err(|e| format!("data URI: invalid base64 ({e})"));
-    }
-    if uri.contains("://") {
-        return Err(format!(
-            "URI {uri:?}: only relative file paths and data URIs are read"
-        ));
-    }
-    let base = path
-        .and_then(Path::parent)
-        .ok_or_else(|| format!("external buffer {uri:?} needs the glTF file's path"))?;
-    let file = base.join(percent_decode(uri));
-    let err = |e: std::io::Error| format!("external buffer {}: {e}", file.display());
-    let f = std::fs::File::open(&file).map_err(err)?;
-    if !f.metadata().map_err(err)?.is_file() {
-        return Err(format!(
-            "external buffer {}: not a regular file",
-            file.display()
-        ));
-    }
-    let mut data = Vec::new();
-    std::io::Read::read_to_end(&mut std::io::Read::take(f, len as u64), &mut data).map_err(err)?;
-    Ok(data)
-}
-
-fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let hex = |c: u8| (c as char).to_digit(16).map(|d| d as u8);
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%'
-            && i + 2 < b.len()
-            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
-        {
-            out.push(h * 16 + l);
-            i += 3;
-            continue;
-        }
-        out.push(b[i]);
-        i += 1;
-    }
-    String::from_utf8_lossy(&out).into_owned()
 }
 
 /// Whether the primitive a path like `meshes[0].primitives[1]...` points into carries the

@@ -15,6 +15,7 @@
 //! them all, the loader stops at the first one that makes the data unusable.
 
 mod accessor;
+mod buffers;
 mod container;
 mod meta;
 mod primitive;
@@ -24,10 +25,11 @@ mod transform;
 
 /// Applies a node's global matrix to a local-space cloud exactly as the loader does
 /// (positions, Σ = M C Cᵀ Mᵀ, SH rotated by the polar factor); findings name `nodes[node]`;
-/// `None` after a blocking finding.
-pub use transform::apply as apply_node_transform;
+/// `None` when a value becomes non-finite or overflows (a blocking finding names the first
+/// splat: what the loader would drop, or refuse in strict mode).
+pub use transform::apply_checked as apply_node_transform;
 
-use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen};
+use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen, Severity, hygiene};
 use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
 use container::{EXT, Parsed};
@@ -88,7 +90,7 @@ pub(crate) fn walk(
     opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Result<Walk, GltfError> {
-    let parsed = container::parse(bytes, format, path, &mut report.findings)?;
+    let parsed = container::parse(bytes, format, path, opts, &mut report.findings)?;
     let mut w = Walk {
         cloud: None,
         cameras: Vec::new(),
@@ -99,15 +101,16 @@ pub(crate) fn walk(
     };
     uses_extension_check(&parsed.json, &mut report.findings);
     // Everything decoded or instantiated is charged to one budget of f32 values, bounded by the
-    // input: 16M values (64 MiB) plus 4 values per input byte (file and external buffers).
+    // input: `limits.decode_budget_values` plus `decode_values_per_byte` per input byte (file
+    // and external buffers).
     let input: u64 = parsed.input_len as u64 + parsed.external_bytes;
-    let budget = Cell::new((16u64 << 20) + 4 * input);
+    let budget = Cell::new(opts.limits.decode_budget(input));
     let Some(decoded) = decode_primitives(&parsed, doc, opts, &budget, &mut report.findings) else {
         return Ok(w);
     };
     let nodes = scene_nodes(doc, &parsed.json, &mut report.findings);
     w.cameras = cameras(&nodes, &parsed.json, &mut report.findings);
-    w.cloud = instantiate(&nodes, &parsed.json, &decoded, &budget, input, report);
+    w.cloud = instantiate(&nodes, &parsed.json, &decoded, &budget, input, opts, report);
     Ok(w)
 }
 
@@ -177,6 +180,7 @@ fn decode_primitives(
                 buffers: &parsed.buffers,
                 path: ppath,
                 scale_space: opts.scale_space,
+                opts,
                 spz_axes: opts.spz_axes,
                 budget,
                 quantization: used.contains(&"KHR_mesh_quantization"),
@@ -193,15 +197,18 @@ fn decode_primitives(
 }
 
 /// Pass 2: the decoded primitives instantiated through the scene's node hierarchy and merged
-/// into one global cloud. `None` without instances, or after a blocking finding.
+/// into one global cloud, each instance cleaned after its transform (numeric hygiene). `None`
+/// without instances, or after a blocking finding.
 fn instantiate(
     nodes: &[(gltf::Node, DMat4)],
     json: &Value,
     decoded: &Decoded,
     budget: &Cell<u64>,
     input: u64,
+    opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Option<SplatCloud> {
+    let mut total = 0u64;
     let meshes = array(json, "meshes");
     let mut cloud: Option<SplatCloud> = None;
     for (node, m) in nodes {
@@ -219,16 +226,37 @@ fn instantiate(
             let per_splat = 11 + 3 * ls.cloud.coeffs_per_splat() as u64;
             let values = ls.cloud.len() as u64 * per_splat;
             if values > budget.get() {
+                let l = &opts.limits;
                 report.findings.push(Finding::fatal(
                     format!("nodes[{node}]"),
                     format!(
-                        "instancing meshes[{mesh}] here would exceed the output this {input}-byte input can justify (16M + 4 values per input byte)"
+                        "instancing meshes[{mesh}] here would exceed the output this {input}-byte input can justify (limits: {} + {} values per input byte)",
+                        l.decode_budget_values, l.decode_values_per_byte
                     ),
                 ));
                 return None;
             }
             budget.set(budget.get() - values);
-            let global = transform::apply(&ls.cloud, *m, node, &mut report.findings)?;
+            total += ls.cloud.len() as u64;
+            if let Err(e) = opts.limits.check_splats(total, "the scene's instances") {
+                report
+                    .findings
+                    .push(Finding::fatal(format!("nodes[{node}]"), e.to_string()));
+                return None;
+            }
+            let mut global = transform::apply(&ls.cloud, *m, node, &mut report.findings);
+            let ppath = format!("meshes[{mesh}].primitives[{pi}]");
+            let site = hygiene::Site {
+                path: &format!("nodes[{node}]"),
+                what: &format!("{ppath} under this node's transform"),
+                severity: Severity::Error,
+                strict: opts.strict,
+                origin: ls.origin.as_deref(),
+            };
+            if let Err(f) = hygiene::clean(&mut global, &site, &mut report.findings) {
+                report.findings.push(f);
+                return None;
+            }
             report.scale_space = Some(ScaleSeen::merge(report.scale_space, ls.scale_seen));
             report.non_unit_quaternions += ls.non_unit;
             if report.details.is_none() {
@@ -238,7 +266,6 @@ fn instantiate(
                 cloud = Some(global);
                 continue;
             };
-            let ppath = format!("meshes[{mesh}].primitives[{pi}]");
             if c.meta != global.meta {
                 report.findings.push(Finding::warning(
                     &ppath,
@@ -362,6 +389,18 @@ fn cameras(
             continue;
         }
         if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+            let values = [p.yfov(), p.znear(), p.aspect_ratio().unwrap_or(1.0)];
+            let far_ok = p.zfar().is_none_or(f32::is_finite);
+            if !(values.iter().all(|v| v.is_finite()) && far_ok && m.as_mat4().is_finite()) {
+                findings.push(Finding::warning(
+                    format!("nodes[{}]", node.index()),
+                    format!(
+                        "cameras[{}] has a non-finite value or global transform; camera skipped",
+                        cam.index()
+                    ),
+                ));
+                continue;
+            }
             out.push(GltfPerspective {
                 yfov: p.yfov(),
                 aspect_ratio: p.aspect_ratio(),

@@ -6,7 +6,7 @@ use super::container::PREFIX;
 use super::rules;
 use crate::cloud::{ColorSpace, SplatCloud, SplatMeta};
 use crate::load::spz::SpzAxes;
-use crate::load::{Details, Finding, ScaleSeen, ScaleSpace};
+use crate::load::{Details, Finding, LoadOptions, ScaleSeen, ScaleSpace, Severity, hygiene};
 use gltf::accessor::DataType;
 use serde_json::{Map, Value};
 
@@ -19,6 +19,8 @@ pub struct LocalSplats {
     pub scale_seen: ScaleSeen,
     /// Quaternions that were not unit within tolerance.
     pub non_unit: usize,
+    /// Accessor index of each splat, when the hygiene pass dropped some.
+    pub origin: Option<Vec<u32>>,
     /// Container facts of a compressed primitive (SPZ), `None` for plain accessors.
     pub details: Option<Details>,
 }
@@ -33,6 +35,8 @@ pub struct Ctx<'a> {
     pub path: String,
     /// How SCALE values are read.
     pub scale_space: ScaleSpace,
+    /// All options (limits, strict mode).
+    pub opts: &'a LoadOptions,
     /// Axes of SPZ payloads (compressed primitives).
     pub spz_axes: SpzAxes,
     /// Whether `KHR_mesh_quantization` is in `extensionsUsed` (quantized POSITION allowed).
@@ -53,17 +57,33 @@ pub fn read(
     f: &mut Vec<Finding>,
 ) -> Option<LocalSplats> {
     check_primitive(&ctx.path, prim, f);
-    if let Some((kind, ext, ext_path)) = super::spz::compression(prim, &ctx.path) {
+    let mut ls = if let Some((kind, ext, ext_path)) = super::spz::compression(prim, &ctx.path) {
         let mut ls = super::spz::read(ctx, prim, kind, ext, &ext_path, f)?;
         ls.cloud.meta = meta.clone();
-        return Some(ls);
+        ls
+    } else {
+        let attrs = fetch(ctx, prim, f)?;
+        rules::check_types_and_counts(ctx, &attrs, f)?;
+        let degree = rules::sh_degree(&ctx.path, &attrs.higher, f);
+        let log = rules::scale_space(ctx, &attrs.scale, f)?;
+        rules::check_opacity(&ctx.path, &attrs.opacity, f)?;
+        assemble(ctx, &attrs, meta, degree, log, f)
+    };
+    let site = hygiene::Site {
+        path: &ctx.path,
+        what: "",
+        severity: Severity::Error,
+        strict: ctx.opts.strict,
+        origin: None,
+    };
+    match hygiene::clean(&mut ls.cloud, &site, f) {
+        Ok(origin) => ls.origin = origin,
+        Err(e) => {
+            f.push(e);
+            return None;
+        }
     }
-    let attrs = fetch(ctx, prim, f)?;
-    rules::check_types_and_counts(ctx, &attrs, f)?;
-    let degree = rules::sh_degree(&ctx.path, &attrs.higher, f);
-    let log = rules::scale_space(ctx, &attrs.scale, f)?;
-    rules::check_opacity(&ctx.path, &attrs.opacity, f)?;
-    assemble(ctx, &attrs, meta, degree, log, f)
+    Some(ls)
 }
 
 /// The attribute semantic as written in the file.
@@ -199,8 +219,39 @@ fn fetch(ctx: &Ctx, prim: &Value, f: &mut Vec<Finding>) -> Option<Attributes> {
     })
 }
 
+/// Counts splats with one problem and remembers the first.
+#[derive(Default)]
+struct Tally {
+    count: usize,
+    first: Option<usize>,
+}
+
+impl Tally {
+    fn add(&mut self, i: usize) {
+        self.count += 1;
+        self.first.get_or_insert(i);
+    }
+    /// An error at `path` and the first index, its message made from the count (blocking
+    /// when `strict`).
+    fn report(
+        &self,
+        path: &str,
+        msg: impl Fn(usize) -> String,
+        strict: bool,
+        f: &mut Vec<Finding>,
+    ) {
+        if let Some(i) = self.first {
+            let mut e = Finding::error(path, msg(self.count));
+            e.blocks_loading = strict;
+            f.push(e.at(i as u64));
+        }
+    }
+}
+
 /// Builds the local cloud: quaternions normalised (unit within a tolerance that allows for the
-/// quantization step, the others counted), scales linearised, SH gathered splat by splat.
+/// quantization step, the others counted), scales linearised, opacity rounding clamped, SH
+/// gathered splat by splat. Unusable values (zero quaternions, non-finite values, log scales
+/// whose `exp` overflows) are reported and stay in the cloud for the hygiene pass to drop.
 fn assemble(
     ctx: &Ctx,
     a: &Attributes,
@@ -208,7 +259,7 @@ fn assemble(
     degree: u8,
     log: bool,
     f: &mut Vec<Finding>,
-) -> Option<LocalSplats> {
+) -> LocalSplats {
     let n = a.position.count();
     let tol = match a.rotation.component {
         DataType::I8 => 1e-2,
@@ -218,37 +269,38 @@ fn assemble(
     let scale_path = attr_path(&ctx.path, &semantic("SCALE"));
     let mut cloud = SplatCloud::with_capacity(degree, n);
     let k = cloud.coeffs_per_splat();
-    let mut non_unit = 0;
-    let mut first_non_unit = None;
+    let (mut non_unit, mut zero, mut overflow) =
+        (Tally::default(), Tally::default(), Tally::default());
     let mut sh = vec![[0.0f32; 3]; k];
     cloud.meta = meta.clone();
     let srgb = cloud.meta.color_space.effective() == ColorSpace::SrgbRec709Display;
     for i in 0..n {
         let q: [f32; 4] = a.rotation.get(i);
         let norm = q.iter().map(|v| (*v as f64).powi(2)).sum::<f64>().sqrt();
-        if norm < 1e-12 {
-            f.push(Finding::fatal(&rot_path, "quaternion is zero").at(i as u64));
-            return None;
-        }
-        if (norm - 1.0).abs() > tol {
-            non_unit += 1;
-            first_non_unit.get_or_insert(i);
-        }
-        let q = if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
-            q // unit to f32 rounding: kept bit for bit
+        let q = if norm < 1e-12 {
+            zero.add(i);
+            q // not unit: dropped by the hygiene pass
         } else {
-            q.map(|v| (v as f64 / norm) as f32)
+            if (norm - 1.0).abs() > tol {
+                non_unit.add(i);
+            }
+            if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
+                q // unit to f32 rounding: kept bit for bit
+            } else {
+                q.map(|v| (v as f64 / norm) as f32)
+            }
         };
         let s: [f32; 3] = a.scale.get(i);
         let s = if log {
-            s.map(f32::exp)
+            let e = s.map(f32::exp);
+            if s.iter().all(|v| v.is_finite()) && !e.iter().all(|v| v.is_finite()) {
+                overflow.add(i);
+            }
+            e
         } else {
-            s.map(|v| v.max(0.0))
+            // -0 → 0; NaN stays NaN (f32::max would turn it into 0).
+            s.map(|v| if v.is_nan() { v } else { v.max(0.0) })
         };
-        if !s.iter().all(|v| v.is_finite()) {
-            f.push(Finding::fatal(&scale_path, "exp(log-space scale) overflows f32").at(i as u64));
-            return None;
-        }
         sh[0] = match (&a.sh0, &a.color0) {
             (Some(d), _) => d.get(i),
             (None, Some(c)) => dc_from_color0(c.get::<3>(i), srgb),
@@ -261,34 +313,45 @@ fn assemble(
                 }
             }
         }
-        cloud.push(a.position.get(i), s, q, a.opacity.data[i], &sh);
+        // Opacity is within 1e-6 of [0, 1] here (rules::check_opacity); NaN stays NaN.
+        let o = a.opacity.data[i].clamp(0.0, 1.0);
+        cloud.push(a.position.get(i), s, q, o, &sh);
     }
-    if let Some(i) = first_non_unit {
-        f.push(
-            Finding::error(
-                &rot_path,
-                format!("{non_unit} quaternions are not unit length (tolerance {tol}); normalised"),
-            )
-            .at(i as u64),
-        );
-    }
+    let strict = ctx.opts.strict;
+    let unit = |n| format!("{n} quaternions are not unit length (tolerance {tol}); normalised");
+    non_unit.report(&rot_path, unit, false, f);
+    let then = |n: usize| match (strict, n) {
+        (true, _) => "strict mode".to_owned(),
+        (false, 1) => "1 splat dropped".to_owned(),
+        (false, n) => format!("{n} splats dropped"),
+    };
+    let zero_msg = |n| format!("quaternion is zero; {}", then(n));
+    zero.report(&rot_path, zero_msg, strict, f);
+    let overflow_msg = |n| format!("exp(log-space scale) overflows f32; {}", then(n));
+    overflow.report(&scale_path, overflow_msg, strict, f);
     let scale_seen = if log {
         ScaleSeen::Log
     } else {
         ScaleSeen::Linear
     };
-    Some(LocalSplats {
+    LocalSplats {
         cloud,
         scale_seen,
-        non_unit,
+        non_unit: non_unit.count,
+        origin: None,
         details: None,
-    })
+    }
 }
 
 /// Inverts the RC's COLOR_0 fallback: COLOR_0 = clamp(SH0·Y₀₀ + 0.5) (sRGB-decoded to linear
 /// when the colour space is sRGB), so SH0 = (c − 0.5) / Y₀₀ with c re-encoded where needed.
+/// A non-finite component gives NaN, never a clamped colour (`f32::clamp` would pass NaN on and
+/// turn ±inf into 1 or 0): the rules report it and the hygiene pass drops the splat.
 fn dc_from_color0(c: [f32; 3], srgb: bool) -> [f32; 3] {
     c.map(|v| {
+        if !v.is_finite() {
+            return f32::NAN;
+        }
         let v = v.clamp(0.0, 1.0) as f64;
         let v = if srgb {
             crate::profile::srgb_encode(v)

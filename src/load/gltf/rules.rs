@@ -59,6 +59,14 @@ pub(super) fn check_types_and_counts(
     } else {
         &[(DataType::F32, false)]
     };
+    if let Err(e) = ctx
+        .opts
+        .limits
+        .check_splats(n as u64, &attr_path(path, "POSITION"))
+    {
+        f.push(Finding::fatal(attr_path(path, "POSITION"), e.to_string()));
+        return None;
+    }
     let mut typed: Vec<Check> = vec![(attr_path(path, "POSITION"), &a.position, 3, position_types)];
     for (name, d) in [
         ("ROTATION", &a.rotation),
@@ -117,21 +125,47 @@ pub(super) fn check_types_and_counts(
         if let Some(m) = &d.misaligned {
             f.push(Finding::error(p.clone(), format!("glTF 2.0 layout: {m}")));
         }
-        if let Some(i) = d.data.iter().position(|v| !v.is_finite()) {
-            f.push(Finding::fatal(p.clone(), "value is not finite").at((i / d.dims) as u64));
+        non_finite(p, d, ctx.opts.strict, f);
+    }
+    if let Some(c) = &a.color0 {
+        if c.count() != n || !(c.dims == 3 || c.dims == 4) {
+            f.push(Finding::fatal(
+                attr_path(path, "COLOR_0"),
+                "COLOR_0 must be VEC3/VEC4 with POSITION's count",
+            ));
             blocked = true;
+        } else {
+            non_finite(&attr_path(path, "COLOR_0"), c, ctx.opts.strict, f);
         }
     }
-    if let Some(c) = &a.color0
-        && (c.count() != n || !(c.dims == 3 || c.dims == 4))
-    {
-        f.push(Finding::fatal(
-            attr_path(path, "COLOR_0"),
-            "COLOR_0 must be VEC3/VEC4 with POSITION's count",
-        ));
-        blocked = true;
-    }
     (!blocked).then_some(())
+}
+
+/// glTF 2.0: accessor values MUST be finite. An error at the first offending element with the
+/// count; the splats stay for the hygiene pass to drop. In strict mode the error is blocking.
+fn non_finite(path: &str, d: &Decoded, strict: bool, f: &mut Vec<Finding>) {
+    let mut bad = d
+        .data
+        .chunks_exact(d.dims.max(1))
+        .enumerate()
+        .filter(|(_, e)| !e.iter().all(|v| v.is_finite()))
+        .map(|(i, _)| i);
+    let Some(first) = bad.next() else {
+        return;
+    };
+    let n = 1 + bad.count();
+    let s = if n == 1 { "" } else { "s" };
+    let then = if strict {
+        "strict mode"
+    } else {
+        "those splats are dropped"
+    };
+    let mut finding = Finding::error(
+        path,
+        format!("value is not finite in {n} element{s} (glTF 2.0: MUST be finite); {then}"),
+    );
+    finding.blocks_loading = strict;
+    f.push(finding.at(first as u64));
 }
 
 /// The highest complete SH degree with every lower degree complete; incomplete degrees are
@@ -216,10 +250,11 @@ pub(super) fn scale_space(ctx: &Ctx, scale: &Decoded, f: &mut Vec<Finding>) -> O
 
 /// Opacity in [0, 1] (with a rounding tolerance). `None` after a blocking finding.
 pub(super) fn check_opacity(path: &str, opacity: &Decoded, f: &mut Vec<Finding>) -> Option<()> {
+    // Non-finite values are reported (and dropped) by the finiteness check.
     let Some(i) = opacity
         .data
         .iter()
-        .position(|v| !(-1e-6..=1.0 + 1e-6).contains(v))
+        .position(|v| v.is_finite() && !(-1e-6..=1.0 + 1e-6).contains(v))
     else {
         return Some(());
     };

@@ -75,7 +75,13 @@ pub fn read(
         }
     };
     // Decoded converted (stored frame → LUF); the flips are undone if it is read as stored.
-    let (mut cloud, mut details, flips) = match decode_bytes(bytes, SpzAxes::Rub, Frame::Gltf, f) {
+    let (mut cloud, mut details, flips) = match decode_bytes(
+        bytes,
+        SpzAxes::Rub,
+        Frame::Gltf,
+        (&ctx.opts.limits, None),
+        f,
+    ) {
         Ok(d) => d,
         Err(e) => {
             f.push(Finding::fatal(
@@ -126,6 +132,7 @@ pub fn read(
         cloud,
         scale_seen: ScaleSeen::Log,
         non_unit: 0,
+        origin: None,
         details: Some(details),
     })
 }

@@ -31,27 +31,36 @@ fn check_decomposable(m: DMat3, node: usize, findings: &mut Vec<Finding>) {
     }
 }
 
-/// Returns the cloud in global space under `m` (the node's global matrix), or `None` after a
-/// blocking finding when the transform produces non-finite values.
-pub fn apply(
-    local: &SplatCloud,
-    m: DMat4,
-    node: usize,
-    findings: &mut Vec<Finding>,
-) -> Option<SplatCloud> {
+/// Returns the cloud in global space under `m` (the node's global matrix). Values the
+/// transform makes non-finite (huge matrices, SH near f32::MAX rotated, covariances that
+/// overflow) are left for the caller's hygiene pass to drop.
+pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Finding>) -> SplatCloud {
     let mut out = local.clone();
     if m == DMat4::IDENTITY {
-        return Some(out);
+        return out;
     }
     let m3 = DMat3::from_mat4(m);
-    check_decomposable(m3, node, findings);
+    // Rotation, similarity test and decomposability do not depend on M's overall scale: judge
+    // them on M / max|Mᵢⱼ|, so huge but finite node chains do not overflow MᵀM or the column
+    // lengths (which made the SH rotation NaN).
+    let big = m3
+        .to_cols_array()
+        .iter()
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let (unit, big) = if big.is_finite() && big > 0.0 {
+        (m3 * (1.0 / big), big)
+    } else {
+        (m3, 1.0)
+    };
+    check_decomposable(unit, node, findings);
     for p in &mut out.positions {
         let g = m.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
         *p = [g.x as f32, g.y as f32, g.z as f32];
     }
     if m3 != DMat3::IDENTITY {
-        match as_similarity(m3, 1e-6) {
+        match as_similarity(unit, 1e-6) {
             Some((r, k)) => {
+                let k = k * big;
                 let qm = DQuat::from_mat3(&r).normalize();
                 for (s, q) in out.scales.iter_mut().zip(out.rotations.iter_mut()) {
                     *s = s.map(|v| (v as f64 * k) as f32);
@@ -68,7 +77,7 @@ pub fn apply(
             }
         }
         if out.sh_degree > 0 {
-            match polar_rotation(m3) {
+            match polar_rotation(unit) {
                 Some(r) => {
                     let rot = ShRotation::new(r);
                     let k = out.coeffs_per_splat();
@@ -83,24 +92,28 @@ pub fn apply(
             }
         }
     }
-    let bad = out
-        .positions
-        .iter()
-        .position(|p| !p.iter().all(|v| v.is_finite()))
-        .or_else(|| {
-            out.scales
-                .iter()
-                .position(|s| !s.iter().all(|v| v.is_finite()))
-        });
-    if let Some(i) = bad {
-        findings.push(
-            Finding::fatal(
-                format!("nodes[{node}]"),
-                "the global transform makes a splat's position or scale non-finite",
-            )
-            .at(i as u64),
-        );
-        return None;
+    out
+}
+
+/// The node transform of `apply` (above), then the loader contract on the result: `None` (with
+/// a blocking finding at `nodes[node]` naming the first broken splat) when the transform made a
+/// value non-finite.
+pub fn apply_checked(
+    local: &SplatCloud,
+    m: DMat4,
+    node: usize,
+    findings: &mut Vec<Finding>,
+) -> Option<SplatCloud> {
+    let out = apply(local, m, node, findings);
+    match out.validate() {
+        Ok(()) => Some(out),
+        Err(v) => {
+            let mut f = Finding::fatal(format!("nodes[{node}]"), v.message);
+            if let Some(i) = v.index {
+                f = f.at(i as u64);
+            }
+            findings.push(f);
+            None
+        }
     }
-    Some(out)
 }

@@ -1,17 +1,17 @@
 //! ASCII PLY bodies: one row per line, values parsed at their declared precision.
 
 use super::header::{Header, Scalar};
-use super::{Layout, PlyError, convert_row};
+use super::{Layout, PlyError, Unusable, convert_row};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 
-/// Decodes the `vertex` rows (element `vi`) of an ASCII body; returns the cloud and the
-/// number of non-unit quaternions.
+/// Decodes the `vertex` rows (element `vi`) of an ASCII body; returns the cloud, the number of
+/// non-unit quaternions and the rows whose values cannot be used (still in the cloud).
 pub(super) fn decode(
     header: &Header,
     vi: usize,
     l: &Layout,
     body: &[u8],
-) -> Result<(SplatCloud, usize), PlyError> {
+) -> Result<(SplatCloud, usize, Unusable), PlyError> {
     let vertex = &header.elements[vi];
     let text = std::str::from_utf8(body).map_err(|e| PlyError::Ascii {
         line: header.lines + 1,
@@ -45,7 +45,7 @@ pub(super) fn decode(
     let mut cloud = SplatCloud::with_capacity(l.sh_degree, n);
     let mut vals = vec![0.0f64; ncols];
     let mut sh = vec![[0.0f32; 3]; k];
-    let mut non_unit = 0;
+    let (mut non_unit, mut bad) = (0, Unusable::default());
     for i in 0..n {
         let (ln, line) = lines.next().ok_or_else(|| PlyError::EndsEarly {
             element: "vertex".into(),
@@ -83,9 +83,12 @@ pub(super) fn decode(
             &mut r,
             &mut o,
             &mut sh,
-        )?;
-        non_unit += off as usize;
+        );
+        match off {
+            Ok(off) => non_unit += off as usize,
+            Err(e) => bad.add(i, e),
+        }
         cloud.push(p, s, r, o, &sh);
     }
-    Ok((cloud, non_unit))
+    Ok((cloud, non_unit, bad))
 }

@@ -2,7 +2,7 @@
 //! `vertex` rows decoded in parallel blocks.
 
 use super::header::{Element, Property, Scalar};
-use super::{Layout, PlyError, convert_row, fixed_rows_len};
+use super::{Layout, PlyError, Unusable, convert_row, fixed_rows_len};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 use rayon::prelude::*;
 
@@ -70,12 +70,14 @@ pub(super) fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<u
 
 const BLOCK: usize = 4096;
 
+/// Decodes the `vertex` rows; returns the cloud, the number of non-unit quaternions and the
+/// rows whose values cannot be used (left in the cloud for the caller to drop or fail on).
 pub(super) fn decode_binary(
     l: &Layout,
     props: &[Property],
     rows: &[u8],
     be: bool,
-) -> Result<(SplatCloud, usize), PlyError> {
+) -> Result<(SplatCloud, usize, Unusable), PlyError> {
     let n = rows.len().checked_div(l.stride).unwrap_or(0);
     let k = sh_coeff_count(l.sh_degree);
     let all_f32_le = !be && l.cols.iter().all(|&(_, t)| t == Scalar::F32);
@@ -85,7 +87,7 @@ pub(super) fn decode_binary(
     cloud.rotations = vec![[0.0; 4]; n];
     cloud.opacities = vec![0.0; n];
     cloud.sh = vec![[0.0; 3]; n * k];
-    let results: Vec<Result<usize, PlyError>> = cloud
+    let results: Vec<(usize, Unusable)> = cloud
         .positions
         .par_chunks_mut(BLOCK)
         .zip(cloud.scales.par_chunks_mut(BLOCK))
@@ -95,35 +97,40 @@ pub(super) fn decode_binary(
         .zip(rows.par_chunks(BLOCK * l.stride))
         .enumerate()
         .map(|(b, (((((p, s), r), o), sh), raw))| {
-            let mut non_unit = 0;
+            let (mut non_unit, mut bad) = (0, Unusable::default());
             for i in 0..p.len() {
                 let row = &raw[i * l.stride..(i + 1) * l.stride];
                 let out = (&mut p[i], &mut s[i], &mut r[i], &mut o[i]);
                 let sh = &mut sh[i * k..(i + 1) * k];
                 // The common case (every column f32, little endian) gets its own
                 // monomorphised copy of `convert_row` without the per-value type dispatch.
+                let index = b * BLOCK + i;
                 let off = if all_f32_le {
                     let get = |c: usize| {
                         let off = l.cols[c].0;
                         f32::from_le_bytes([row[off], row[off + 1], row[off + 2], row[off + 3]])
                             as f64
                     };
-                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
+                    convert_row(l, props, index, get, out.0, out.1, out.2, out.3, sh)
                 } else {
                     let get = |c: usize| {
                         let (off, ty) = l.cols[c];
                         ty.read(&row[off..], be)
                     };
-                    convert_row(l, props, b * BLOCK + i, get, out.0, out.1, out.2, out.3, sh)?
+                    convert_row(l, props, index, get, out.0, out.1, out.2, out.3, sh)
                 };
-                non_unit += off as usize;
+                match off {
+                    Ok(off) => non_unit += off as usize,
+                    Err(e) => bad.add(index, e),
+                }
             }
-            Ok(non_unit)
+            (non_unit, bad)
         })
         .collect();
-    let mut non_unit = 0;
-    for r in results {
-        non_unit += r?;
+    let (mut non_unit, mut bad) = (0, Unusable::default());
+    for (n, b) in results {
+        non_unit += n;
+        bad.extend(b);
     }
-    Ok((cloud, non_unit))
+    Ok((cloud, non_unit, bad))
 }

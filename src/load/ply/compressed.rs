@@ -12,8 +12,8 @@
 //!
 //! The rotation's four components are in the INRIA order (w, x, y, z).
 
-use super::PlyError;
 use super::header::{Element, Encoding, Header, Scalar};
+use super::{PlyError, Unusable};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 use crate::load::Details;
 
@@ -207,8 +207,9 @@ fn sh_element<'a>(
 }
 
 /// Decodes a compressed PLY whose header is `h` and body `body`. Quaternions are rebuilt unit
-/// from their smallest three components, so none is reported as non-unit.
-pub(super) fn decode(h: &Header, body: &[u8]) -> Result<SplatCloud, PlyError> {
+/// from their smallest three components, so none is reported as non-unit. Rows that decode to
+/// unusable values are returned beside the cloud (which holds a placeholder for each).
+pub(super) fn decode(h: &Header, body: &[u8]) -> Result<(SplatCloud, Unusable), PlyError> {
     if h.encoding != Encoding::Le {
         return Err(PlyError::Unsupported(
             "compressed PLY must be binary_little_endian".into(),
@@ -239,6 +240,7 @@ pub(super) fn decode(h: &Header, body: &[u8]) -> Result<SplatCloud, PlyError> {
     let degree = sh.as_ref().map_or(0, |s| s.2);
     let mut cloud = SplatCloud::with_capacity(degree, n);
     let mut coeffs = vec![[0.0f32; 3]; sh_coeff_count(degree)];
+    let mut bad = Unusable::default();
     for i in 0..n {
         if let Some((cols, offs, _)) = &sh {
             let per = offs.len() / 3;
@@ -246,9 +248,12 @@ pub(super) fn decode(h: &Header, body: &[u8]) -> Result<SplatCloud, PlyError> {
                 coeffs[1 + j % per][j / per] = sh_byte(cols.data[i * cols.row + o]);
             }
         }
-        push_splat(&chunks, &verts, &fields, i, &mut coeffs, &mut cloud)?;
+        if let Err(e) = push_splat(&chunks, &verts, &fields, i, &mut coeffs, &mut cloud) {
+            bad.add(i, e);
+            cloud.push([0.0; 3], [0.0; 3], [0.0, 0.0, 0.0, 1.0], 0.0, &coeffs);
+        }
     }
-    Ok(cloud)
+    Ok((cloud, bad))
 }
 
 /// Decodes splat `i` and appends it to `cloud` with `coeffs`, whose DC term it sets (the

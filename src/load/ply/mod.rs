@@ -11,7 +11,7 @@
 //! Binary rows are decoded in parallel (rayon, blocks of rows) with property offsets resolved
 //! once from the header: no per-property lookups in the inner loop.
 
-use super::{Finding, LoadReport, ScaleSeen};
+use super::{Finding, LoadOptions, LoadReport, ScaleSeen};
 use crate::cloud::SplatCloud;
 
 /// What is wrong with a PLY file.
@@ -87,6 +87,9 @@ pub enum PlyError {
         /// What is wrong.
         message: String,
     },
+    /// A [`crate::load::Limits`] bound was exceeded.
+    #[error(transparent)]
+    Limit(#[from] crate::load::LimitExceeded),
 }
 
 mod ascii;
@@ -171,7 +174,7 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
                 (1 + j % k_rest) * 3 + j / k_rest,
             ))
         })
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, PlyError>>()?;
     Ok(Layout {
         pos: [need("x")?, need("y")?, need("z")?],
         dc,
@@ -283,8 +286,69 @@ fn convert_row(
     }
 }
 
+/// Rows whose values cannot be used ([`PlyError::Value`] from [`convert_row`]): how many, and
+/// the first one's error. Without strict mode they are dropped; with it, the first one fails.
+#[derive(Debug, Default)]
+pub(super) struct Unusable {
+    /// Row indices, ascending.
+    pub rows: Vec<usize>,
+    /// The first row's error.
+    pub first: Option<PlyError>,
+}
+
+impl Unusable {
+    /// Records row `i` (rows must come in ascending order).
+    pub(super) fn add(&mut self, i: usize, e: PlyError) {
+        self.rows.push(i);
+        self.first.get_or_insert(e);
+    }
+    /// Appends a later block's rows.
+    pub(super) fn extend(&mut self, other: Unusable) {
+        self.rows.extend(other.rows);
+        if let Some(e) = other.first {
+            self.first.get_or_insert(e);
+        }
+    }
+    /// Strict: the first error. Otherwise the rows are dropped from `cloud` and one warning
+    /// names the first row's property and problem and the count.
+    fn settle(
+        self,
+        cloud: &mut SplatCloud,
+        strict: bool,
+        findings: &mut Vec<Finding>,
+    ) -> Result<(), PlyError> {
+        let Some(first) = self.first else {
+            return Ok(());
+        };
+        if strict {
+            return Err(first);
+        }
+        let n = self.rows.len();
+        let (path, msg) = match &first {
+            PlyError::Value {
+                property, message, ..
+            } => (format!("vertex.{property}"), message.clone()),
+            e => ("vertex".to_owned(), e.to_string()),
+        };
+        let s = if n == 1 { "" } else { "s" };
+        findings.push(
+            Finding::warning(
+                path,
+                format!("{msg}; {n} splat{s} with unusable values dropped (the first is named)"),
+            )
+            .at(self.rows[0] as u64),
+        );
+        super::hygiene::drop_splats(cloud, &self.rows);
+        Ok(())
+    }
+}
+
 /// Reads a PLY file from memory; what it notices goes to `report`.
-pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, PlyError> {
+pub(crate) fn read(
+    bytes: &[u8],
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Result<SplatCloud, PlyError> {
     let header = parse_header(bytes)?;
     let vi = header
         .elements
@@ -292,20 +356,22 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
         .position(|e| e.name == "vertex")
         .ok_or(PlyError::NoVertexElement)?;
     let vertex = &header.elements[vi];
+    opts.limits.check_splats(vertex.count, "element 'vertex'")?;
     let body = &bytes[header.body..];
     report.scale_space = Some(ScaleSeen::Log);
     if compressed::is_compressed(vertex) {
-        let cloud = compressed::decode(&header, body)?;
+        let (mut cloud, bad) = compressed::decode(&header, body)?;
         report.details = Some(compressed::details(cloud.sh_degree));
         report.findings.push(Finding::warning(
             "",
             "PlayCanvas compressed PLY: quantised positions, scales, rotations and colours",
         ));
+        bad.settle(&mut cloud, opts.strict, &mut report.findings)?;
         return Ok(cloud);
     }
     let l = layout(vertex)?;
 
-    let (cloud, non_unit) = match header.encoding {
+    let (mut cloud, non_unit, bad) = match header.encoding {
         Encoding::Ascii => ascii::decode(&header, vi, &l, body)?,
         enc => {
             let start = skip_binary(&header.elements[..vi], body, enc == Encoding::Be)?;
@@ -328,6 +394,7 @@ pub(crate) fn read(bytes: &[u8], report: &mut LoadReport) -> Result<SplatCloud, 
             )?
         }
     };
+    bad.settle(&mut cloud, opts.strict, &mut report.findings)?;
     if non_unit > 0 {
         report.findings.push(Finding::warning(
             "vertex.rot_0..3",

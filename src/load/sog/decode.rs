@@ -101,11 +101,13 @@ fn coeffs(bands: u8) -> usize {
     (bands as usize + 1).pow(2) - 1
 }
 
-/// Decodes the textures (in [`names`] order) into a cloud; `limit` bounds the decoded pixels.
+/// Decodes the textures (in [`names`] order) into a cloud; `limit` bounds the decoded pixels
+/// and the cloud; splats with unusable values are dropped at `drop_at`
+/// ([`crate::load::codec::finish_cloud`]).
 pub(super) fn decode(
     m: &Meta,
     textures: &[Vec<u8>],
-    limit: u64,
+    (limit, drop_at): (u64, Option<&str>),
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SogError> {
     let names = names(m);
@@ -174,7 +176,7 @@ pub(super) fn decode(
         .into_par_iter()
         .map(|(d, file, role)| read_rgba(d, file, role))
         .collect::<Result<_, _>>()?;
-    let cloud = splats(m, &tex, sh, findings);
+    let cloud = splats(m, &tex, sh, drop_at, findings);
     Ok((cloud, describe(m, sh)))
 }
 
@@ -192,6 +194,7 @@ fn splats(
     m: &Meta,
     t: &[Tex],
     sh: Option<(u8, usize, usize)>,
+    drop_at: Option<&str>,
     findings: &mut Vec<Finding>,
 ) -> SplatCloud {
     let (lo, hi) = (&t[0].rgba, &t[1].rgba);
@@ -259,16 +262,13 @@ fn splats(
             format!("{labels} palette labels out of range: those splats get no SH beyond DC"),
         ));
     }
-    let (dropped, first) = crate::load::codec::finish_cloud(&mut cloud);
-    if let Some(i) = first {
-        findings.push(
-            Finding::warning(
-                "splats",
-                format!("{dropped} splats dropped ({tags} with a quats tag outside 252-255)"),
-            )
-            .at(i as u64),
-        );
+    if tags > 0 {
+        findings.push(Finding::warning(
+            "quats",
+            format!("{tags} splats with a quats tag outside 252-255 (no rotation: dropped)"),
+        ));
     }
+    crate::load::codec::finish_cloud(&mut cloud, drop_at, findings);
     cloud
 }
 

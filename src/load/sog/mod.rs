@@ -6,8 +6,10 @@
 mod decode;
 pub mod zip;
 
-use super::codec::budget_for;
-use super::{Details, Finding, Format, LoadReport, ScaleSeen, Scene};
+use super::codec::{self, BUDGET_RULE, budget_for};
+use super::{
+    Details, Finding, Format, LimitExceeded, Limits, LoadOptions, LoadReport, ScaleSeen, Scene,
+};
 use crate::cloud::SplatCloud;
 use serde_json::Value;
 use std::path::Path;
@@ -52,7 +54,7 @@ pub enum SogError {
     },
     /// Decoding the textures would pass the budget.
     #[error(
-        "decoded textures and cloud take {needed} bytes, over the budget of {limit} bytes (16 MiB + 64 × input)"
+        "decoded textures and cloud take {needed} bytes, over the budget of {limit} bytes ({BUDGET_RULE})"
     )]
     OverBudget {
         /// Bytes needed.
@@ -61,8 +63,16 @@ pub enum SogError {
         limit: u64,
     },
     /// An unbundled meta.json without the folder that holds its textures.
-    #[error("an unbundled meta.json needs its path to find the WebP textures")]
+    #[error(
+        "an unbundled meta.json needs its path (or LoadOptions::resolver) to find the WebP textures"
+    )]
     NoDirectory,
+    /// In strict mode: a splat with a non-finite or overflowing value (which, and where).
+    #[error("{0}")]
+    Unusable(String),
+    /// A [`Limits`] bound was exceeded (splat count, bytes read, JSON nesting).
+    #[error(transparent)]
+    Limit(#[from] LimitExceeded),
 }
 
 /// The parts of meta.json the decoder uses.
@@ -148,8 +158,10 @@ fn range(v: &Value, path: &str, n: usize) -> Result<Quant, SogError> {
     Ok(Quant::Range(get(lo, "mins")?, get(hi, "maxs")?))
 }
 
-/// Parses meta.json (version 2, or version 1 when `version` is absent).
-pub(crate) fn parse_meta(json: &[u8]) -> Result<Meta, SogError> {
+/// Parses meta.json (version 2, or version 1 when `version` is absent) after checking its
+/// nesting against `limits.max_json_depth`; its count is checked against `limits.max_splats`.
+pub(crate) fn parse_meta(json: &[u8], limits: &Limits) -> Result<Meta, SogError> {
+    super::check_json_depth(json, limits.max_json_depth).map_err(|e| meta_err("$", e))?;
     let v: Value = serde_json::from_slice(json).map_err(|e| meta_err("$", e.to_string()))?;
     let version = match v.get("version") {
         None => 1,
@@ -172,6 +184,7 @@ pub(crate) fn parse_meta(json: &[u8]) -> Result<Meta, SogError> {
             .and_then(Value::as_u64)
     }
     .ok_or_else(|| meta_err("count", "expected a non-negative integer"))?;
+    limits.check_splats(count, "meta.json count")?;
     let mm = (
         numbers(field(means, "means", "mins")?, "means.mins", Some(3))?,
         numbers(field(means, "means", "maxs")?, "means.maxs", Some(3))?,
@@ -226,16 +239,17 @@ pub(crate) fn is_bundle(bytes: &[u8]) -> bool {
 }
 
 /// Reads a SOG from memory into `report`: a bundle (zip), or a meta.json whose textures are
-/// read beside `path`.
+/// read beside `path` (or from `opts.resolver`).
 pub(crate) fn read(
     bytes: &[u8],
     path: Option<&Path>,
+    opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Result<SplatCloud, SogError> {
     let (cloud, details) = if is_meta_json(bytes) {
-        read_dir(bytes, path, &mut report.findings)
+        read_dir(bytes, path, opts, &mut report.findings)
     } else {
-        read_bundle(bytes, &mut report.findings)
+        read_bundle(bytes, opts, &mut report.findings)
     }?;
     report.details = Some(details);
     report.scale_space = Some(ScaleSeen::Log);
@@ -245,31 +259,39 @@ pub(crate) fn read(
 /// Reads a bundled `.sog` (zip) from memory.
 fn read_bundle(
     bytes: &[u8],
+    opts: &LoadOptions,
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SogError> {
     let archive = zip::Archive::new(bytes)?;
-    let mut budget = budget_for(bytes.len());
-    let meta = parse_meta(&archive.read("meta.json", &mut budget)?)?;
+    let mut budget = budget_for(bytes.len(), &opts.limits);
+    let meta = parse_meta(&archive.read("meta.json", &mut budget)?, &opts.limits)?;
     let textures = decode::names(&meta)
         .iter()
         .map(|(_, name)| archive.read(name, &mut budget))
         .collect::<Result<Vec<_>, _>>()?;
-    let (cloud, mut d) = decode::decode(&meta, &textures, budget, findings)?;
+    let drop_at = codec::drop_site("splats", opts);
+    let (cloud, mut d) = decode::decode(&meta, &textures, (budget, drop_at), findings)?;
     d.compression = "WebP lossless, in a zip".into();
     Ok((cloud, d))
 }
 
 /// Reads an unbundled SOG from wherever its textures are (memory, an archive, the network):
 /// `meta` is the meta.json text, and `load` returns the bytes of a texture it names. The
-/// budget counts meta.json and every texture as input.
+/// budget counts meta.json and every texture as input. `opts` apply as to any load (limits,
+/// strict mode); the cloud passes the same exit checks as [`super::load_bytes`]'s.
 pub fn read_unbundled(
     meta: &[u8],
+    opts: &LoadOptions,
     load: &mut dyn FnMut(&str) -> Result<Vec<u8>, SogError>,
 ) -> Result<Scene, SogError> {
     let mut report = LoadReport::new(Format::Sog);
-    let (cloud, details) = unbundled(meta, load, &mut report.findings)?;
+    let (mut cloud, details) = unbundled(meta, opts, load, &mut report.findings)?;
     report.details = Some(details);
     report.scale_space = Some(ScaleSeen::Log);
+    super::finish(&mut cloud, opts, &mut report).map_err(|e| match e {
+        super::ReadError::Limit(l) => SogError::Limit(l),
+        e => SogError::Unusable(e.to_string()),
+    })?;
     Ok(Scene {
         cloud,
         cameras: Vec::new(),
@@ -279,50 +301,70 @@ pub fn read_unbundled(
 
 fn unbundled(
     meta: &[u8],
+    opts: &LoadOptions,
     load: &mut dyn FnMut(&str) -> Result<Vec<u8>, SogError>,
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SogError> {
-    let m = parse_meta(meta)?;
+    let m = parse_meta(meta, &opts.limits)?;
     let textures = decode::names(&m)
         .iter()
         .map(|(_, name)| load(name))
         .collect::<Result<Vec<_>, _>>()?;
     let input = meta.len() + textures.iter().map(Vec::len).sum::<usize>();
-    let (cloud, mut d) = decode::decode(&m, &textures, budget_for(input), findings)?;
+    let budget = budget_for(input, &opts.limits);
+    let drop_at = codec::drop_site("splats", opts);
+    let (cloud, mut d) = decode::decode(&m, &textures, (budget, drop_at), findings)?;
     d.compression = "WebP lossless, meta.json + files".into();
     Ok((cloud, d))
 }
 
-/// Reads the textures of an unbundled SOG beside `path` (plain names only; regular files).
+/// Reads the textures of an unbundled SOG: from `opts.resolver` when there is one, else beside
+/// `path` under the containment rule ([`crate::files::contained`]: inside meta.json's folder
+/// after `..` and symlinks are resolved, unless `opts.allow_outside_paths`), regular files
+/// only, all of them together within `limits.max_bytes`.
 fn read_dir(
     meta: &[u8],
     path: Option<&Path>,
+    opts: &LoadOptions,
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details), SogError> {
-    let dir = path
-        .ok_or(SogError::NoDirectory)?
-        .parent()
-        .unwrap_or(Path::new(""));
+    let mut so_far = 0u64;
+    let count = |name: &str, data: Vec<u8>, so_far: &mut u64| {
+        *so_far += data.len() as u64;
+        opts.limits
+            .check_bytes(*so_far, &format!("'{name}' (with the textures before it)"))?;
+        Ok::<_, SogError>(data)
+    };
+    if let Some(resolver) = &opts.resolver {
+        let mut load = |name: &str| -> Result<Vec<u8>, SogError> {
+            let data = resolver(name).map_err(|message| SogError::Member {
+                member: name.into(),
+                message: format!("resolver: {message}"),
+            })?;
+            count(name, data, &mut so_far)
+        };
+        return unbundled(meta, opts, &mut load, findings);
+    }
+    let dir = match path.ok_or(SogError::NoDirectory)?.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+        _ => std::path::PathBuf::from("."),
+    };
     let mut load = |name: &str| -> Result<Vec<u8>, SogError> {
         let fail = |message: String| SogError::Member {
             member: name.into(),
             message,
         };
-        let rel = Path::new(name);
-        let plain = rel
-            .components()
-            .all(|c| matches!(c, std::path::Component::Normal(_)));
-        if name.is_empty() || !plain {
-            return Err(fail("not a plain relative file name".into()));
-        }
-        let p = dir.join(rel);
-        match std::fs::metadata(&p) {
-            Ok(m) if m.is_file() => std::fs::read(&p).map_err(|e| fail(e.to_string())),
-            Ok(_) => Err(fail("not a regular file".into())),
-            Err(_) => Err(SogError::Missing {
+        if !dir.join(name).exists() && !Path::new(name).is_absolute() {
+            return Err(SogError::Missing {
                 member: name.into(),
-            }),
+            });
         }
+        let file = crate::files::contained_path(&dir, Path::new(name), opts.allow_outside_paths)
+            .map_err(fail)?;
+        let left = opts.limits.max_bytes.saturating_sub(so_far);
+        let data = crate::files::read_bounded(&file, left, "the texture")
+            .map_err(|e| fail(e.to_string()))?;
+        count(name, data, &mut so_far)
     };
-    unbundled(meta, &mut load, findings)
+    unbundled(meta, opts, &mut load, findings)
 }

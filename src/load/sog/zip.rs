@@ -116,8 +116,10 @@ impl<'a> Archive<'a> {
         }
         if e.size > *budget {
             return Err(fail(format!(
-                "unpacks to {} bytes, over the {} left of the budget (16 MiB + 64 × input)",
-                e.size, budget
+                "unpacks to {} bytes, over the {} left of the budget ({})",
+                e.size,
+                budget,
+                codec::BUDGET_RULE
             )));
         }
         let l = e.local as usize;

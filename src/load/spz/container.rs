@@ -3,21 +3,21 @@
 //! Sizes claimed by a header are checked against the budget before anything is allocated.
 
 use super::{ATTRIBUTES, FLAG_EXTENSIONS, Header, MAGIC, MAX_VERSION, SpzError, header, sizes};
-use crate::load::Finding;
 use crate::load::codec::{self, InflateError, cloud_bytes};
+use crate::load::{Finding, Limits};
 use rayon::prelude::*;
 use std::io::Read;
 
 /// The six attribute blocks (borrowed from the decompressed legacy buffer or owned v4 streams).
 pub(crate) type Blocks<'a> = Vec<std::borrow::Cow<'a, [u8]>>;
 
-/// Checks a header's version and degree, and that its blocks plus the cloud they decode to fit
-/// the budget. Returns the total size of the blocks.
+/// Checks a header's version, degree and count (`limits.max_splats`), and that its blocks plus
+/// the cloud they decode to fit the budget `limit`. Returns the total size of the blocks.
 fn check(
     h: &Header,
     versions: std::ops::RangeInclusive<u32>,
     container: &'static str,
-    limit: u64,
+    (limit, limits): (u64, &Limits),
     input: usize,
 ) -> Result<u64, SpzError> {
     if !versions.contains(&h.version) {
@@ -45,6 +45,7 @@ fn check(
             input,
         });
     }
+    limits.check_splats(h.count as u64, "header")?;
     Ok(total)
 }
 
@@ -55,7 +56,11 @@ const MAX_EXTENSIONS: u64 = 1 << 20;
 /// blocks are read into one allocation of exactly their size. Extension records (flag 0x2)
 /// are kept (at most 1 MiB); other trailing data is read (so the CRC is checked) but not kept, and its length
 /// returned. Everything decompressed counts against `limit`.
-pub(crate) fn gunzip_legacy(bytes: &[u8], limit: u64) -> Result<(Vec<u8>, u64), SpzError> {
+pub(crate) fn gunzip_legacy(
+    bytes: &[u8],
+    limit: u64,
+    limits: &Limits,
+) -> Result<(Vec<u8>, u64), SpzError> {
     let gz = |e: std::io::Error| SpzError::Gzip(InflateError::Corrupt(e.to_string()));
     let mut d = flate2::read::GzDecoder::new(bytes);
     let mut head = [0u8; 16];
@@ -71,7 +76,7 @@ pub(crate) fn gunzip_legacy(bytes: &[u8], limit: u64) -> Result<(Vec<u8>, u64), 
         return Ok((head[..got].to_vec(), 0));
     }
     let h = header(&head);
-    let total = 16 + check(&h, 1..=3, "a gzip member", limit, bytes.len())?;
+    let total = 16 + check(&h, 1..=3, "a gzip member", (limit, limits), bytes.len())?;
     let mut out = Vec::with_capacity(total as usize);
     out.extend_from_slice(&head);
     (&mut d)
@@ -113,7 +118,7 @@ pub(crate) fn legacy<'a>(
     data: &'a [u8],
     container: &'static str,
     trailing: u64,
-    limit: u64,
+    (limit, limits): (u64, &Limits),
     findings: &mut Vec<Finding>,
 ) -> Result<(Header, Blocks<'a>, &'a [u8]), SpzError> {
     if data.len() < 16 {
@@ -129,7 +134,7 @@ pub(crate) fn legacy<'a>(
         return Err(SpzError::BadMagic { found });
     }
     let h = header(data);
-    let total = 16 + check(&h, 1..=3, container, limit, data.len())?;
+    let total = 16 + check(&h, 1..=3, container, (limit, limits), data.len())?;
     let sz = sizes(&h);
     if total > data.len() as u64 {
         let mut off = 16u64;
@@ -176,7 +181,11 @@ pub(crate) fn legacy<'a>(
 }
 
 /// v4 layout: 32-byte header, extensions up to the TOC, TOC, zstd streams to the end.
-pub(crate) fn v4(bytes: &[u8], limit: u64) -> Result<(Header, Blocks<'static>, &[u8]), SpzError> {
+pub(crate) fn v4<'a>(
+    bytes: &'a [u8],
+    limit: u64,
+    limits: &Limits,
+) -> Result<(Header, Blocks<'static>, &'a [u8]), SpzError> {
     if bytes.len() < 32 {
         return Err(SpzError::Truncated {
             count: 0,
@@ -190,7 +199,7 @@ pub(crate) fn v4(bytes: &[u8], limit: u64) -> Result<(Header, Blocks<'static>, &
         &h,
         4..=MAX_VERSION,
         "an uncompressed file",
-        limit,
+        (limit, limits),
         bytes.len(),
     )?;
     let (streams, toc) = (bytes[15] as usize, codec::u32_at(bytes, 16) as usize);

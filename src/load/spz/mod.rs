@@ -15,8 +15,10 @@
 //! extensions) the payload is unpacked to glTF's LUF instead: x and z negated. [`SpzAxes::Raw`]
 //! reads the numbers as they are (what `splat-transform` 3.x writes).
 
-use super::codec::{self, InflateError, budget_for, build_cloud, finish_cloud, sh_flip_signs};
-use super::{Details, Finding, LoadReport, ScaleSeen};
+use super::codec::{
+    self, BUDGET_RULE, InflateError, budget_for, build_cloud, finish_cloud, sh_flip_signs,
+};
+use super::{Details, Finding, LimitExceeded, Limits, LoadOptions, LoadReport, ScaleSeen};
 use crate::cloud::{MAX_SH_DEGREE, SplatCloud};
 
 mod container;
@@ -133,7 +135,7 @@ pub enum SpzError {
     },
     /// The count would decompress to more than the budget allows.
     #[error(
-        "header claims {count} points ({needed} bytes decompressed and decoded), over the budget of {limit} bytes for a {input}-byte file (16 MiB + 64 × input)"
+        "header claims {count} points ({needed} bytes decompressed and decoded), over the budget of {limit} bytes for a {input}-byte file ({BUDGET_RULE})"
     )]
     OverBudget {
         /// Claimed count.
@@ -145,6 +147,9 @@ pub enum SpzError {
         /// Input size.
         input: usize,
     },
+    /// The point count exceeds [`Limits::max_splats`].
+    #[error(transparent)]
+    Limit(#[from] LimitExceeded),
     /// The v4 table of contents is inconsistent.
     #[error("v4 table of contents: {0}")]
     Toc(String),
@@ -203,10 +208,17 @@ pub(crate) fn header(b: &[u8]) -> Header {
 /// Reads an SPZ file into `report` (findings, container details, log scale space).
 pub(crate) fn read(
     bytes: &[u8],
-    axes: SpzAxes,
+    opts: &LoadOptions,
     report: &mut LoadReport,
 ) -> Result<SplatCloud, SpzError> {
-    let (cloud, details, _) = decode_bytes(bytes, axes, Frame::Ply, &mut report.findings)?;
+    let drop_at = codec::drop_site("points", opts);
+    let (cloud, details, _) = decode_bytes(
+        bytes,
+        opts.spz_axes,
+        Frame::Ply,
+        (&opts.limits, drop_at),
+        &mut report.findings,
+    )?;
     report.details = Some(details);
     report.scale_space = Some(ScaleSeen::Log);
     Ok(cloud)
@@ -215,31 +227,33 @@ pub(crate) fn read(
 /// Decodes an SPZ payload (gzip v1–v3, uncompressed legacy, or v4 zstd streams): the cloud,
 /// the container's details and the axis flips applied — from the stored frame to `frame`, none
 /// when `axes` is [`SpzAxes::Raw`]. The glTF SPZ compression extensions call this on a
-/// bufferView.
+/// bufferView. `limits` bound the count and the budget ([`budget_for`]); splats with unusable
+/// values are dropped at `drop_at` (see [`codec::finish_cloud`]).
 pub(crate) fn decode_bytes(
     bytes: &[u8],
     axes: SpzAxes,
     frame: Frame,
+    (limits, drop_at): (&Limits, Option<&str>),
     findings: &mut Vec<Finding>,
 ) -> Result<(SplatCloud, Details, [bool; 3]), SpzError> {
-    let limit = budget_for(bytes.len());
+    let limit = budget_for(bytes.len(), limits);
     let mut d = Details::new("spz", "");
     let inner;
     let (h, blocks, ext) = if bytes.starts_with(&[0x1f, 0x8b]) {
         let trailing;
-        (inner, trailing) = container::gunzip_legacy(bytes, limit)?;
+        (inner, trailing) = container::gunzip_legacy(bytes, limit, limits)?;
         d.compression = "gzip".into();
-        container::legacy(&inner, "a gzip member", trailing, limit, findings)?
+        container::legacy(&inner, "a gzip member", trailing, (limit, limits), findings)?
     } else if bytes.starts_with(MAGIC) && bytes.len() >= 8 && codec::u32_at(bytes, 4) >= 4 {
         d.compression = "zstd (one stream per attribute)".into();
-        container::v4(bytes, limit)?
+        container::v4(bytes, limit, limits)?
     } else if bytes.starts_with(MAGIC) {
         findings.push(Finding::warning(
             "container",
             "legacy SPZ without its gzip wrapping (read as is)",
         ));
         d.compression = "none".into();
-        container::legacy(bytes, "an uncompressed file", 0, limit, findings)?
+        container::legacy(bytes, "an uncompressed file", 0, (limit, limits), findings)?
     } else {
         let found = bytes.iter().take(4).map(|b| format!("{b:02x}")).collect();
         return Err(SpzError::BadMagic { found });
@@ -248,7 +262,7 @@ pub(crate) fn decode_bytes(
     d.version = h.version.to_string();
     d.antialiased = h.flags & FLAG_ANTIALIASED != 0;
     describe(&h, &mut d);
-    let cloud = decode(&h, &blocks, flips, findings);
+    let cloud = decode(&h, &blocks, flips, drop_at, findings);
     Ok((cloud, d, flips))
 }
 
@@ -356,7 +370,13 @@ fn smallest_three(b: &[u8]) -> [f32; 4] {
     q
 }
 
-fn decode(h: &Header, b: &Blocks<'_>, flip: [bool; 3], f: &mut Vec<Finding>) -> SplatCloud {
+fn decode(
+    h: &Header,
+    b: &Blocks<'_>,
+    flip: [bool; 3],
+    drop_at: Option<&str>,
+    f: &mut Vec<Finding>,
+) -> SplatCloud {
     let degree = h.degree.min(MAX_SH_DEGREE);
     if h.degree > MAX_SH_DEGREE {
         f.push(Finding::warning(
@@ -403,15 +423,6 @@ fn decode(h: &Header, b: &Blocks<'_>, flip: [bool; 3], f: &mut Vec<Finding>) -> 
         Ok(())
     });
     let Ok(mut cloud) = cloud;
-    let (dropped, first) = finish_cloud(&mut cloud);
-    if let Some(i) = first {
-        f.push(
-            Finding::warning(
-                "points",
-                format!("{dropped} points with unusable values dropped"),
-            )
-            .at(i as u64),
-        );
-    }
+    finish_cloud(&mut cloud, drop_at, f);
     cloud
 }
