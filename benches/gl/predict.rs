@@ -1,0 +1,144 @@
+//! The fragment-count prediction of the opacity-aware quads, and the pre-pass crossover.
+
+use rayon::prelude::*;
+use splatgl::profile::{CUTOFF_M2, OPACITY_M2_MARGIN, opacity_cutoff_m2};
+use splatgl::reference::{RenderOptions, footprints};
+
+use super::{Bench, PathKind, Row, scene};
+use splatgl::cull::CullBounds;
+
+/// Pixel centres of a `w × h` image inside the quad the GL vertex stage builds for one
+/// footprint `[u, v, a, b, c, opacity]` with Mahalanobis² extent `k2` (the rectangle along
+/// Σ''s eigenvectors, half-axes `min(1.02·√(k2·λ) + 0.5, ⌈√(k2·λ₁')⌉)`, as in
+/// `glsl/splat_project.glsl`).
+fn quad_pixels(f: &[f32; 6], k2: f64, w: u32, h: u32) -> u64 {
+    let [u, v, a, b, c, _] = f.map(f64::from);
+    let mid = 0.5 * (a + c);
+    let det = a * c - b * b;
+    if det.is_nan() || det <= 0.0 {
+        return 0;
+    }
+    let l1 = mid + (mid * mid - det).max(0.0).sqrt();
+    let l2 = det / l1;
+    let lambda1 = mid + (mid * mid - det).max(0.1).sqrt();
+    let radius = (k2 * lambda1).sqrt().ceil();
+    let mut axis = if a >= c { [l1 - c, b] } else { [b, l1 - a] };
+    let len = (axis[0] * axis[0] + axis[1] * axis[1]).sqrt();
+    axis = if len > 0.0 {
+        [axis[0] / len, axis[1] / len]
+    } else {
+        [1.0, 0.0]
+    };
+    let h1 = ((k2 * l1).sqrt() * 1.02 + 0.5).min(radius);
+    let h2 = ((k2 * l2).sqrt() * 1.02 + 0.5).min(radius);
+    let ext_x = h1 * axis[0].abs() + h2 * axis[1].abs();
+    let ext_y = h1 * axis[1].abs() + h2 * axis[0].abs();
+    let x0 = (u - ext_x - 0.5).ceil().max(0.0) as i64;
+    let x1 = (u + ext_x - 0.5).floor().min(w as f64 - 1.0) as i64;
+    let y0 = (v - ext_y - 0.5).ceil().max(0.0) as i64;
+    let y1 = (v + ext_y - 0.5).floor().min(h as f64 - 1.0) as i64;
+    let mut n = 0;
+    for y in y0..=y1 {
+        let dy = y as f64 + 0.5 - v;
+        for x in x0..=x1 {
+            let dx = x as f64 + 0.5 - u;
+            let p1 = dx * axis[0] + dy * axis[1];
+            let p2 = -dx * axis[1] + dy * axis[0];
+            n += u64::from(p1.abs() <= h1 && p2.abs() <= h2);
+        }
+    }
+    n
+}
+
+/// Predicted fragments of all footprints: (3σ quads, opacity-aware quads).
+fn predicted(fp: &[[f32; 6]], w: u32, h: u32) -> (u64, u64) {
+    fp.par_iter()
+        .map(|f| {
+            let k2 = (opacity_cutoff_m2(f[5]) + OPACITY_M2_MARGIN).min(f64::from(CUTOFF_M2));
+            (quad_pixels(f, 9.0, w, h), quad_pixels(f, k2, w, h))
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+}
+
+/// The real scenes, framed: measured fragment-shader invocations of the 3σ and the
+/// opacity-aware quads (same culled order, direct path) against the prediction.
+pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)], scale: f32) {
+    if b.query.is_none() {
+        println!("\n(no fragment counter in this context: prediction table skipped)");
+        return;
+    }
+    let (w, h) = b.size;
+    println!(
+        "\n{:>7} | {:>8} | {:>13} | {:>13} | {:>9} | {:>15} | {:>15} | {:>9}",
+        "scene",
+        "splats",
+        "fragments 3σ",
+        "fragments k",
+        "measured",
+        "predicted 3σ",
+        "predicted k",
+        "predicted"
+    );
+    for name in ["biker", "guitar", "fox", "tower", "fruit"] {
+        let Some((cloud, cam, target)) = scene(name, w, h, scale) else {
+            continue;
+        };
+        b.renderer.upload(b.gl, &cloud).unwrap();
+        let bounds = CullBounds::new(&cloud);
+        let full = b.run(&cloud, &bounds, &cam, target, PathKind::Cull);
+        let k = b.run(&cloud, &bounds, &cam, target, PathKind::Extent);
+        // The same cameras as the measured frames (median of the per-frame predictions).
+        let (mut pf, mut pk): (Vec<u64>, Vec<u64>) = (1..=b.frames)
+            .map(|f| {
+                let c = super::orbit(&cam, target, 0.004 * f as f32);
+                predicted(&footprints(&cloud, &c, &RenderOptions::default()), w, h)
+            })
+            .unzip();
+        let (p_full, p_k) = (super::median(&mut pf), super::median(&mut pk));
+        let (m_full, m_k) = (full.fragments.unwrap(), k.fragments.unwrap());
+        println!(
+            "{:>7} | {:>8} | {:>13} | {:>13} | {:>8.1}% | {:>15} | {:>15} | {:>8.1}%",
+            name,
+            cloud.len(),
+            m_full,
+            m_k,
+            100.0 * m_k as f64 / m_full as f64,
+            p_full,
+            p_k,
+            100.0 * p_k as f64 / p_full as f64
+        );
+    }
+}
+
+/// Draw time direct vs pre-pass by splat count (SH 3, everything in view).
+pub fn crossover(b: &mut Bench, sizes: &str, scale: f32) {
+    if sizes == "none" {
+        return;
+    }
+    let (w, h) = b.size;
+    println!(
+        "\n{:>8} | {:>14} | {:>14} | {:>10} | {:>12} | {:>12}",
+        "splats", "direct draw ms", "pre-pass ms", "direct/pre", "direct CPU", "pre-pass CPU"
+    );
+    for n in sizes
+        .split(',')
+        .filter_map(|s| s.trim().parse::<usize>().ok())
+    {
+        let Some((cloud, cam, target)) = scene(&n.to_string(), w, h, scale) else {
+            continue;
+        };
+        b.renderer.upload(b.gl, &cloud).unwrap();
+        let bounds = CullBounds::new(&cloud);
+        let d = b.run(&cloud, &bounds, &cam, target, PathKind::Extent);
+        let p = b.run(&cloud, &bounds, &cam, target, PathKind::PrePass);
+        println!(
+            "{:>8} | {:>14.2} | {:>14.2} | {:>9.2}× | {:>12.2} | {:>12.2}",
+            n,
+            d.draw,
+            p.draw,
+            d.draw / p.draw,
+            d.draw_cpu,
+            p.draw_cpu
+        );
+    }
+}
