@@ -12,6 +12,7 @@
 //! per-splat maths (the path before issue 15); `cull` = the same draw of only the splats the
 //! cull keeps; `extent` = also opacity-aware quads; `new` = also the transform-feedback
 //! pre-pass (the default path, `Pipeline::Auto`). All four draw the same image.
+//! `SPLATGL_BENCH_PATHS` (default `former,cull,extent,new`) runs some of them only.
 //!
 //! Columns: splats drawn (instances), fragment-shader invocations
 //! (`GL_FRAGMENT_SHADER_INVOCATIONS` of `GL_ARB_pipeline_statistics_query` in a desktop
@@ -24,8 +25,8 @@
 //! Then: the predicted fragment ratio of the opacity-aware quads on the real scenes (pixel
 //! centres inside each splat's quad rectangle with k and with 3, counted on the CPU from the
 //! reference's projection) against the measured invocation ratio; and the pre-pass crossover
-//! (`SPLATGL_BENCH_CROSSOVER`, default `1000,4000,16000,64000,256000` splats, SH 3, direct vs
-//! pre-pass; `none` skips it).
+//! (`SPLATGL_BENCH_CROSSOVER`, default `10,100,1000,10000,100000` splats, SH 3, direct vs
+//! pre-pass; `none` skips it). `SPLATGL_BENCH_PREDICT=0` skips the prediction table.
 //!
 //! `cargo bench --bench gl`; `scripts/bench-gpu.sh` runs it at 1920×1080 with 1M and 4M.
 
@@ -124,7 +125,7 @@ impl PathKind {
     fn draw_path(self) -> DrawPath {
         let with = |pipeline| DrawPath {
             pipeline,
-            full_extent: false,
+            former_quads: false,
         };
         match self {
             PathKind::Former | PathKind::Cull => DrawPath::FORMER,
@@ -354,6 +355,7 @@ fn main() {
         .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
         .unwrap_or((1280u32, 720u32));
     let scale: f32 = env("SPLATGL_BENCH_SCALE", 1.0);
+    let paths: String = env("SPLATGL_BENCH_PATHS", "former,cull,extent,new".to_owned());
     let scenes: String = if smoke {
         "5000".into()
     } else {
@@ -364,7 +366,7 @@ fn main() {
     } else {
         env(
             "SPLATGL_BENCH_CROSSOVER",
-            "1000,4000,16000,64000,256000".to_owned(),
+            "10,100,1000,10000,100000".to_owned(),
         )
     };
     // A desktop context where it counts fragment-shader invocations; else ES.
@@ -434,6 +436,10 @@ fn main() {
         for (view, c) in [("full", cam), ("half", half)] {
             let mut rows = Vec::new();
             for path in PathKind::ALL {
+                if !paths.split(',').any(|p| p.trim() == path.name()) {
+                    rows.push(Row::default());
+                    continue;
+                }
                 let r = b.run(&cloud, &bounds, &c, target, path);
                 println!(
                     "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8.2} | {:>9.1} | {:>11.1} | {:>9.1} | {:>7.2} | {}",
@@ -455,7 +461,9 @@ fn main() {
         }
     }
     print_summary(&summary);
-    predict::fragment_table(&mut b, &summary, scale);
+    if env("SPLATGL_BENCH_PREDICT", 1u8) != 0 && !smoke {
+        predict::fragment_table(&mut b, &summary, scale);
+    }
     predict::crossover(&mut b, &crossover, scale);
     b.renderer.destroy(gl);
     frame.destroy(gl);

@@ -5,7 +5,7 @@
 // Mirrors the step structure of KHR_gaussian_splatting (review draft) Appendix A with every
 // erratum fixed; docs/appendix-errata.md lists each deviation. The `#version` line, precision
 // statements and every numeric constant (SH_C*, DILATION, CUTOFF_M2, ALPHA_MAX, ALPHA_MIN,
-// OPACITY_M2_MARGIN, FOV_CLAMP, SH_DC_BIAS, texture layout GEOM_* / MAX_SH_TEXELS /
+// OPACITY_M2_MARGIN, QUAD_*, FOV_CLAMP, SH_DC_BIAS, texture layout GEOM_* / MAX_SH_TEXELS /
 // TEX_WIDTH / LAYER_ROWS, MAX_CLOUDS) are injected from Rust (splatgl::profile, splatgl::sh)
 // as `#define`s; `ERRATUM_*` defines switch in the appendix's literal behaviour for the
 // erratum tests only.
@@ -36,7 +36,7 @@ uniform int u_splat_count;         // splats uploaded: an order index past them 
 uniform int u_model_count;
 uniform vec4 u_model_rows[3 * MAX_CLOUDS]; // rows 0..2 of each model's affine matrix
 uniform mat3 u_sh_rotation[MAX_CLOUDS];    // world -> model directions (polar rotation^T)
-uniform int u_full_extent;         // 1: quads bound the 3-sigma ellipse whatever the opacity
+uniform int u_former_quads;        // 1: the former quads (3 sigma, FORMER_QUAD_MARGIN_PX)
 
 // What the quad's corners and the fragments need of one splat.
 struct Splat {
@@ -166,12 +166,17 @@ bool project_splat(uint index, out Splat s) {
     // the quad bounds the ellipse of k2 (plus a margin for log/exp rounding), capped at the
     // 3-sigma cut-off. The fragment test is unchanged: the image is the same.
     float k2 = min(CUTOFF_M2, 2.0 * log(a_glob_opacity / ALPHA_MIN) + OPACITY_M2_MARGIN);
-#ifdef ERRATUM_D
-    k2 = CUTOFF_M2; // the appendix's quad is no bounding box: keep its size
-#endif
-    if (u_full_extent != 0) {
+    float quad_margin = QUAD_MARGIN_PX;
+#ifdef FORMER_QUADS
+    // Erratum variants draw exactly the former quads (erratum d's is no bounding box).
+    k2 = CUTOFF_M2;
+    quad_margin = FORMER_QUAD_MARGIN_PX;
+#else
+    if (u_former_quads != 0) {
         k2 = CUTOFF_M2;
+        quad_margin = FORMER_QUAD_MARGIN_PX;
     }
+#endif
     float mid = 0.5 * (cov2d[0][0] + cov2d[1][1]);
     float lambda1 = mid + sqrt(max(0.1, mid * mid - det));
     float radius = ceil(sqrt(k2 * lambda1));
@@ -197,8 +202,9 @@ bool project_splat(uint index, out Splat s) {
     // The quad is the k-ellipse's bounding rectangle along the eigenvectors of Sigma'
     // rather than the appendix's square of side 2 * radius: far fewer fragments for elongated
     // splats. The fragment shader's exact cut decides which pixels count, so any quad that
-    // contains the ellipse gives the same image; the 2% + 0.5 px margin covers f32 rounding in
-    // the eigen-decomposition, and the square still bounds it.
+    // contains the ellipse gives the same image; the QUAD_AXIS_FACTOR (2%) + QUAD_MARGIN_PX
+    // margin covers f32 rounding in the eigen-decomposition and vertex snapping, and the
+    // square still bounds it.
     float l1 = mid + sqrt(max(mid * mid - det, 0.0));
     float l2 = det / l1;
     vec2 axis1 = cov2d[0][0] >= cov2d[1][1] ? vec2(l1 - cov2d[1][1], cov2d[0][1])
@@ -206,7 +212,8 @@ bool project_splat(uint index, out Splat s) {
     float axis1_len = length(axis1);
     axis1 = axis1_len > 0.0 ? axis1 / axis1_len : vec2(1.0, 0.0);
     vec2 axis2 = vec2(-axis1.y, axis1.x);
-    vec2 half_axes = min(sqrt(k2 * vec2(l1, l2)) * 1.02 + 0.5, vec2(radius));
+    vec2 half_axes = min(sqrt(k2 * vec2(l1, l2)) * QUAD_AXIS_FACTOR + quad_margin,
+                         vec2(radius));
     // The clip-space offsets of the corners (+-1, 0) and (0, +-1): r px are 2r/viewport in NDC.
     vec2 to_clip = (2.0 / u_viewport.zw) * clip_space_pos.w;
     s.axes = vec4(half_axes.x * axis1 * to_clip, half_axes.y * axis2 * to_clip);

@@ -15,7 +15,7 @@
 //!   `z < max(0.2, near)` minus a rounding margin (3DGS culls by the centre's depth alone).
 //!   Sides: the projected footprint's half-extent along x is at most
 //!   `|fx|/z · R · √(1 + lim²) + 3·√0.3` pixels (`lim` = the J clamp 1.3·tan, the 0.3 px²
-//!   dilation) and the GL quad adds at most √2·2 % and 0.5 px; a splat is culled only if even
+//!   dilation) and the GL quad adds at most √2·2 % and √2·⅛ px; a splat is culled only if even
 //!   [`CULL_RADIUS_FACTOR`]·that, plus [`CULL_MARGIN_PX`], misses the image.
 //!
 //! Every comparison is written so that NaN keeps the splat (the backends decide).
@@ -28,11 +28,11 @@ use crate::cloud::SplatCloud;
 use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, JACOBIAN_CLAMP};
 
 /// Factor on the footprint bound `|f|/z·R·√(1 + lim²)`: covers the GL quad's rectangle along
-/// Σ''s axes (its corners reach √2 beyond the ellipse's box, with the 2 % margin:
-/// √2·1.02 = 1.443) and f32 rounding.
+/// Σ''s axes (its corners reach √2 beyond the ellipse's box, with the
+/// [`QUAD_AXIS_FACTOR`](crate::profile::QUAD_AXIS_FACTOR): √2·1.02 = 1.443) and f32 rounding.
 pub const CULL_RADIUS_FACTOR: f32 = 1.5;
 /// Pixels added to the footprint bound: the dilation's `1.443·3·√0.3 = 2.37` px, the quad's
-/// `0.5·√2` px and rounding (4 ≥ 3.08).
+/// `QUAD_MARGIN_PX·√2` and rounding (a unit test checks 4 against them).
 pub const CULL_MARGIN_PX: f32 = 4.0;
 /// Relative rounding margin of the plane tests (≈ 64 f32 ulps of the coordinates involved):
 /// the GPU computes the same camera-space values in its own f32 order of operations.
@@ -42,10 +42,14 @@ pub const CULL_RELATIVE_MARGIN: f32 = 1.0 / (1 << 18) as f32;
 const NEVER: f32 = -1.0;
 
 /// Per-splat cull radii of one cloud (computed once per upload): the world-space sphere
-/// around each mean that holds the splat's 3σ ellipsoid.
+/// around each mean that holds the splat's 3σ ellipsoid; with [`CullBounds::new`] also the
+/// box of the means, so a view that holds the whole cloud skips the per-splat test.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CullBounds {
     radius: Vec<f32>,
+    /// The box of the finite means, when every radius is ≥ 0 (or NaN): with it inside a
+    /// frustum every splat is visible.
+    whole: Option<[[f32; 3]; 2]>,
 }
 
 impl CullBounds {
@@ -55,12 +59,57 @@ impl CullBounds {
             .into_par_iter()
             .map(|i| splat_radius(cloud, i))
             .collect();
-        CullBounds { radius }
+        let mut b = CullBounds {
+            radius,
+            whole: None,
+        };
+        b.set_extent(&cloud.positions);
+        b
     }
 
-    /// Bounds from radii (`< 0`: never visible; NaN: always kept).
+    /// Bounds from radii (`< 0`: never visible; NaN: always kept), without the box of the
+    /// means (see [`CullBounds::set_extent`]).
     pub fn from_radii(radius: Vec<f32>) -> Self {
-        CullBounds { radius }
+        CullBounds {
+            radius,
+            whole: None,
+        }
+    }
+
+    /// Records the box of `positions` (the means these radii belong to), which lets a view
+    /// that holds all of them skip the per-splat test. Call it again after moving them.
+    pub fn set_extent(&mut self, positions: &[[f32; 3]]) {
+        let drawn = !self.radius.par_iter().any(|r| *r < 0.0);
+        let (lo, hi) = positions
+            .par_iter()
+            .fold(
+                || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+                |(mut lo, mut hi), p| {
+                    for k in 0..3 {
+                        if p[k].is_finite() {
+                            lo[k] = lo[k].min(p[k]);
+                            hi[k] = hi[k].max(p[k]);
+                        }
+                    }
+                    (lo, hi)
+                },
+            )
+            .reduce(
+                || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+                |a, b| {
+                    let m = |f: fn(f32, f32) -> f32, x: [f32; 3], y: [f32; 3]| {
+                        [f(x[0], y[0]), f(x[1], y[1]), f(x[2], y[2])]
+                    };
+                    (m(f32::min, a.0, b.0), m(f32::max, a.1, b.1))
+                },
+            );
+        self.whole = (drawn && positions.len() == self.radius.len()).then_some([lo, hi]);
+    }
+
+    /// Whether `frustum` sees every splat (the box of the means inside all its planes, no
+    /// splat that is never drawn): then the cull keeps them all without testing each.
+    pub fn all_visible(&self, frustum: &Frustum) -> bool {
+        self.whole.is_some_and(|[lo, hi]| frustum.holds_box(lo, hi))
     }
 
     /// The radii, one per splat.
@@ -68,8 +117,10 @@ impl CullBounds {
         &self.radius
     }
 
-    /// Mutable radii (a scene rescales those of a moved cloud).
-    pub fn radii_mut(&mut self) -> &mut Vec<f32> {
+    /// Mutable radii (a scene rescales those of a moved cloud); forgets the box of the means
+    /// until the next [`CullBounds::set_extent`].
+    pub fn radii_mut(&mut self) -> &mut [f32] {
+        self.whole = None;
         &mut self.radius
     }
 
@@ -191,19 +242,32 @@ impl Frustum {
         Frustum { planes, t }
     }
 
-    /// Whether a splat at `p` with cull radius `radius` ([`CullBounds`]) may touch the image.
-    #[inline]
-    pub fn may_see(&self, p: [f32; 3], radius: f32) -> bool {
-        if radius < 0.0 {
-            return false;
+    /// Whether every point of the box `lo..=hi` passes every plane (so every splat with its
+    /// mean there does: the radius and rounding terms only add).
+    fn holds_box(&self, lo: [f32; 3], hi: [f32; 3]) -> bool {
+        if lo.iter().zip(&hi).any(|(l, h)| l > h) {
+            return true; // no finite mean
         }
-        let v = Vec3::from_array(p);
-        let size = v.abs().element_sum() + self.t;
         self.planes.iter().all(|pl| {
-            // NaN (non-finite data) is kept: the backends skip it.
-            let x = pl.n.dot(v) + pl.w + pl.grow * radius + pl.rel * size;
-            x >= 0.0 || x.is_nan()
+            let corner = |k: usize, n: f32| if n >= 0.0 { lo[k] } else { hi[k] };
+            let (x, y, z) = (corner(0, pl.n.x), corner(1, pl.n.y), corner(2, pl.n.z));
+            pl.n.x * x + pl.n.y * y + pl.n.z * z + pl.w >= 0.0
         })
+    }
+
+    /// Whether a splat at `p` with cull radius `radius` ([`CullBounds`]) may touch the image.
+    #[inline(always)]
+    pub fn may_see(&self, p: [f32; 3], radius: f32) -> bool {
+        let [x, y, z] = p;
+        let size = x.abs() + y.abs() + z.abs() + self.t;
+        // Branch-free (`&`, `|`, no early exit) so that the cull pass vectorises. NaN (in the
+        // data or a radius) keeps the splat: the backends skip it.
+        let mut keep = radius >= 0.0 || radius.is_nan();
+        for pl in &self.planes {
+            let v = pl.n.x * x + pl.n.y * y + pl.n.z * z + pl.w + pl.grow * radius + pl.rel * size;
+            keep &= v >= 0.0 || v.is_nan();
+        }
+        keep
     }
 }
 
@@ -229,23 +293,35 @@ pub fn visible_into(
     if out.len() < n {
         out.resize(n, 0);
     }
+    if bounds.all_visible(frustum) {
+        out[..n]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, o)| *o = i as u32);
+        return n;
+    }
     const CHUNK: usize = 1 << 14;
     let radii = bounds.radii();
-    // Each chunk writes its visible indices at the start of its own range, then END.
+    // Each chunk writes its visible indices at the start of its own range, then END: blocks
+    // of the (vectorised) test into a mask, then a branch-free compaction.
+    const BLOCK: usize = 256;
     out[..n]
         .par_chunks_mut(CHUNK)
         .enumerate()
         .for_each(|(c, dst)| {
             let start = c * CHUNK;
             let mut k = 0;
-            for (j, (p, r)) in positions[start..start + dst.len()]
-                .iter()
-                .zip(&radii[start..])
-                .enumerate()
-            {
-                if frustum.may_see(*p, *r) {
-                    dst[k] = (start + j) as u32;
-                    k += 1;
+            let mut mask = [false; BLOCK];
+            for b in (0..dst.len()).step_by(BLOCK) {
+                let len = BLOCK.min(dst.len() - b);
+                let (ps, rs) = (&positions[start + b..][..len], &radii[start + b..][..len]);
+                for ((m, p), r) in mask.iter_mut().zip(ps).zip(rs) {
+                    *m = frustum.may_see(*p, *r);
+                }
+                for (j, &m) in mask[..len].iter().enumerate() {
+                    // k ≤ b + j < dst.len(): the write is in bounds and never past what is read.
+                    dst[k] = (start + b + j) as u32;
+                    k += usize::from(m);
                 }
             }
             if k < dst.len() {
@@ -276,12 +352,13 @@ mod tests {
 
     #[test]
     fn margins_cover_the_quad_and_the_dilation() {
-        // The GL quad: half-axes 1.02·3√λ + 0.5 along Σ''s axes; its x-extent is at most
-        // √2·(1.02·3√Σ'xx + 0.5), and 3√Σ'xx ≤ |f|/z·R·√(1 + lim²) + 3√0.3.
-        let quad = 1.02 * 2f64.sqrt();
+        // The GL quad: half-axes f·3√λ + m along Σ''s axes; its x-extent is at most
+        // √2·(f·3√Σ'xx + m), and 3√Σ'xx ≤ |f|/z·R·√(1 + lim²) + 3√0.3.
+        use crate::profile::{DILATION_PX2, QUAD_AXIS_FACTOR, QUAD_MARGIN_PX};
+        let quad = QUAD_AXIS_FACTOR * 2f64.sqrt();
         assert!(f64::from(CULL_RADIUS_FACTOR) >= quad);
-        let dilation = f64::from(CUTOFF_M2).sqrt() * crate::profile::DILATION_PX2.sqrt();
-        assert!(f64::from(CULL_MARGIN_PX) >= quad * dilation + 0.5 * 2f64.sqrt());
+        let dilation = f64::from(CUTOFF_M2).sqrt() * DILATION_PX2.sqrt();
+        assert!(f64::from(CULL_MARGIN_PX) >= quad * dilation + QUAD_MARGIN_PX * 2f64.sqrt());
     }
 
     #[test]
@@ -350,6 +427,43 @@ mod tests {
             .collect();
         assert!(m > 1000 && m < n / 2, "{m}");
         assert_eq!(&out[..m], &want[..]);
+    }
+
+    #[test]
+    fn a_view_of_the_whole_cloud_keeps_every_splat_without_testing() {
+        let mut cloud = SplatCloud::new(0);
+        for i in 0..300 {
+            let t = i as f32 * 0.1;
+            let p = [t.sin(), t.cos(), (0.3 * t).sin()];
+            cloud.push(p, [0.01; 3], [0.0, 0.0, 0.0, 1.0], 0.5, &[[0.0; 3]]);
+        }
+        let b = CullBounds::new(&cloud);
+        let wide = Frustum::from_camera(&cam(), 0.2);
+        assert!(b.all_visible(&wide));
+        let all = (0..300).all(|i| wide.may_see(cloud.positions[i], b.radii()[i]));
+        assert!(all, "the box test agrees with the per-splat test");
+        let mut ids = Vec::new();
+        assert_eq!(visible_into(&wide, &cloud.positions, &b, &mut ids), 300);
+        // Turned away: not all; a splat that is never drawn: not all either.
+        let away = Camera::look_at(
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(9.0, 0.0, 5.0),
+            Vec3::Y,
+            0.8,
+            64,
+            48,
+        );
+        assert!(!b.all_visible(&Frustum::from_camera(&away, 0.2)));
+        cloud.opacities[7] = 0.0;
+        let never = CullBounds::new(&cloud);
+        assert!(!never.all_visible(&wide));
+        assert_eq!(visible_into(&wide, &cloud.positions, &never, &mut ids), 299);
+        let mut moved = b.clone();
+        moved.radii_mut()[0] = 1.0;
+        assert!(
+            !moved.all_visible(&wide),
+            "radii changed: the box is forgotten"
+        );
     }
 
     #[test]

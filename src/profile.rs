@@ -102,6 +102,20 @@ pub fn opacity_cutoff_m2(opacity: f32) -> f64 {
 /// in scene units. `reference::RenderOptions::near_cull` overrides it for the reference.
 pub const NEAR_CULL: f64 = 0.2;
 
+/// The GL quad: the rectangle along Σ''s eigenvectors with half-axes
+/// `QUAD_AXIS_FACTOR·√(k²λᵢ) + QUAD_MARGIN_PX` (capped by the 3DGS radius), i.e. 2 % and
+/// ⅛ px beyond the bounding rectangle of the ellipse m² ≤ k². Any quad that contains every
+/// pixel centre the fragment test can pass gives the same image; the margins cover the f32
+/// eigen-decomposition (≪ 2 %) and the rasterizer's vertex snapping (≤ 1/32 px at the 4
+/// sub-pixel bits GLES 3.0 guarantees; llvmpipe has 8).
+pub const QUAD_AXIS_FACTOR: f64 = 1.02;
+/// See [`QUAD_AXIS_FACTOR`] (pixels).
+pub const QUAD_MARGIN_PX: f64 = 0.125;
+/// The quad margin before the opacity-aware extent (pixels): what the erratum variants and
+/// the benchmarks' "former" path draw with.
+#[doc(hidden)]
+pub const FORMER_QUAD_MARGIN_PX: f64 = 0.5;
+
 // ---------------------------------------------------------------------------------------------
 // §8 GPU data layout (the GL backend's textures; docs/gl-backend.md "Data layout")
 // ---------------------------------------------------------------------------------------------

@@ -1,7 +1,10 @@
 //! The fragment-count prediction of the opacity-aware quads, and the pre-pass crossover.
 
 use rayon::prelude::*;
-use splatgl::profile::{CUTOFF_M2, OPACITY_M2_MARGIN, opacity_cutoff_m2};
+use splatgl::profile::{
+    CUTOFF_M2, FORMER_QUAD_MARGIN_PX, OPACITY_M2_MARGIN, QUAD_AXIS_FACTOR, QUAD_MARGIN_PX,
+    opacity_cutoff_m2,
+};
 use splatgl::reference::{RenderOptions, footprints};
 
 use super::{Bench, PathKind, Row, scene};
@@ -9,9 +12,9 @@ use splatgl::cull::CullBounds;
 
 /// Pixel centres of a `w × h` image inside the quad the GL vertex stage builds for one
 /// footprint `[u, v, a, b, c, opacity]` with Mahalanobis² extent `k2` (the rectangle along
-/// Σ''s eigenvectors, half-axes `min(1.02·√(k2·λ) + 0.5, ⌈√(k2·λ₁')⌉)`, as in
+/// Σ''s eigenvectors, half-axes `min(QUAD_AXIS_FACTOR·√(k2·λ) + margin, ⌈√(k2·λ₁')⌉)`, as in
 /// `glsl/splat_project.glsl`).
-fn quad_pixels(f: &[f32; 6], k2: f64, w: u32, h: u32) -> u64 {
+fn quad_pixels(f: &[f32; 6], k2: f64, margin: f64, w: u32, h: u32) -> u64 {
     let [u, v, a, b, c, _] = f.map(f64::from);
     let mid = 0.5 * (a + c);
     let det = a * c - b * b;
@@ -29,8 +32,8 @@ fn quad_pixels(f: &[f32; 6], k2: f64, w: u32, h: u32) -> u64 {
     } else {
         [1.0, 0.0]
     };
-    let h1 = ((k2 * l1).sqrt() * 1.02 + 0.5).min(radius);
-    let h2 = ((k2 * l2).sqrt() * 1.02 + 0.5).min(radius);
+    let h1 = ((k2 * l1).sqrt() * QUAD_AXIS_FACTOR + margin).min(radius);
+    let h2 = ((k2 * l2).sqrt() * QUAD_AXIS_FACTOR + margin).min(radius);
     let ext_x = h1 * axis[0].abs() + h2 * axis[1].abs();
     let ext_y = h1 * axis[1].abs() + h2 * axis[0].abs();
     let x0 = (u - ext_x - 0.5).ceil().max(0.0) as i64;
@@ -50,18 +53,23 @@ fn quad_pixels(f: &[f32; 6], k2: f64, w: u32, h: u32) -> u64 {
     n
 }
 
-/// Predicted fragments of all footprints: (3σ quads, opacity-aware quads).
+/// Predicted fragments of all footprints: (the former quads: 3σ, 0.5 px; the new ones:
+/// opacity-aware k, ⅛ px).
 fn predicted(fp: &[[f32; 6]], w: u32, h: u32) -> (u64, u64) {
     fp.par_iter()
         .map(|f| {
             let k2 = (opacity_cutoff_m2(f[5]) + OPACITY_M2_MARGIN).min(f64::from(CUTOFF_M2));
-            (quad_pixels(f, 9.0, w, h), quad_pixels(f, k2, w, h))
+            (
+                quad_pixels(f, 9.0, FORMER_QUAD_MARGIN_PX, w, h),
+                quad_pixels(f, k2, QUAD_MARGIN_PX, w, h),
+            )
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
-/// The real scenes, framed: measured fragment-shader invocations of the 3σ and the
-/// opacity-aware quads (same culled order, direct path) against the prediction.
+/// The real scenes, framed: measured fragment-shader invocations of the former quads (3σ,
+/// 0.5 px) and the new ones (opacity-aware, ⅛ px; same culled order, direct path) against
+/// the prediction.
 pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)], scale: f32) {
     if b.query.is_none() {
         println!("\n(no fragment counter in this context: prediction table skipped)");
@@ -72,11 +80,11 @@ pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)
         "\n{:>7} | {:>8} | {:>13} | {:>13} | {:>9} | {:>15} | {:>15} | {:>9}",
         "scene",
         "splats",
-        "fragments 3σ",
-        "fragments k",
+        "frags former",
+        "frags new",
         "measured",
-        "predicted 3σ",
-        "predicted k",
+        "pred. former",
+        "pred. new",
         "predicted"
     );
     for name in ["biker", "guitar", "fox", "tower", "fruit"] {
@@ -110,7 +118,8 @@ pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)
     }
 }
 
-/// Draw time direct vs pre-pass by splat count (SH 3, everything in view).
+/// Draw time direct vs pre-pass by splat count (SH 3, everything in view, splats of the 1M
+/// scene's size whatever the count, so the per-splat work is what changes).
 pub fn crossover(b: &mut Bench, sizes: &str, scale: f32) {
     if sizes == "none" {
         return;
@@ -124,9 +133,14 @@ pub fn crossover(b: &mut Bench, sizes: &str, scale: f32) {
         .split(',')
         .filter_map(|s| s.trim().parse::<usize>().ok())
     {
-        let Some((cloud, cam, target)) = scene(&n.to_string(), w, h, scale) else {
+        let Some((mut cloud, cam, target)) = scene(&n.to_string(), w, h, scale) else {
             continue;
         };
+        // Back to the 1M scene's splat size: × ((10⁵/10⁶) / (10⁵/n))^(1/3).
+        let k = (n as f32 / 1e6).cbrt();
+        for s in &mut cloud.scales {
+            *s = s.map(|v| v * k);
+        }
         b.renderer.upload(b.gl, &cloud).unwrap();
         let bounds = CullBounds::new(&cloud);
         let d = b.run(&cloud, &bounds, &cam, target, PathKind::Extent);

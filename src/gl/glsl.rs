@@ -100,6 +100,9 @@ impl Errata {
                 s.push_str(&format!("#define {name}\n"));
             }
         }
+        if *self != Errata::default() {
+            s.push_str("#define FORMER_QUADS\n");
+        }
         s
     }
 }
@@ -123,6 +126,12 @@ pub(crate) fn defines(layout: &TextureLayout) -> String {
     def("ALPHA_MAX", f32_lit(profile::ALPHA_MAX as f64));
     def("ALPHA_MIN", f32_lit(profile::ALPHA_MIN as f64));
     def("OPACITY_M2_MARGIN", f32_lit(profile::OPACITY_M2_MARGIN));
+    def("QUAD_AXIS_FACTOR", f32_lit(profile::QUAD_AXIS_FACTOR));
+    def("QUAD_MARGIN_PX", f32_lit(profile::QUAD_MARGIN_PX));
+    def(
+        "FORMER_QUAD_MARGIN_PX",
+        f32_lit(profile::FORMER_QUAD_MARGIN_PX),
+    );
     def("FOV_CLAMP", f32_lit(profile::JACOBIAN_CLAMP));
     def("SH_DC_BIAS", f32_lit(profile::SH_DC_BIAS));
     def("SH_C0", float_lit(SH_C0));
@@ -239,6 +248,12 @@ mod tests {
             ("ALPHA_MAX".into(), profile::ALPHA_MAX as f64),
             ("ALPHA_MIN".into(), profile::ALPHA_MIN as f64),
             ("OPACITY_M2_MARGIN".into(), profile::OPACITY_M2_MARGIN),
+            ("QUAD_AXIS_FACTOR".into(), profile::QUAD_AXIS_FACTOR),
+            ("QUAD_MARGIN_PX".into(), profile::QUAD_MARGIN_PX),
+            (
+                "FORMER_QUAD_MARGIN_PX".into(),
+                profile::FORMER_QUAD_MARGIN_PX,
+            ),
             ("FOV_CLAMP".into(), profile::JACOBIAN_CLAMP),
             ("SH_DC_BIAS".into(), profile::SH_DC_BIAS),
             ("SH_C0".into(), SH_C0),

@@ -32,11 +32,13 @@ const COMPONENTS: [i32; 5] = [4, 4, 4, 3, 2];
 /// Bytes of one record: 17 floats.
 pub(crate) const RECORD_BYTES: usize = 68;
 
-/// Below this many splats drawn, [`Pipeline::Auto`](super::Pipeline::Auto) draws directly:
-/// the pre-pass's fixed cost (a second draw, its state changes, the records round trip)
-/// outweighs the three corners' maths it saves. Measured on llvmpipe with `cargo bench
-/// --bench gl` (`docs/gl-backend.md`, "Pre-pass crossover").
-pub const PREPASS_MIN_SPLATS: usize = 4096;
+/// Below this many splats drawn, [`Pipeline::Auto`](super::Pipeline::Auto) draws directly.
+/// On llvmpipe the pre-pass wins from about 10 splats on (`cargo bench --bench gl`,
+/// `docs/gl-backend.md` "Pre-pass crossover"): its fixed cost there is a few µs. On a GPU a
+/// second draw with its program switch costs tens of µs, more than a direct draw of a
+/// thousand splats takes, so small clouds keep the direct path (costing at most 0.4 ms on
+/// llvmpipe); `scripts/bench-gpu.sh` measures the crossover where a GPU is available.
+pub const PREPASS_MIN_SPLATS: usize = 1024;
 
 /// The pre-pass's GL objects.
 #[derive(Debug)]

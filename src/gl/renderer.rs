@@ -102,16 +102,17 @@ pub enum Pipeline {
 pub struct DrawPath {
     /// Direct, pre-pass, or chosen by the splat count.
     pub pipeline: Pipeline,
-    /// Quads bound the 3σ ellipse whatever the opacity (the former rule) instead of the
-    /// opacity-aware extent.
-    pub full_extent: bool,
+    /// The former quads: the 3σ ellipse's rectangle whatever the opacity, with the former
+    /// 0.5 px margin ([`crate::profile::FORMER_QUAD_MARGIN_PX`]), instead of the
+    /// opacity-aware extent and [`crate::profile::QUAD_MARGIN_PX`].
+    pub former_quads: bool,
 }
 
 impl DrawPath {
     /// The path before the opacity-aware extent and the pre-pass.
     pub const FORMER: DrawPath = DrawPath {
         pipeline: Pipeline::Direct,
-        full_extent: true,
+        former_quads: true,
     };
 }
 

@@ -133,6 +133,7 @@ impl SplatScene {
         self.world.clone_from(&self.local);
         self.local_bounds = CullBounds::from_radii(radii);
         self.world_bounds = self.local_bounds.clone();
+        self.world_bounds.set_extent(&self.world);
         self.stale = self.models.iter().map(|m| *m != Mat4::IDENTITY).collect();
         self.order.clear();
         Ok(())
@@ -210,6 +211,7 @@ impl SplatScene {
     /// Sorts the splats the view may see ([`crate::cull`], on their world positions and
     /// radii) by the distance of their world positions to the eye and uploads the order.
     fn sort(&mut self, gl: &glow::Context, view: &ViewParams) -> Result<(), GlError> {
+        let mut moved = false;
         for (k, stale) in self.stale.iter_mut().enumerate() {
             if std::mem::take(stale) {
                 let (r, m) = (self.ranges[k].clone(), self.models[k]);
@@ -221,7 +223,11 @@ impl SplatScene {
                 for (w, l) in self.world_bounds.radii_mut()[r].iter_mut().zip(local) {
                     *w = l * grow;
                 }
+                moved = true;
             }
+        }
+        if moved {
+            self.world_bounds.set_extent(&self.world);
         }
         let frustum = view.frustum();
         let (world, bounds) = (&self.world, &self.world_bounds);

@@ -426,6 +426,18 @@ impl Sorter {
     /// Keys (`fill(first, block)` writes those of `first..first + block.len()`) → `out[..n]`
     /// in ascending key order (ties by index).
     fn sort_u32(&mut self, n: usize, t: usize, fill: impl Fn(usize, &mut [u32]) + Sync) {
+        self.sort_u32_ids(n, t, fill, None);
+    }
+
+    /// [`Sorter::sort_u32`] writing `ids[position]` instead of the position (see
+    /// [`RadixBuffers::sort`]).
+    fn sort_u32_ids(
+        &mut self,
+        n: usize,
+        t: usize,
+        fill: impl Fn(usize, &mut [u32]) + Sync,
+        ids: Option<&[u32]>,
+    ) {
         // Counts and indices are u32: more would wrap and make the parallel scatter race.
         assert!(
             n <= u32::MAX as usize,
@@ -435,7 +447,7 @@ impl Sorter {
         rb.prepare(n, t);
         let (keys, minmax) = rb.keys_and_minmax(n, t);
         fill_keys(keys, minmax, t, fill);
-        rb.sort(n, t, self.max_digit_bits);
+        rb.sort(n, t, self.max_digit_bits, ids);
         self.n = n;
     }
 }

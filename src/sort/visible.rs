@@ -2,7 +2,11 @@
 
 use rayon::prelude::*;
 
-use super::{LastView, SortMode, SortRequest, Sorter, bits_of, radix};
+use super::radix::chunk_count;
+use super::{
+    LastView, Outcome, Precision, SortMode, SortRequest, Sorter, bits_of, far_first_key, radix,
+    squared_distance, view_depth,
+};
 use crate::cull::{CullBounds, Frustum, visible_into};
 
 impl Sorter {
@@ -45,23 +49,51 @@ impl Sorter {
         if self.reuse_last(&view) {
             return self.order();
         }
+        if bounds.all_visible(frustum) {
+            // Every splat is in view: the full sort, with nothing to test or map.
+            assert_eq!(bounds.len(), positions.len(), "one cull radius per splat");
+            self.sort_positions(positions, mode, eye, forward);
+            self.last = Some(view);
+            return self.order();
+        }
         let mut ids = std::mem::take(&mut self.scratch.visible);
-        let mut vis = std::mem::take(&mut self.scratch.visible_positions);
         let m = visible_into(frustum, positions, bounds, &mut ids);
-        radix::grow(&mut vis, m);
-        vis[..m]
-            .par_iter_mut()
-            .zip(&ids[..m])
-            .for_each(|(v, &i)| *v = positions[i as usize]);
-        self.sort_positions(&vis[..m], mode, eye, forward);
-        // Positions in the visible list → splat indices (the list ascends, so ties by
-        // visible position are ties by splat index).
-        let ids_ref = &ids[..m];
-        self.scratch.radix.out[..m]
-            .par_iter_mut()
-            .for_each(|o| *o = ids_ref[*o as usize]);
+        let visible = &ids[..m];
+        match self.precision {
+            // Keys straight from the visible splats' means; the radix carries their indices.
+            Precision::Full => {
+                let t = chunk_count(m);
+                let key = |i: u32| {
+                    let p = positions[i as usize];
+                    far_first_key(match mode {
+                        SortMode::Distance => squared_distance(p, eye),
+                        SortMode::ViewDepth => view_depth(p, eye, forward),
+                    })
+                };
+                let fill = |start: usize, block: &mut [u32]| {
+                    for (k, &i) in block.iter_mut().zip(&visible[start..]) {
+                        *k = key(i);
+                    }
+                };
+                self.sort_u32_ids(m, t, fill, Some(visible));
+                self.outcome = Outcome::Sorted;
+            }
+            // Quantized: the visible means gathered, sorted by the shared core, mapped back.
+            Precision::Quantized { .. } => {
+                let mut vis = std::mem::take(&mut self.scratch.visible_positions);
+                radix::grow(&mut vis, m);
+                vis[..m]
+                    .par_iter_mut()
+                    .zip(visible)
+                    .for_each(|(v, &i)| *v = positions[i as usize]);
+                self.sort_positions(&vis[..m], mode, eye, forward);
+                self.scratch.radix.out[..m]
+                    .par_iter_mut()
+                    .for_each(|o| *o = visible[*o as usize]);
+                self.scratch.visible_positions = vis;
+            }
+        }
         self.scratch.visible = ids;
-        self.scratch.visible_positions = vis;
         self.last = Some(view);
         self.order()
     }
