@@ -35,7 +35,7 @@ for (p,ls,q,lo,dc,rest) in spl:
     body+=struct.pack('<%df'%len(row),*row)
 open("s.ply","wb").write(hdr.encode()+body)
 eye=(0.3,0.5,3.0); tgt=(0.0,0.0,0.0)
-subprocess.run([exe,"render","s.ply","--backend","reference","--look-at","%g,%g,%g,%g,%g,%g"%(eye+tgt),"--width",str(W),"--height",str(H),"--fov","60","-o","out.pfm"],check=True)
+subprocess.run([exe,"render","s.ply","--backend","reference","--look-at","%g,%g,%g,%g,%g,%g,0,1,0"%(eye+tgt),"--width",str(W),"--height",str(H),"--fov","60","-o","out.pfm"],check=True)
 # --- independent implementation (f64) ---
 def sub(a,b): return [a[i]-b[i] for i in range(3)]
 def dot(a,b): return sum(a[i]*b[i] for i in range(3))

@@ -13,13 +13,24 @@
 //! - [`Camera::look_at`]: eye, target, up, vertical field of view.
 //! - [`Camera::from_3dgs`]: one entry of a 3DGS `cameras.json` ([`parse_cameras_json`]).
 //! - [`Camera::from_gltf`]: a glTF perspective camera on a node ([`GltfPerspective`]).
-//! - [`Camera::frame_points`]: frames a point set (the CLI's default view).
+//! - [`Camera::frame_cloud`]: frames a cloud's content (its splats' 3σ boxes) with an
+//!   [`UpAxis`] (the CLI's and the viewer's default view); [`Camera::frame_points`] frames
+//!   bare points.
+//! - [`ViewOptions::camera`]: the camera options of `splatgl render` and `splatgl view`
+//!   (cameras.json, glTF camera node, look-at, framing) for a scene.
+//!
+//! The way back: [`Camera::as_look_at`] (a paste-able `--look-at` line) and
+//! [`Camera::to_3dgs_json`] (a `cameras.json` entry).
 //!
 //! All of them produce the same type, so both backends and every test see one camera model.
 
 use glam::{DMat3, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
 
+mod choose;
+mod frame;
 mod json;
+pub use choose::{LookAtSpec, SceneView, ViewOptions};
+pub use frame::{Extent, LookAt, UpAxis};
 pub use json::{CamerasJsonEntry, load_cameras_json, parse_cameras_json};
 
 /// Why a camera could not be built.
@@ -48,6 +59,11 @@ pub enum CameraError {
     /// length, degenerate pose).
     #[error("invalid camera: {0}")]
     Degenerate(String),
+    /// The camera options ask for a view the scene or the options cannot give (a cameras.json
+    /// index or glTF camera node that does not exist, a field of view out of range, nothing to
+    /// frame).
+    #[error("{0}")]
+    Unavailable(String),
 }
 
 /// A glTF 2.0 perspective camera as instanced by a node, in the glTF convention: the camera

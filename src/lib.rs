@@ -35,6 +35,8 @@ pub mod reference;
 pub mod scene;
 pub mod sh;
 pub mod sort;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 pub mod write;
 
 pub use cloud::SplatCloud;

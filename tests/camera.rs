@@ -185,3 +185,61 @@ fn framing_keeps_the_bulk_of_the_points_in_view() {
     assert_eq!(inside, 1000);
     assert!(Camera::frame_points(&[], 0.8, 10, 10).is_none());
 }
+
+/// Framing uses the splats' 3σ boxes, not their centres: coincident splats with large scales
+/// (the bevy conformance matrix has 15 at one point) put the eye outside every box, and a
+/// single tiny splat stays beyond the near cull.
+#[test]
+fn framing_from_extents_keeps_the_eye_outside_every_splat() {
+    use splatgl::camera::UpAxis;
+    let mut cloud = splatgl::SplatCloud::new(0);
+    for (i, s) in [[1.0, 1.6, 0.6], [2.7, 0.1, 20.0], [7.4, 0.05, 54.6]]
+        .iter()
+        .enumerate()
+    {
+        let q = Quat::from_rotation_y(0.3 * i as f32).to_array();
+        cloud.push([1.0, 2.0, 3.0], *s, q, 0.25, &[[0.2; 3]]);
+    }
+    for up in [UpAxis::Y, UpAxis::NegY, UpAxis::Z] {
+        let cam = Camera::frame_cloud(&cloud, up, 0.8, 160, 120).unwrap();
+        let e = cam.eye() - Vec3::new(1.0, 2.0, 3.0);
+        for i in 0..cloud.len() {
+            // Mahalanobis distance of the eye from the splat's centre: > 3 means outside.
+            let r = glam::Mat3::from_quat(Quat::from_array(cloud.rotations[i]));
+            let local = r.transpose() * e;
+            let m = (local / Vec3::from_array(cloud.scales[i])).length();
+            assert!(m > 3.0, "{up:?}: eye inside splat {i} (m = {m})");
+        }
+        // Image "up" is the up axis: it projects above the centre.
+        let (c, _) = cam.project(Vec3::new(1.0, 2.0, 3.0)).unwrap();
+        let (u, _) = cam.project(Vec3::new(1.0, 2.0, 3.0) + up.vector()).unwrap();
+        assert!(u.y < c.y && (c.x - 80.0).abs() < 1e-2, "{up:?}: {c} {u}");
+    }
+    let mut one = splatgl::SplatCloud::new(0);
+    one.push([0.0; 3], [0.01; 3], [0.0, 0.0, 0.0, 1.0], 1.0, &[[0.2; 3]]);
+    let cam = Camera::frame_cloud(&one, UpAxis::Y, 0.8, 160, 120).unwrap();
+    let depth = cam.to_camera(Vec3::ZERO).z;
+    assert!(depth - 0.03 > splatgl::profile::NEAR_CULL as f32, "{depth}");
+    // Nothing drawable (zero opacity, NaN position): no framing.
+    let mut none = splatgl::SplatCloud::new(0);
+    none.push([0.0; 3], [1.0; 3], [0.0, 0.0, 0.0, 1.0], 0.0, &[[0.2; 3]]);
+    none.push(
+        [f32::NAN; 3],
+        [1.0; 3],
+        [0.0, 0.0, 0.0, 1.0],
+        1.0,
+        &[[0.2; 3]],
+    );
+    assert!(Camera::frame_cloud(&none, UpAxis::Y, 0.8, 160, 120).is_none());
+}
+
+/// `--up auto`: glTF is +Y up, PLY (COLMAP axes) −Y, the default scene +Y.
+#[test]
+fn auto_up_axis_follows_the_format() {
+    use splatgl::camera::UpAxis;
+    use splatgl::load::Format;
+    assert_eq!(UpAxis::for_format(Some(Format::Glb)), UpAxis::Y);
+    assert_eq!(UpAxis::for_format(Some(Format::Gltf)), UpAxis::Y);
+    assert_eq!(UpAxis::for_format(Some(Format::Ply)), UpAxis::NegY);
+    assert_eq!(UpAxis::for_format(None), UpAxis::Y);
+}

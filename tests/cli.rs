@@ -332,3 +332,66 @@ fn errors_are_reported_not_panics() {
         );
     }
 }
+
+/// The `camera:` line `render` prints on stderr, pasted back, renders the same image; and
+/// `--print-camera-json` writes a cameras.json that does too.
+#[test]
+fn printed_camera_renders_the_same_image() {
+    let cloud = splatgl::scene::random_cloud(300, 1, 1.0, 11);
+    let ply = tmp("printed.ply", &splatgl::write::to_inria_ply(&cloud));
+    let dir = ply.parent().unwrap().to_owned();
+    let out = |n: &str| dir.join(n).to_str().unwrap().to_owned();
+    let base = ["render", ply.to_str().unwrap(), "--backend", "reference"];
+    let size = ["--width", "80", "--height", "60"];
+    let (code, json, err) = splatgl(
+        &[
+            &base[..],
+            &size,
+            &["--print-camera-json", "-o", &out("a.pfm")],
+        ]
+        .concat(),
+    );
+    assert_eq!(code, 0, "{err}");
+    let line = err
+        .lines()
+        .find_map(|l| l.strip_prefix("camera: "))
+        .expect("camera line");
+    let pasted: Vec<&str> = line.split_whitespace().collect();
+    assert_eq!(pasted[0], "--look-at");
+    let (code, _, err) = splatgl(&[&base[..], &pasted, &["-o", &out("b.pfm")]].concat());
+    assert_eq!(code, 0, "{err}");
+    let cams = tmp("printed-cameras.json", json.trim().as_bytes());
+    let c = ["--camera", cams.to_str().unwrap(), "-o"];
+    let (code, _, err) = splatgl(&[&base[..], &c, &[&out("c.pfm")]].concat());
+    assert_eq!(code, 0, "{err}");
+    let a = Image::read(out("a.pfm")).unwrap();
+    for other in ["b.pfm", "c.pfm"] {
+        let b = Image::read(out(other)).unwrap();
+        let s = splatgl::compare::compare(&a, &b, 1.0 / 255.0).unwrap();
+        assert!(s.psnr > 50.0, "{other}: {} dB", s.psnr);
+    }
+}
+
+/// `--look-at` without an up vector takes the scene's up axis: −Y for PLY (as the automatic
+/// framing does), or the `--up` given.
+#[test]
+fn look_at_default_up_is_the_up_axis() {
+    let cloud = splatgl::scene::random_cloud(200, 0, 1.0, 12);
+    let ply = tmp("up.ply", &splatgl::write::to_inria_ply(&cloud));
+    let dir = ply.parent().unwrap().to_owned();
+    let render = |extra: &[&str], name: &str| {
+        let o = dir.join(name);
+        let args = ["render", ply.to_str().unwrap(), "--backend", "reference"];
+        let size = ["--width", "40", "--height", "30", "-o", o.to_str().unwrap()];
+        let (code, _, err) = splatgl(&[&args[..], &size, extra].concat());
+        assert_eq!(code, 0, "{err}");
+        Image::read(&o).unwrap()
+    };
+    let auto = render(&["--look-at", "0.3,0.2,4,0,0,0"], "auto.pfm");
+    let minus_y = render(&["--look-at", "0.3,0.2,4,0,0,0,0,-1,0"], "my.pfm");
+    let plus_y = render(&["--look-at", "0.3,0.2,4,0,0,0", "--up", "y"], "py.pfm");
+    let y_given = render(&["--look-at", "0.3,0.2,4,0,0,0,0,1,0"], "yg.pfm");
+    assert_eq!(auto.pixels, minus_y.pixels);
+    assert_eq!(plus_y.pixels, y_given.pixels);
+    assert_ne!(auto.pixels, plus_y.pixels);
+}

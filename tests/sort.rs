@@ -509,6 +509,14 @@ fn async_sorter_delivers_newest_order() {
     let want = Sorter::new().sort_by_distance(&positions, eyes[9]).to_vec();
     assert_eq!(frame.order(), want.as_slice());
     assert_eq!(frame.request(), Some(SortRequest::distance(eyes[9])));
+    let g = asorter.request(SortRequest::distance(eyes[0]));
+    // `current` keeps the order taken last, even once a newer one has finished.
+    let newer = asorter.wait_for(g).unwrap().generation();
+    assert_eq!(newer, g);
+    assert_eq!(asorter.current().unwrap().generation(), g);
+    asorter.request(SortRequest::distance(eyes[1]));
+    std::thread::sleep(std::time::Duration::from_millis(50));
+    assert_eq!(asorter.current().unwrap().generation(), g);
     // Round trips keep working with recycled buffers.
     for &eye in &eyes[..4] {
         let g = asorter.request(SortRequest::distance(eye));
@@ -516,6 +524,55 @@ fn async_sorter_delivers_newest_order() {
         assert_eq!(f.order(), Sorter::new().sort_by_distance(&positions, eye));
     }
     assert!(asorter.wait_for(1000).is_none(), "never issued");
+}
+
+/// `SortedFrame::exact_radius` (the viewer's staleness bound) is sound for sorted and for
+/// reused orders: any eye within it of the request's eye gets the same order from a fresh sort.
+#[test]
+fn async_exact_radius_is_sound_for_sorted_and_reused_orders() {
+    let mut rng = Rng::new(29);
+    let mut checked = 0;
+    for trial in 0..20 {
+        let positions: Arc<[[f32; 3]]> = random_positions(&mut rng, 40 + trial * 5, 3.0).into();
+        let mut a = AsyncSorter::new(
+            Arc::clone(&positions),
+            Sorter::new().with_reuse(Reuse::MotionBound),
+        )
+        .expect("thread");
+        let eye = [rng.range(-20.0, 20.0), rng.range(-20.0, 20.0), 15.0];
+        let r0 = {
+            let f = a.wait_for(a.request(SortRequest::distance(eye))).unwrap();
+            f.exact_radius()
+        };
+        if r0 == 0.0 {
+            continue;
+        }
+        // A request 0.5 R away is reused; its own radius shrinks by the distance moved.
+        let near = [eye[0] + 0.5 * r0 as f32, eye[1], eye[2]];
+        let f = a.wait_for(a.request(SortRequest::distance(near))).unwrap();
+        assert!(matches!(f.outcome(), Outcome::ReusedWithinBound { .. }));
+        let r1 = f.exact_radius();
+        // (The f32 eye is 0.5 R away to within an f32 ulp of its coordinates.)
+        assert!(r1 > 0.0 && r1 <= 0.5 * r0 + 1e-5, "{r1} vs {r0}");
+        for _ in 0..10 {
+            let d = [
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            ];
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-6);
+            let step = (0.99 * r1) as f32 / l;
+            let moved = [
+                near[0] + d[0] * step,
+                near[1] + d[1] * step,
+                near[2] + d[2] * step,
+            ];
+            let fresh = Sorter::new().sort_by_distance(&positions, moved).to_vec();
+            assert_eq!(fresh.as_slice(), f.order(), "moved within the exact radius");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 50, "only {checked} motions checked");
 }
 
 // ---------------------------------------------------------------- allocations

@@ -121,3 +121,63 @@ pub fn load_cameras_json(
     })?;
     parse_cameras_json(&text)
 }
+
+impl super::Camera {
+    /// This camera as one `cameras.json` entry of the INRIA 3DGS trainer (`id`, `img_name`,
+    /// `width`, `height`, `position`, `rotation` camera → world by rows, `fx`, `fy`; `cx`/`cy`
+    /// only when the principal point is off the image centre). [`super::Camera::from_3dgs`]
+    /// reads it back (its near/far are the trainer's 0.01 / 100).
+    pub fn to_3dgs_json(&self, id: i64, img_name: &str) -> Value {
+        let inv = self.world_to_camera.as_dmat4().inverse();
+        let c2w = glam::DMat3::from_mat4(inv);
+        // Row i of camera → world: element i of each camera axis.
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|i| vec![c2w.x_axis[i], c2w.y_axis[i], c2w.z_axis[i]])
+            .map(|r| r.into_iter().map(|v| v as f32 as f64).collect())
+            .collect();
+        let centre = inv.w_axis.truncate().as_vec3();
+        let mut e = serde_json::json!({
+            "id": id,
+            "img_name": img_name,
+            "width": self.width,
+            "height": self.height,
+            "position": centre.to_array(),
+            "rotation": rows,
+            "fx": self.fx,
+            "fy": self.fy,
+        });
+        let off = |c: f32, size: u32| (c - 0.5 * size as f32).abs() > 1e-4 * size as f32;
+        if off(self.cx, self.width) || off(self.cy, self.height) {
+            e["cx"] = self.cx.into();
+            e["cy"] = self.cy.into();
+        }
+        e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    #[test]
+    fn cameras_json_entry_reads_back_as_the_same_camera() {
+        let mut cam = super::super::Camera::look_at(
+            Vec3::new(0.5, -1.0, 4.0),
+            Vec3::new(0.0, 0.3, 0.0),
+            Vec3::new(0.0, -1.0, 0.0),
+            0.7,
+            400,
+            300,
+        );
+        cam.cx = 190.0;
+        let text = serde_json::to_string(&vec![cam.to_3dgs_json(3, "v")]).unwrap();
+        let e = &super::parse_cameras_json(&text).unwrap()[0];
+        let back = super::super::Camera::from_3dgs(e).unwrap();
+        assert_eq!((back.width, back.height, back.cx), (400, 300, 190.0));
+        assert!((back.fx - cam.fx).abs() < 1e-4 && (back.cy - 150.0).abs() < 1e-6);
+        let d = (back.world_to_camera - cam.world_to_camera)
+            .abs()
+            .to_cols_array();
+        assert!(d.iter().all(|v| *v < 1e-5), "{d:?}");
+    }
+}

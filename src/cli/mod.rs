@@ -3,12 +3,15 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod camera_args;
 mod compare;
 mod conformance;
 mod convert;
 mod info;
 mod render;
 mod validate;
+#[cfg(feature = "viewer")]
+mod view;
 
 /// splatgl: render, inspect and validate 3D Gaussian splat files (glTF KHR_gaussian_splatting,
 /// INRIA PLY, Niantic SPZ, .splat, .ksplat, PlayCanvas SOG).
@@ -41,6 +44,10 @@ enum Command {
     /// Convert a splat file to glTF (.glb/.gltf, KHR_gaussian_splatting RC) or INRIA PLY.
     /// Exit status: 0, or 2 on any error.
     Convert(convert::Args),
+    /// Open a window and fly through a scene (without a scene: the bundled default scene).
+    /// H or F1 in the window prints the controls. Exit status: 0, or 2 on errors.
+    #[cfg(feature = "viewer")]
+    View(view::Args),
     /// The KHR_gaussian_splatting conformance suite: generate it, or run it on images.
     #[command(subcommand)]
     Conformance(conformance::Command),
@@ -93,5 +100,7 @@ pub fn run() -> ExitCode {
         Command::Compare(a) => compare::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Conformance(c) => conformance::run(c),
+        #[cfg(feature = "viewer")]
+        Command::View(a) => view::run(a),
     }
 }

@@ -1,10 +1,9 @@
 //! `splatgl render`: one image of a scene (or of the bundled default scene).
 
-use glam::Vec3;
-use splatgl::SplatCloud;
-use splatgl::camera::{Camera, GltfPerspective, load_cameras_json};
+use super::camera_args::{camera_json_line, floats, look_at_line};
+use splatgl::camera::{Camera, SceneView};
 use splatgl::image::{Image, PngDepth};
-use splatgl::load::{Format, Scene};
+use splatgl::load::Scene;
 use splatgl::reference::{RenderOptions, SortMode};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -47,36 +46,8 @@ pub struct Args {
     /// Scene file (.ply, .gltf, .glb, .spz, .splat, .ksplat, .sog, SOG meta.json). Without it:
     /// the bundled default scene.
     pub scene: Option<PathBuf>,
-    /// 3DGS cameras.json to take the view from (see --view).
-    #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
-    pub camera: Option<PathBuf>,
-    /// Index (0-based, list order) of the view in --camera.
-    #[arg(long, default_value_t = 0, value_name = "N")]
-    pub view: usize,
-    /// Look-at camera: eye, target and optionally up (default 0,1,0).
-    #[arg(
-        long,
-        value_name = "ex,ey,ez,tx,ty,tz[,ux,uy,uz]",
-        allow_hyphen_values = true
-    )]
-    #[arg(conflicts_with = "gltf_camera")]
-    pub look_at: Option<String>,
-    /// Use the N-th glTF camera node of the scene.
-    ///
-    /// Without any camera option the view frames the scene: glTF from +Z with +Y up, PLY
-    /// (COLMAP axes, also SPZ, .splat, .ksplat and SOG) from +Z with −Y up; the default scene
-    /// has its own camera.
-    #[arg(long, value_name = "N")]
-    pub gltf_camera: Option<usize>,
-    /// Image width (default 640, or the cameras.json view's, scaled).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub width: Option<u32>,
-    /// Image height (default 480, or the cameras.json view's, scaled).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub height: Option<u32>,
-    /// Vertical field of view in degrees (look-at and automatic framing).
-    #[arg(long, default_value_t = 50.0, value_name = "DEG")]
-    pub fov: f32,
+    #[command(flatten)]
+    pub cam: super::camera_args::CameraArgs,
     /// Highest SH degree to evaluate (the file's degree caps it).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=3))]
     pub sh_degree: u8,
@@ -106,111 +77,12 @@ pub struct Args {
     pub load: super::LoadArgs,
 }
 
-fn floats(s: &str, what: &str, counts: &[usize]) -> Result<Vec<f32>, String> {
-    let v: Result<Vec<f32>, _> = s.split(',').map(|t| t.trim().parse::<f32>()).collect();
-    match v {
-        Ok(v) if counts.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
-        _ => Err(format!(
-            "{what}: expected {} comma-separated finite numbers, got {s:?}",
-            counts
-                .iter()
-                .map(|c| c.to_string())
-                .collect::<Vec<_>>()
-                .join(" or ")
-        )),
-    }
-}
-
-fn size_or(a: &Args, w: u32, h: u32) -> (u32, u32) {
-    match (a.width, a.height) {
-        (Some(x), Some(y)) => (x, y),
-        (Some(x), None) => (
-            x,
-            ((x as u64 * h as u64 + w as u64 / 2) / w as u64).max(1) as u32,
-        ),
-        (None, Some(y)) => (
-            ((y as u64 * w as u64 + h as u64 / 2) / h as u64).max(1) as u32,
-            y,
-        ),
-        (None, None) => (w, h),
-    }
-}
-
-/// The view: from --camera, --gltf-camera (one of the scene file's `cameras`), --look-at, or
-/// framing `cloud` (read from a file of `format`, `None` for the default scene).
-fn camera(
-    a: &Args,
-    cloud: &SplatCloud,
-    format: Option<Format>,
-    cameras: &[GltfPerspective],
-) -> Result<Camera, String> {
-    let fov = a.fov.to_radians();
-    if !(fov > 0.0 && fov < std::f32::consts::PI) {
-        return Err(format!("--fov {} must be in (0, 180)", a.fov));
-    }
-    if let Some(path) = &a.camera {
-        let list = load_cameras_json(path).map_err(|e| e.to_string())?;
-        let e = list.get(a.view).ok_or_else(|| {
-            format!(
-                "--view {}: {} has {} views",
-                a.view,
-                path.display(),
-                list.len()
-            )
-        })?;
-        let cam = Camera::from_3dgs(e).map_err(|e| e.to_string())?;
-        let (w, h) = size_or(a, cam.width, cam.height);
-        return Ok(cam.resized(w, h));
-    }
-    if let Some(n) = a.gltf_camera {
-        let Some(path) = &a.scene else {
-            return Err("--gltf-camera needs a glTF scene file".into());
-        };
-        if !matches!(format, Some(Format::Gltf | Format::Glb)) {
-            return Err("--gltf-camera needs a .gltf or .glb scene".into());
-        }
-        let g = cameras.get(n).ok_or_else(|| {
-            format!(
-                "--gltf-camera {n}: {} has {} perspective camera node(s)",
-                path.display(),
-                cameras.len()
-            )
-        })?;
-        // Keep the camera's aspect ratio when no size is given.
-        let h = a.height.unwrap_or(480);
-        let w = a.width.unwrap_or_else(|| {
-            g.aspect_ratio
-                .map_or(640, |r| ((h as f32 * r).round() as u32).clamp(1, 16384))
-        });
-        return Camera::from_gltf(g, w, h).map_err(|e| e.to_string());
-    }
-    let (w, h) = size_or(a, 640, 480);
-    if let Some(s) = &a.look_at {
-        let v = floats(s, "--look-at", &[6, 9])?;
-        let up = if v.len() == 9 {
-            Vec3::new(v[6], v[7], v[8])
-        } else {
-            Vec3::Y
-        };
-        let (eye, target) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
-        let fwd = target - eye;
-        if fwd.length() == 0.0 || fwd.cross(up).length() <= 1e-6 * fwd.length() * up.length() {
-            return Err("--look-at: eye = target, or up parallel to the view direction".into());
-        }
-        return Ok(Camera::look_at(eye, target, up, fov, w, h));
-    }
-    if a.scene.is_none() {
-        return Ok(splatgl::scene::default_camera(w, h));
-    }
-    // Every format but glTF is in PLY axes (SPZ is converted to them).
-    let framed = if !matches!(format, Some(Format::Gltf | Format::Glb)) {
-        // INRIA/COLMAP axes: −Y up. Look from +Z, slightly from above (−Y).
-        let fwd = Vec3::new(0.0, 0.35, -1.0);
-        Camera::frame_points_along(&cloud.positions, fwd, -Vec3::Y, fov, w, h)
-    } else {
-        Camera::frame_points(&cloud.positions, fov, w, h)
-    };
-    framed.ok_or_else(|| "the scene has no finite splat to frame; give --look-at".into())
+/// The view (see [`splatgl::camera::ViewOptions::camera`]) and the distance to print its
+/// target at.
+fn camera(a: &Args, scene: SceneView<'_>) -> Result<(Camera, f32), String> {
+    let opts = a.cam.options()?;
+    let cam = opts.camera(scene, (640, 480)).map_err(|e| e.to_string())?;
+    Ok((cam, opts.focus_distance(&cam, scene.cloud)))
 }
 
 fn write(img: &Image, a: &Args) -> Result<(), String> {
@@ -250,7 +122,12 @@ fn go(a: &Args) -> Result<(), String> {
         }
         None => (splatgl::scene::default_scene(), None, Vec::new()),
     };
-    let cam = camera(a, &cloud, format, &cameras)?;
+    let scene = SceneView {
+        cloud: &cloud,
+        format,
+        cameras: &cameras,
+    };
+    let (cam, distance) = camera(a, scene)?;
     // cameras.json sizes and derived sizes are bounded like the flags (an image is 16 bytes
     // per pixel in f32).
     if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
@@ -307,6 +184,10 @@ fn go(a: &Args) -> Result<(), String> {
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;
     write(&img, a)?;
     let visible = visible.map_or(String::new(), |v| format!(" ({v} visible)"));
+    eprintln!("camera: {}", look_at_line(&cam, distance));
+    if a.cam.print_camera_json {
+        println!("{}", camera_json_line(&cam));
+    }
     eprintln!(
         "splatgl render: {} splats{visible}, {}x{}, backend {backend}: render {render_ms:.1} ms, \
          total {:.1} ms -> {}",

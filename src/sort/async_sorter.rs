@@ -8,6 +8,7 @@
 
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use super::{Outcome, SortMode, Sorter};
 use crate::cull::{CullBounds, Frustum};
@@ -51,6 +52,8 @@ pub struct SortedFrame {
     frustum: Option<Frustum>,
     generation: u64,
     outcome: Outcome,
+    exact_radius: f64,
+    sort_time: Duration,
 }
 
 impl SortedFrame {
@@ -61,7 +64,23 @@ impl SortedFrame {
             frustum: None,
             generation: 0,
             outcome: Outcome::None,
+            exact_radius: 0.0,
+            sort_time: Duration::ZERO,
         }
+    }
+
+    /// How far the eye may be from the request's eye with this order still exactly the one a
+    /// fresh sort would return (distance sorts with [`Reuse::MotionBound`](super::Reuse), full
+    /// precision; 0 otherwise or when nothing is provably safe). For a reused order it is the
+    /// sorter's safe radius minus the distance the request's eye had moved from the sorted eye.
+    pub fn exact_radius(&self) -> f64 {
+        self.exact_radius
+    }
+
+    /// Wall time the worker spent on this request (keys, sort and, with
+    /// [`Reuse::MotionBound`](super::Reuse), the safe radius; near zero when reused).
+    pub fn sort_time(&self) -> Duration {
+        self.sort_time
     }
 
     /// Splat indices back to front.
@@ -198,6 +217,7 @@ impl AsyncSorter {
                             st = sh.wake.wait(st).unwrap_or_else(PoisonError::into_inner);
                         }
                     };
+                    let started = Instant::now();
                     let culled = frustum.zip(bounds.as_deref());
                     let order = match (culled, req.mode) {
                         (Some((f, b)), _) => sorter.sort_visible(&positions, b, &f, &req),
@@ -212,6 +232,11 @@ impl AsyncSorter {
                     back.frustum = culled.map(|(f, _)| f);
                     back.generation = generation;
                     back.outcome = sorter.last_outcome();
+                    back.exact_radius = match back.outcome {
+                        Outcome::ReusedWithinBound { moved, radius } => (radius - moved).max(0.0),
+                        _ => sorter.reuse_radius(),
+                    };
+                    back.sort_time = started.elapsed();
                     let mut st = sh.lock();
                     let unread = st.ready.replace(back);
                     back = unread
@@ -263,6 +288,13 @@ impl AsyncSorter {
             st.spare = Some(old);
         }
         drop(st);
+        self.front.as_ref()
+    }
+
+    /// The order the last [`latest`](Self::latest) or [`wait_for`](Self::wait_for) returned,
+    /// without switching to a newer one (so a caller can check an order and then draw that
+    /// same order).
+    pub fn current(&self) -> Option<&SortedFrame> {
         self.front.as_ref()
     }
 

@@ -1,0 +1,304 @@
+//! Default views: which world axis is up ([`UpAxis`]), the extent of a cloud's content
+//! ([`Extent`], from each splat's 3σ box) and a camera that frames it ([`Camera::frame_cloud`]),
+//! and the way back from a camera to a `--look-at` line ([`LookAt`]).
+
+use glam::{Mat3, Quat, Vec3};
+
+use super::Camera;
+use crate::cloud::SplatCloud;
+use crate::load::Format;
+
+/// The world axis that is up in a scene: the orbit axis of the viewer, the default `up` of
+/// `--look-at` and the up of automatic framing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum UpAxis {
+    /// +Y (glTF).
+    Y,
+    /// −Y (COLMAP / INRIA 3DGS training output, and the packed formats derived from it).
+    NegY,
+    /// +Z (CAD, robotics, many scanners).
+    Z,
+}
+
+impl UpAxis {
+    /// The rule for `--up auto`: glTF (`.gltf`, `.glb`) is +Y up by the glTF spec; every other
+    /// format splatgl reads (INRIA and compressed PLY, and the packed formats) stores 3DGS
+    /// training output in COLMAP axes, −Y up. The bundled default scene (`None`) is +Y up.
+    pub fn for_format(format: Option<Format>) -> Self {
+        match format {
+            None | Some(Format::Gltf | Format::Glb) => UpAxis::Y,
+            #[allow(unreachable_patterns)] // formats added later are COLMAP-axis packings
+            Some(_) => UpAxis::NegY,
+        }
+    }
+
+    /// The unit vector.
+    pub fn vector(self) -> Vec3 {
+        match self {
+            UpAxis::Y => Vec3::Y,
+            UpAxis::NegY => -Vec3::Y,
+            UpAxis::Z => Vec3::Z,
+        }
+    }
+
+    /// The command-line spelling: `y`, `-y` or `z`.
+    pub fn name(self) -> &'static str {
+        match self {
+            UpAxis::Y => "y",
+            UpAxis::NegY => "-y",
+            UpAxis::Z => "z",
+        }
+    }
+
+    /// The next axis in the viewer's `U` cycle: +Y → −Y → +Z → +Y.
+    pub fn next(self) -> Self {
+        match self {
+            UpAxis::Y => UpAxis::NegY,
+            UpAxis::NegY => UpAxis::Z,
+            UpAxis::Z => UpAxis::Y,
+        }
+    }
+
+    /// The direction of the default view: from the "front" (+Z for ±Y up, −Y for +Z up),
+    /// looking slightly down (a slope of 0.35 against the up axis). For +Y this is the
+    /// historical `(0, −0.35, −1)`, for −Y `(0, 0.35, −1)`.
+    pub fn default_forward(self) -> Vec3 {
+        let front = match self {
+            UpAxis::Y | UpAxis::NegY => Vec3::Z,
+            UpAxis::Z => -Vec3::Y,
+        };
+        (-front - 0.35 * self.vector()).normalize()
+    }
+}
+
+/// The box a default view frames: per axis, the 1st percentile of the splats' 3σ box minima
+/// and the 99th percentile of their maxima, over the splats that can be drawn (finite position
+/// and scale, opacity ≥ [`ALPHA_MIN`](crate::profile::ALPHA_MIN)). The 3σ box of a splat is
+/// the axis-aligned box of its ellipsoid at three standard deviations (the profile's cut-off),
+/// half-extent `3·sqrt(Σ_j (R_kj s_j)²)` on axis k. Percentiles keep a few stray splats (1 %
+/// on each side) from shrinking the view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extent {
+    /// Lower corner.
+    pub lo: Vec3,
+    /// Upper corner.
+    pub hi: Vec3,
+}
+
+impl Extent {
+    /// The extent of `cloud`'s content; `None` when no splat can be drawn.
+    pub fn of_cloud(cloud: &SplatCloud) -> Option<Self> {
+        let k = crate::profile::CUTOFF_M2.sqrt(); // 3σ
+        let mut lo: [Vec<f32>; 3] = Default::default();
+        let mut hi: [Vec<f32>; 3] = Default::default();
+        for i in 0..cloud.len() {
+            let (p, s) = (cloud.positions[i], cloud.scales[i]);
+            let q = cloud.rotations[i];
+            let drawable = cloud.opacities[i] >= crate::profile::ALPHA_MIN;
+            if !drawable || !p.iter().chain(&s).chain(&q).all(|v| v.is_finite()) {
+                continue;
+            }
+            let r = Mat3::from_quat(Quat::from_array(q).normalize());
+            let m = Mat3::from_cols(r.x_axis * s[0], r.y_axis * s[1], r.z_axis * s[2]);
+            // Half-extent on world axis a: k · |row a of R diag(s)|.
+            let rows = m.transpose();
+            for (a, row) in [rows.x_axis, rows.y_axis, rows.z_axis].iter().enumerate() {
+                let h = k * row.length();
+                lo[a].push(p[a] - h);
+                hi[a].push(p[a] + h);
+            }
+        }
+        let n = lo[0].len();
+        if n == 0 {
+            return None;
+        }
+        let (i0, i1) = ((n - 1) / 100, n - 1 - (n - 1) / 100);
+        let pick = |v: &mut Vec<f32>, i: usize| *v.select_nth_unstable_by(i, f32::total_cmp).1;
+        let [l0, l1, l2] = &mut lo;
+        let [h0, h1, h2] = &mut hi;
+        let lo = Vec3::new(pick(l0, i0), pick(l1, i0), pick(l2, i0));
+        let hi = Vec3::new(pick(h0, i1), pick(h1, i1), pick(h2, i1));
+        // Percentiles taken per side can cross for a near-degenerate axis: keep lo ≤ hi.
+        Some(Extent {
+            lo: lo.min(hi),
+            hi: lo.max(hi),
+        })
+    }
+
+    /// Centre of the box.
+    pub fn centre(&self) -> Vec3 {
+        0.5 * (self.lo + self.hi)
+    }
+
+    /// Radius of the box's bounding sphere (half its diagonal).
+    pub fn radius(&self) -> f32 {
+        0.5 * (self.hi - self.lo).length()
+    }
+}
+
+impl Camera {
+    /// The default view of a cloud: looking along [`UpAxis::default_forward`] with `up` up,
+    /// at the centre of its [`Extent`], from [`Camera::frame_extent_along`]'s distance.
+    /// `None` when no splat can be drawn.
+    pub fn frame_cloud(
+        cloud: &SplatCloud,
+        up: UpAxis,
+        fov_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        let extent = Extent::of_cloud(cloud)?;
+        Self::frame_extent_along(
+            &extent,
+            up.default_forward(),
+            up.vector(),
+            fov_y,
+            width,
+            height,
+        )
+    }
+
+    /// A camera looking along `forward` (`up` roughly up) at the centre of `extent`, far
+    /// enough that the box's bounding sphere fits the smaller field of view with a 10 % margin,
+    /// so the eye is outside the box; and at least 1.5 × the near cull
+    /// ([`NEAR_CULL`](crate::profile::NEAR_CULL)) in front of the sphere, so tiny content is
+    /// not culled. An extent without size (coincident points of zero scale) is framed as a unit
+    /// sphere. `None` when `forward ∥ up`.
+    pub fn frame_extent_along(
+        extent: &Extent,
+        forward: Vec3,
+        up: Vec3,
+        fov_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        if forward.cross(up).length_squared() <= 1e-12 {
+            return None;
+        }
+        let centre = extent.centre();
+        let half = extent.radius();
+        let radius = if half > 1e-6 { half } else { 1.0 };
+        let tan_y = (0.5 * fov_y).tan();
+        let tan_min = tan_y.min(tan_y * width as f32 / height.max(1) as f32);
+        let fit = 1.1 * radius / tan_min.atan().sin();
+        let dist = fit.max(radius + 1.5 * crate::profile::NEAR_CULL as f32);
+        let eye = centre - forward.normalize() * dist;
+        let mut cam = Self::look_at(eye, centre, up, fov_y, width, height);
+        cam.far = (dist + 2.0 * radius).max(cam.far);
+        Some(cam)
+    }
+
+    /// The distance to focus on `point`: its depth along the view axis, or (when it is not in
+    /// front of the camera) its distance, at least 1. The viewer's pivot distance and the
+    /// target distance of a printed `--look-at`.
+    pub fn focus_distance_to(&self, point: Vec3) -> f32 {
+        let z = self.to_camera(point).z;
+        if z > 1e-3 {
+            z
+        } else {
+            (point - self.eye()).length().max(1.0)
+        }
+    }
+
+    /// This camera as `--look-at` values: its eye, the point `distance` in front of it on the
+    /// optical axis as target, its image "up" (−y of the OpenCV axes) and its vertical field of
+    /// view. See [`LookAt`] for when this is exact.
+    pub fn as_look_at(&self, distance: f32) -> LookAt {
+        let inv = self.world_to_camera.inverse();
+        let eye = inv.w_axis.truncate();
+        let forward = inv.z_axis.truncate().normalize();
+        let up = -inv.y_axis.truncate().normalize();
+        let fov_y_deg = (2.0 * (0.5 * self.height as f32 / self.fy).atan()).to_degrees();
+        let rel = |a: f32, b: f32| (a - b).abs() <= 1e-4 * b.abs().max(1.0);
+        LookAt {
+            eye,
+            target: eye + forward * distance.max(1e-3),
+            up,
+            fov_y_deg,
+            width: self.width,
+            height: self.height,
+            exact: rel(self.fx, self.fy)
+                && rel(self.cx, 0.5 * self.width as f32)
+                && rel(self.cy, 0.5 * self.height as f32),
+        }
+    }
+}
+
+/// A camera written as the `--look-at … --fov … --width … --height …` options of
+/// `splatgl render` / `splatgl view` (its `Display`). `exact` is false when the camera has
+/// `fx ≠ fy` or an off-centre principal point, which a look-at cannot express: the line then
+/// gives the same pose and vertical field of view only (a `cameras.json` entry is exact).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LookAt {
+    /// Eye.
+    pub eye: Vec3,
+    /// Target.
+    pub target: Vec3,
+    /// Up (perpendicular to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_deg: f32,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Whether `Camera::look_at` of these values gives back the same intrinsics.
+    pub exact: bool,
+}
+
+impl std::fmt::Display for LookAt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
+        write!(
+            f,
+            "--look-at {},{},{} --fov {} --width {} --height {}",
+            v(self.eye),
+            v(self.target),
+            v(self.up),
+            self.fov_y_deg,
+            self.width,
+            self.height
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn look_at_line_rebuilds_the_camera() {
+        let cam = Camera::look_at(
+            Vec3::new(1.0, -2.0, 3.5),
+            Vec3::new(0.1, 0.2, -0.3),
+            Vec3::new(0.0, -1.0, 0.2),
+            0.8,
+            320,
+            200,
+        );
+        let l = cam.as_look_at(2.0);
+        assert!(l.exact);
+        let back = Camera::look_at(
+            l.eye,
+            l.target,
+            l.up,
+            l.fov_y_deg.to_radians(),
+            l.width,
+            l.height,
+        );
+        let d = (back.world_to_camera - cam.world_to_camera)
+            .abs()
+            .to_cols_array();
+        assert!(d.iter().all(|e| *e < 1e-5), "{d:?}");
+        assert!((back.fy - cam.fy).abs() < 1e-3 * cam.fy);
+    }
+
+    #[test]
+    fn default_forward_is_the_historical_one_for_y_and_minus_y() {
+        let y = UpAxis::Y.default_forward();
+        let ny = UpAxis::NegY.default_forward();
+        assert!((y - Vec3::new(0.0, -0.35, -1.0).normalize()).length() < 1e-6);
+        assert!((ny - Vec3::new(0.0, 0.35, -1.0).normalize()).length() < 1e-6);
+        assert!(UpAxis::Z.default_forward().dot(Vec3::Z) < 0.0);
+    }
+}

@@ -1,0 +1,418 @@
+//! The event loop: the window and its context, events → controls and commands, background
+//! loads (installed when they finish; a failure keeps the previous scene).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use glam::Vec3;
+use winit::application::ApplicationHandler;
+use winit::dpi::LogicalSize;
+use winit::event::{MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::keyboard::PhysicalKey;
+use winit::window::{Fullscreen, Window, WindowId};
+
+use super::controls::Controls;
+use super::draw::Targets;
+use super::frame::BenchRun;
+use super::loading::{LoadEvent, Loaded, display_name, spawn};
+use super::order::Orders;
+use super::rig::Rig;
+use super::stats::Stats;
+use super::surface::GlSurfaceWindow;
+use super::{ViewerError, ViewerOptions};
+use crate::camera::{Camera, CamerasJsonEntry, Extent, GltfPerspective, SceneView, UpAxis};
+use crate::gl::{DrawSettings, SplatRenderer};
+use crate::load::{Format, LoadOptions};
+
+/// Events from other threads.
+#[derive(Debug)]
+pub(super) enum UserEvent {
+    /// From a loading thread.
+    Load(LoadEvent),
+    /// A path chosen in the `O` dialog (or typed on stdin).
+    Open(PathBuf),
+}
+
+/// The scene on screen.
+pub(super) struct Shown {
+    pub name: String,
+    pub path: Option<PathBuf>,
+    pub len: usize,
+    pub file_len: usize,
+    pub sh_degree: u8,
+    pub cameras: Vec<GltfPerspective>,
+    pub extent: Option<Extent>,
+    pub orders: Orders,
+    /// Generation of the order in the renderer's buffer.
+    pub uploaded: Option<u64>,
+    pub up: UpAxis,
+    pub home: Rig,
+}
+
+/// The viewer's state.
+pub(super) struct App {
+    pub opts: ViewerOptions,
+    load_opts: Arc<LoadOptions>,
+    pub proxy: EventLoopProxy<UserEvent>,
+    pub win: Option<GlSurfaceWindow>,
+    pub renderer: Option<SplatRenderer>,
+    pub targets: Targets,
+    pub shown: Option<Shown>,
+    pub rig: Option<Rig>,
+    pub controls: Controls,
+    pub settings: DrawSettings,
+    pub stats: Stats,
+    pub bench: Option<BenchRun>,
+    load_id: u64,
+    pub loading_name: String,
+    /// Progress of the load under way (title).
+    pub status: Option<String>,
+    /// The last error, shown in the title for a few seconds.
+    pub message: Option<(String, Instant)>,
+    pub screenshot: bool,
+    pub camera_index: usize,
+    pub json_cameras: Vec<CamerasJsonEntry>,
+    pub last_frame: Option<Instant>,
+    pub last_title: Option<Instant>,
+    pub frames_shown: u64,
+    pub prev_eye: Option<Vec3>,
+    /// The last frame wants a next one without new input.
+    pub animating: bool,
+    pub dialog_open: Arc<AtomicBool>,
+    pub result: Result<(), ViewerError>,
+}
+
+pub(super) fn run(opts: ViewerOptions) -> Result<(), ViewerError> {
+    let json_cameras = opts.view.cameras_json_entries()?;
+    let event_loop = EventLoop::<UserEvent>::with_user_event()
+        .build()
+        .map_err(|e| ViewerError::Window(e.to_string()))?;
+    event_loop.set_control_flow(ControlFlow::Wait);
+    let mut app = App {
+        load_opts: Arc::new(opts.load),
+        // (Struct update: DrawSettings may gain fields, e.g. state restoring.)
+        settings: DrawSettings {
+            sh_degree: Some(opts.sh_degree),
+            ..DrawSettings::default()
+        },
+        opts: ViewerOptions {
+            load: Default::default(),
+            ..opts
+        },
+        proxy: event_loop.create_proxy(),
+        win: None,
+        renderer: None,
+        targets: Targets::default(),
+        shown: None,
+        rig: None,
+        controls: Controls::default(),
+        stats: Stats::default(),
+        bench: None,
+        load_id: 0,
+        loading_name: String::new(),
+        status: None,
+        message: None,
+        screenshot: false,
+        camera_index: 0,
+        json_cameras,
+        last_frame: None,
+        last_title: None,
+        frames_shown: 0,
+        prev_eye: None,
+        animating: false,
+        dialog_open: Arc::new(AtomicBool::new(false)),
+        result: Ok(()),
+    };
+    app.settings.depth_test = false; // the viewer has no depth buffer to test against
+    app.targets.force_rgba8 = app.opts.target == super::TargetChoice::Rgba8;
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| ViewerError::Window(e.to_string()))?;
+    app.result
+}
+
+impl App {
+    /// The window's initial logical size: --width/--height, else the cameras.json view's,
+    /// else 1280 × 720 (a missing side from the other's aspect ratio).
+    fn window_size(&self) -> (u32, u32) {
+        let v = &self.opts.view;
+        match self.json_cameras.get(v.view) {
+            Some(e) if v.width.is_none() && v.height.is_none() => (e.width, e.height),
+            _ => v.size_or(1280, 720),
+        }
+    }
+
+    /// The image size: the window's pixels × --resolution-scale.
+    pub fn render_size(&self) -> (u32, u32) {
+        let s = self.win.as_ref().map_or((1, 1), |w| {
+            let p = w.window.inner_size();
+            (p.width, p.height)
+        });
+        let k = self.opts.resolution_scale;
+        let f = |v: u32| ((v as f32 * k).round() as u32).max(1);
+        (f(s.0), f(s.1))
+    }
+
+    /// Stops with an error.
+    pub fn fail(&mut self, el: &ActiveEventLoop, e: ViewerError) {
+        self.result = Err(e);
+        el.exit();
+    }
+
+    /// Starts loading `path` (`None`: the default scene) in the background.
+    pub fn start_load(&mut self, path: Option<PathBuf>) {
+        self.load_id += 1;
+        self.loading_name = display_name(path.as_deref());
+        self.status = Some(format!("loading {}", self.loading_name));
+        eprintln!("loading {}", self.loading_name);
+        let proxy = self.proxy.clone();
+        let send = move |ev| {
+            // The loop is gone only while exiting: nothing to report to.
+            let _ = proxy.send_event(UserEvent::Load(ev));
+        };
+        let opts = Arc::clone(&self.load_opts);
+        spawn(self.load_id, path, opts, self.opts.max_splats, send);
+        self.update_title(true);
+    }
+
+    /// Reports a failed load; without a scene to keep it ends the viewer.
+    fn load_failed(&mut self, el: &ActiveEventLoop, msg: String) {
+        self.status = None;
+        if self.shown.is_none() {
+            self.fail(el, ViewerError::Load(msg));
+            return;
+        }
+        eprintln!(
+            "error: {msg} (keeping {})",
+            self.shown.as_ref().map_or("", |s| &s.name)
+        );
+        self.message = Some((format!("error: {msg}"), Instant::now()));
+        self.update_title(true);
+    }
+
+    /// The first camera of a scene: the command-line options for the first file, a framing
+    /// with the scene's up axis for later ones; and the pivot distance.
+    fn first_camera(&self, l: &Loaded, up: UpAxis) -> Result<(Camera, f32), String> {
+        let (w, h) = self.render_size();
+        if self.shown.is_none() {
+            let mut v = self.opts.view.clone();
+            (v.width, v.height) = (Some(w), Some(h));
+            let scene = SceneView {
+                cloud: &l.cloud,
+                format: l.format,
+                cameras: &l.cameras,
+            };
+            let cam = v.camera(scene, (w, h)).map_err(|e| e.to_string())?;
+            return Ok((cam, v.focus_distance(&cam, &l.cloud)));
+        }
+        let fov = self
+            .rig
+            .map_or(self.opts.view.fov_deg.to_radians(), |r| r.fov_y());
+        let cam = Camera::frame_cloud(&l.cloud, up, fov, w, h)
+            .ok_or("no splat that can be drawn, nothing to frame")?;
+        let focus = Extent::of_cloud(&l.cloud).map_or(1.0, |e| cam.focus_distance_to(e.centre()));
+        Ok((cam, focus))
+    }
+
+    /// Shows a loaded scene (or keeps the previous one when it cannot be shown).
+    fn install(&mut self, el: &ActiveEventLoop, l: Loaded) {
+        let name = l.name();
+        let up = self.opts.view.up_for(l.format);
+        let (cam, focus) = match self.first_camera(&l, up) {
+            Ok(c) => c,
+            Err(e) if self.shown.is_none() => {
+                return self.fail(el, ViewerError::Load(format!("{name}: {e}")));
+            }
+            Err(e) => return self.load_failed(el, format!("{name}: {e}")),
+        };
+        let positions: Arc<[[f32; 3]]> = l.cloud.positions.as_slice().into();
+        let tau = self.opts.stale.tolerance(&l.cloud);
+        let orders = match Orders::new(positions, tau, self.opts.sort_sync) {
+            Ok(o) => o,
+            Err(e) => return self.load_failed(el, format!("{name}: sorter thread: {e}")),
+        };
+        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+            return;
+        };
+        if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
+            return self.load_failed(el, format!("{name}: {e}"));
+        }
+        for w in &l.warnings {
+            eprintln!("warning: {w}");
+        }
+        let extent = Extent::of_cloud(&l.cloud);
+        let rig = Rig::from_camera(&cam, focus, up.vector());
+        self.controls.fly_speed = extent.map_or(1.0, |e| (0.5 * e.radius()).max(0.05));
+        self.controls.stop();
+        let budget = if l.cloud.len() < l.file_len {
+            format!(" (of {}, --max-splats)", l.file_len)
+        } else {
+            String::new()
+        };
+        let format = l.format.map_or("built in", Format::name);
+        println!(
+            "loaded: {name}: {} splats{budget}, SH degree {}, {format}, up {}, stale tolerance {tau}",
+            l.cloud.len(),
+            l.cloud.sh_degree,
+            up.name()
+        );
+        self.shown = Some(Shown {
+            name,
+            path: l.path,
+            len: l.cloud.len(),
+            file_len: l.file_len,
+            sh_degree: l.cloud.sh_degree,
+            cameras: l.cameras,
+            extent,
+            orders,
+            uploaded: None,
+            up,
+            home: rig,
+        });
+        self.rig = Some(rig);
+        self.camera_index = 0;
+        self.frames_shown = 0;
+        self.prev_eye = None;
+        if let Some(b) = self.opts.bench.filter(|_| self.bench.is_none()) {
+            self.bench = Some(BenchRun::new(b, rig));
+        }
+        self.update_title(true);
+        self.request_redraw();
+    }
+
+    pub fn request_redraw(&self) {
+        if let Some(w) = &self.win {
+            w.window.request_redraw();
+        }
+    }
+
+    /// A window event (also the test hook's injected `DroppedFile`).
+    pub fn handle(&mut self, el: &ActiveEventLoop, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => el.exit(),
+            WindowEvent::Resized(_) => {
+                if let Some(w) = &self.win {
+                    w.resize();
+                }
+                self.request_redraw();
+            }
+            WindowEvent::RedrawRequested => self.frame(el),
+            WindowEvent::DroppedFile(p) => {
+                println!("open: {}", p.display());
+                self.start_load(Some(p));
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                let PhysicalKey::Code(code) = event.physical_key else {
+                    return;
+                };
+                if self.controls.key(code, event.state) {
+                    self.request_redraw();
+                } else if event.state.is_pressed() && !event.repeat {
+                    self.command(el, code, &event.logical_key);
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                // In image pixels (the window's × --resolution-scale), like the camera.
+                let k = self.opts.resolution_scale;
+                let p = glam::Vec2::new(position.x as f32, position.y as f32) * k;
+                self.controls.cursor_moved(p);
+                self.request_redraw();
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                self.controls.button(button, state);
+                self.request_redraw();
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                self.controls.wheel(notches);
+                self.request_redraw();
+            }
+            _ => {}
+        }
+    }
+
+    /// The test hook: a file "dropped" through [`App::handle`] after a few frames.
+    pub fn test_drop(&mut self, el: &ActiveEventLoop) {
+        if self.shown.is_some()
+            && self.frames_shown >= 3
+            && let Some(p) = self.opts.test_drop.take()
+        {
+            self.handle(el, WindowEvent::DroppedFile(p));
+        }
+    }
+}
+
+impl ApplicationHandler<UserEvent> for App {
+    fn resumed(&mut self, el: &ActiveEventLoop) {
+        if self.win.is_some() {
+            return;
+        }
+        let (w, h) = self.window_size();
+        let mut attrs = Window::default_attributes()
+            .with_title("splatgl")
+            .with_inner_size(LogicalSize::new(w, h));
+        if self.opts.fullscreen {
+            attrs = attrs.with_fullscreen(Some(Fullscreen::Borderless(None)));
+        }
+        let win = match GlSurfaceWindow::new(el, attrs, self.opts.vsync) {
+            Ok(w) => w,
+            Err(e) => return self.fail(el, ViewerError::Window(e)),
+        };
+        match SplatRenderer::new(&win.gl) {
+            Ok(r) => self.renderer = Some(r),
+            Err(e) => return self.fail(el, e.into()),
+        }
+        eprintln!("GL: {}", win.info());
+        self.win = Some(win);
+        self.start_load(self.opts.file.clone());
+    }
+
+    fn user_event(&mut self, el: &ActiveEventLoop, event: UserEvent) {
+        match event {
+            UserEvent::Load(LoadEvent::Progress { id, done, total }) if id == self.load_id => {
+                let pct = (100 * done).checked_div(total).unwrap_or(100);
+                self.status = Some(format!("loading {} {pct}%", self.loading_name));
+                self.progress_line(pct);
+                self.update_title(true);
+            }
+            UserEvent::Load(LoadEvent::Decoding { id }) if id == self.load_id => {
+                self.status = Some(format!("decoding {}", self.loading_name));
+                self.progress_line(100);
+                self.update_title(true);
+            }
+            UserEvent::Load(LoadEvent::Done { id, result }) if id == self.load_id => {
+                self.status = None;
+                match result {
+                    Ok(l) => self.install(el, *l),
+                    Err(msg) => self.load_failed(el, msg),
+                }
+            }
+            UserEvent::Load(_) => {} // a load superseded by a newer one
+            UserEvent::Open(p) => self.start_load(Some(p)),
+        }
+    }
+
+    fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        self.handle(el, event);
+    }
+
+    fn about_to_wait(&mut self, _el: &ActiveEventLoop) {
+        let hook = self.opts.test_drop.is_some() && self.shown.is_some();
+        if self.animating || self.bench.is_some() || self.screenshot || hook {
+            self.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _el: &ActiveEventLoop) {
+        if let (Some(win), Some(r)) = (&self.win, &mut self.renderer) {
+            r.destroy(&win.gl);
+            self.targets.destroy(&win.gl);
+        }
+    }
+}

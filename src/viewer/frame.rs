@@ -1,0 +1,255 @@
+//! One frame: controls (or the benchmark's orbit) → camera → order (staleness bound) → upload
+//! if it changed → draw → screenshot → prefetch the next sort → swap; and the title bar.
+
+use std::io::{IsTerminal, Write};
+use std::time::{Duration, Instant};
+
+use glow::HasContext;
+use winit::event_loop::ActiveEventLoop;
+
+use super::app::App;
+use super::order::Freshness;
+use super::rig::Rig;
+use super::stats::BenchLog;
+use super::{Bench, ViewerError};
+
+/// Frames drawn before `--bench-frames` starts measuring (upload, first sort, shader warm-up).
+const BENCH_WARMUP: usize = 2;
+
+/// A `--bench-frames` run.
+#[derive(Debug)]
+pub(super) struct BenchRun {
+    spec: Bench,
+    home: Rig,
+    done: usize,
+    last_end: Option<Instant>,
+    log: BenchLog,
+}
+
+impl BenchRun {
+    pub fn new(spec: Bench, home: Rig) -> Self {
+        BenchRun {
+            spec,
+            home,
+            done: 0,
+            last_end: None,
+            log: BenchLog::default(),
+        }
+    }
+
+    /// The camera of frame `i`: one full turn around the up axis through the pivot over the
+    /// measured frames (`--orbit`), else the initial camera.
+    fn rig(&self) -> Rig {
+        let mut r = self.home;
+        if self.spec.orbit {
+            let i = self.done.saturating_sub(BENCH_WARMUP) as f32;
+            r.orbit(
+                std::f32::consts::TAU * i / self.spec.frames.max(1) as f32,
+                0.0,
+            );
+        }
+        r
+    }
+}
+
+/// Thousands separators: 152746 → "152,746".
+pub fn thousands(n: usize) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+impl App {
+    /// Draws one frame (on `RedrawRequested`).
+    pub fn frame(&mut self, el: &ActiveEventLoop) {
+        if let Err(e) = self.draw_frame(el) {
+            self.fail(el, e);
+        }
+        self.test_drop(el);
+    }
+
+    fn draw_frame(&mut self, el: &ActiveEventLoop) -> Result<(), ViewerError> {
+        let now = Instant::now();
+        let dt = self
+            .last_frame
+            .map_or(0.0, |t| now.duration_since(t).as_secs_f32());
+        self.last_frame = Some(now);
+        let render = self.render_size();
+        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+            return Ok(());
+        };
+        let size = win.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(());
+        }
+        let window = (size.width, size.height);
+        let gl = &win.gl;
+        let (Some(shown), Some(rig)) = (&mut self.shown, &mut self.rig) else {
+            // Nothing loaded yet: the background, and the title says what is loading.
+            let bg = self.opts.background;
+            // SAFETY: clearing the default framebuffer.
+            unsafe {
+                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+                gl.viewport(0, 0, window.0 as i32, window.1 as i32);
+                gl.clear_color(bg[0], bg[1], bg[2], 1.0);
+                gl.clear(glow::COLOR_BUFFER_BIT);
+            }
+            return win.swap().map_err(ViewerError::Window);
+        };
+        let moving = match &self.bench {
+            Some(b) => {
+                *rig = b.rig();
+                b.spec.orbit
+            }
+            None => self.controls.update(rig, dt, render),
+        };
+        let cam = rig.camera(render.0, render.1);
+        let eye = cam.eye();
+        let Some((order, fresh)) = shown.orders.for_frame(eye) else {
+            return Err(ViewerError::Window("the sorter thread stopped".into()));
+        };
+        let sort_time = order.sort_time();
+        if shown.uploaded != Some(order.generation()) {
+            renderer.set_order(gl, order.order())?;
+            shown.uploaded = Some(order.generation());
+        }
+        // Prefetch, before drawing so the sort overlaps the draw: sort for where the camera
+        // will be next frame (linear prediction), so the next frame finds a close order.
+        let next = match self.prev_eye {
+            Some(p) if moving => eye + (eye - p),
+            _ => eye,
+        };
+        shown.orders.request(next);
+        self.prev_eye = Some(eye);
+        let bg = self.opts.background;
+        self.targets
+            .draw(gl, renderer, &cam, &self.settings, bg, window)?;
+        if std::mem::take(&mut self.screenshot) {
+            let img = super::draw::read_back_buffer(gl, window.0, window.1);
+            let path = screenshot_name();
+            match img.write_png(&path, crate::image::PngDepth::Eight, false) {
+                Ok(()) => println!("screenshot: {} ({}x{})", path.display(), window.0, window.1),
+                Err(e) => eprintln!("error: screenshot {}: {e}", path.display()),
+            }
+        }
+        win.swap().map_err(ViewerError::Window)?;
+        self.frames_shown += 1;
+        self.animating = moving || matches!(fresh, Freshness::Stale { .. });
+        let frame_time = Duration::from_secs_f32(dt);
+        self.stats.push(now, frame_time, sort_time, fresh);
+        if let Some(b) = &mut self.bench {
+            // SAFETY: glFinish has no preconditions: the frame is complete when timed.
+            unsafe { gl.finish() };
+            let end = Instant::now();
+            if b.done >= BENCH_WARMUP
+                && let Some(last) = b.last_end
+            {
+                b.log.push(end - last, sort_time, fresh);
+            }
+            b.last_end = Some(end);
+            b.done += 1;
+            if b.done >= b.spec.frames + BENCH_WARMUP {
+                let what = format!(
+                    "{} ({} splats, {}x{}{})",
+                    shown.name,
+                    thousands(shown.len),
+                    render.0,
+                    render.1,
+                    if b.spec.orbit { ", orbit" } else { ", still" }
+                );
+                println!("{}", b.log.report(&what, &win.info()));
+                el.exit();
+            }
+        }
+        self.update_title(false);
+        Ok(())
+    }
+
+    /// Sets the title (at most every 250 ms unless `now`): file, splats, SH degree, frame
+    /// and sort times, order freshness, mode; a load in progress; the last error.
+    pub fn update_title(&mut self, now: bool) {
+        let due = self
+            .last_title
+            .is_none_or(|t| t.elapsed() >= Duration::from_millis(250));
+        if !(now || due) {
+            return;
+        }
+        self.last_title = Some(Instant::now());
+        let mut t = String::from("splatgl");
+        if let Some(s) = &self.shown {
+            t += &format!(" — {} — {} splats", s.name, thousands(s.len));
+            if s.len < s.file_len {
+                t += &format!(" of {}", thousands(s.file_len));
+            }
+            let d = self.settings.sh_degree.unwrap_or(3).min(s.sh_degree);
+            t += &format!(" — SH {d}/{} — {}", s.sh_degree, self.stats.title_part());
+            if self.controls.mode == super::controls::Mode::Fly {
+                t += " — fly";
+            }
+        }
+        if let Some(st) = &self.status {
+            t += &format!(" — {st}");
+        }
+        if let Some((m, at)) = &self.message
+            && at.elapsed() < Duration::from_secs(8)
+        {
+            t += &format!(" — {m}");
+        }
+        if let Some(w) = &self.win {
+            w.window.set_title(&t);
+        }
+    }
+
+    /// The terminal progress bar (on a terminal only; the title shows it anyway).
+    pub fn progress_line(&self, pct: u64) {
+        let mut err = std::io::stderr();
+        if !err.is_terminal() {
+            return;
+        }
+        let filled = (pct.min(100) / 5) as usize;
+        let bar = format!("{}{}", "#".repeat(filled), "-".repeat(20 - filled));
+        let _ = write!(err, "\r{} [{bar}] {pct:3}%", self.loading_name);
+        if pct >= 100 {
+            let _ = writeln!(err);
+        }
+        let _ = err.flush();
+    }
+}
+
+/// `splatgl-YYYYMMDD-HHMMSS-mmm.png` (UTC) in the current directory.
+fn screenshot_name() -> std::path::PathBuf {
+    let t = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap_or_default();
+    let secs = t.as_secs();
+    let (days, rem) = ((secs / 86_400) as i64, secs % 86_400);
+    // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    let (hh, mm, ss) = (rem / 3600, rem / 60 % 60, rem % 60);
+    let ms = t.subsec_millis();
+    format!("splatgl-{y:04}{m:02}{d:02}-{hh:02}{mm:02}{ss:02}-{ms:03}.png").into()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn thousands_separators() {
+        assert_eq!(super::thousands(152_746), "152,746");
+        assert_eq!(super::thousands(999), "999");
+        assert_eq!(super::thousands(1_000_000), "1,000,000");
+    }
+}

@@ -1,0 +1,166 @@
+//! Loading scenes on a background thread: the file is read in 1 MiB chunks (progress in
+//! bytes), then decoded by [`load_bytes`] (reported as "decoding"), then cut to the
+//! `--max-splats` budget. The window keeps drawing the previous scene meanwhile.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::camera::GltfPerspective;
+use crate::cloud::SplatCloud;
+use crate::load::{Format, LoadOptions, load_bytes};
+
+/// A scene ready to show.
+#[derive(Debug)]
+pub struct Loaded {
+    /// The file (`None`: the bundled default scene).
+    pub path: Option<PathBuf>,
+    /// The splats (after the budget).
+    pub cloud: SplatCloud,
+    /// Splats in the file.
+    pub file_len: usize,
+    /// The file's format (`None`: the default scene).
+    pub format: Option<Format>,
+    /// The file's glTF camera nodes.
+    pub cameras: Vec<GltfPerspective>,
+    /// The loader's warnings, summarised.
+    pub warnings: Vec<String>,
+}
+
+impl Loaded {
+    /// The name shown in the title: the file name, or "default scene".
+    pub fn name(&self) -> String {
+        display_name(self.path.as_deref())
+    }
+}
+
+/// The file name of `path` (or "default scene").
+pub fn display_name(path: Option<&Path>) -> String {
+    match path {
+        Some(p) => p
+            .file_name()
+            .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into()),
+        None => "default scene".into(),
+    }
+}
+
+/// What the loading thread reports.
+#[derive(Debug)]
+pub enum LoadEvent {
+    /// `done` of `total` bytes read.
+    Progress {
+        /// The load's id.
+        id: u64,
+        /// Bytes read.
+        done: u64,
+        /// File size.
+        total: u64,
+    },
+    /// Reading finished; decoding.
+    Decoding {
+        /// The load's id.
+        id: u64,
+    },
+    /// Finished.
+    Done {
+        /// The load's id.
+        id: u64,
+        /// The scene, or the error message (naming the file).
+        result: Result<Box<Loaded>, String>,
+    },
+}
+
+/// Starts loading `path` (`None`: the bundled default scene) on a new thread; `send` delivers
+/// its events (throttled progress, then exactly one `Done`).
+pub fn spawn(
+    id: u64,
+    path: Option<PathBuf>,
+    opts: Arc<LoadOptions>,
+    max_splats: Option<usize>,
+    send: impl Fn(LoadEvent) + Send + 'static,
+) {
+    let body = move || {
+        let result = load(id, path, &opts, max_splats, &send);
+        send(LoadEvent::Done { id, result });
+    };
+    if let Err(e) = std::thread::Builder::new()
+        .name("splatgl-load".into())
+        .spawn(body)
+    {
+        eprintln!("error: cannot start the loading thread: {e}");
+    }
+}
+
+fn load(
+    id: u64,
+    path: Option<PathBuf>,
+    opts: &LoadOptions,
+    max_splats: Option<usize>,
+    send: &impl Fn(LoadEvent),
+) -> Result<Box<Loaded>, String> {
+    let (cloud, format, cameras, warnings) = match &path {
+        None => (crate::scene::default_scene(), None, Vec::new(), Vec::new()),
+        Some(p) => {
+            let bytes = read_with_progress(id, p, send)?;
+            send(LoadEvent::Decoding { id });
+            let scene = load_bytes(&bytes, Some(p), opts).map_err(|e| e.to_string())?;
+            let warnings = scene.report.summarized_warnings();
+            (
+                scene.cloud,
+                Some(scene.report.format),
+                scene.cameras,
+                warnings,
+            )
+        }
+    };
+    if cloud.is_empty() {
+        return Err(format!(
+            "{}: no splats to show",
+            display_name(path.as_deref())
+        ));
+    }
+    let file_len = cloud.len();
+    let cloud = match max_splats.and_then(|n| super::budget::subset(&cloud, n)) {
+        Some(s) => s,
+        None => cloud,
+    };
+    Ok(Box::new(Loaded {
+        path,
+        cloud,
+        file_len,
+        format,
+        cameras,
+        warnings,
+    }))
+}
+
+/// Reads a file in 1 MiB chunks, reporting progress at most every 100 ms.
+fn read_with_progress(id: u64, p: &Path, send: &impl Fn(LoadEvent)) -> Result<Vec<u8>, String> {
+    let err = |e: std::io::Error| format!("{}: {e}", p.display());
+    let mut f = std::fs::File::open(p).map_err(err)?;
+    let total = f.metadata().map_err(err)?.len();
+    // The size is a hint only (special files report 0); the vector grows as needed.
+    let mut bytes = Vec::with_capacity(total.min(1 << 32) as usize);
+    let mut chunk = vec![0u8; 1 << 20];
+    let mut last = Instant::now();
+    loop {
+        let n = match f.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(err(e)),
+        };
+        bytes.extend_from_slice(&chunk[..n]);
+        if last.elapsed() >= Duration::from_millis(100) {
+            last = Instant::now();
+            let done = bytes.len() as u64;
+            send(LoadEvent::Progress {
+                id,
+                done,
+                total: total.max(done),
+            });
+        }
+    }
+    Ok(bytes)
+}
