@@ -14,12 +14,12 @@ use splatgl::cull::CullBounds;
 /// footprint `[u, v, a, b, c, opacity]` with Mahalanobis² extent `k2` (the rectangle along
 /// Σ''s eigenvectors, half-axes `min(QUAD_AXIS_FACTOR·√(k2·λ) + margin, ⌈√(k2·λ₁')⌉)`, as in
 /// `glsl/splat_project.glsl`).
-fn quad_pixels(f: &[f32; 6], k2: f64, margin: f64, w: u32, h: u32) -> u64 {
+fn quad_pixels(f: &[f32; 6], k2: f64, margin: f64, w: u32, h: u32) -> [u64; 3] {
     let [u, v, a, b, c, _] = f.map(f64::from);
     let mid = 0.5 * (a + c);
     let det = a * c - b * b;
     if det.is_nan() || det <= 0.0 {
-        return 0;
+        return [0; 3];
     }
     let l1 = mid + (mid * mid - det).max(0.0).sqrt();
     let l2 = det / l1;
@@ -40,31 +40,44 @@ fn quad_pixels(f: &[f32; 6], k2: f64, margin: f64, w: u32, h: u32) -> u64 {
     let x1 = (u + ext_x - 0.5).floor().min(w as f64 - 1.0) as i64;
     let y0 = (v - ext_y - 0.5).ceil().max(0.0) as i64;
     let y1 = (v + ext_y - 0.5).floor().min(h as f64 - 1.0) as i64;
-    let mut n = 0;
-    for y in y0..=y1 {
-        let dy = y as f64 + 0.5 - v;
-        for x in x0..=x1 {
-            let dx = x as f64 + 0.5 - u;
-            let p1 = dx * axis[0] + dy * axis[1];
-            let p2 = -dx * axis[1] + dy * axis[0];
-            n += u64::from(p1.abs() <= h1 && p2.abs() <= h2);
+    let inside = |x: i64, y: i64| {
+        let (dx, dy) = (x as f64 + 0.5 - u, y as f64 + 0.5 - v);
+        let p1 = dx * axis[0] + dy * axis[1];
+        let p2 = -dx * axis[1] + dy * axis[0];
+        p1.abs() <= h1 && p2.abs() <= h2
+    };
+    // Pixels covered, 2×2 pixel quads touched (GPUs shade whole quads) and 4×4 blocks
+    // touched (llvmpipe's fragment-shader unit): each as the fragments it costs.
+    let mut out = [0u64; 3];
+    for (g, o) in [1i64, 2, 4].into_iter().zip(&mut out) {
+        for by in y0.div_euclid(g)..=y1.div_euclid(g) {
+            for bx in x0.div_euclid(g)..=x1.div_euclid(g) {
+                let mut n = 0;
+                for y in (by * g).max(y0)..=((by + 1) * g - 1).min(y1) {
+                    for x in (bx * g).max(x0)..=((bx + 1) * g - 1).min(x1) {
+                        n += u64::from(inside(x, y));
+                    }
+                }
+                *o += if n > 0 { (g * g) as u64 } else { 0 };
+            }
         }
     }
-    n
+    out
 }
 
-/// Predicted fragments of all footprints: (the former quads: 3σ, 0.5 px; the new ones:
-/// opacity-aware k, ⅛ px).
-fn predicted(fp: &[[f32; 6]], w: u32, h: u32) -> (u64, u64) {
+/// Predicted fragments of all footprints, `[pixels, 4 × 2×2 quads, 16 × 4×4 blocks]` each for
+/// the former quads (3σ, 0.5 px) and the new ones (opacity-aware k, ⅛ px).
+fn predicted(fp: &[[f32; 6]], w: u32, h: u32) -> [[u64; 3]; 2] {
+    let add = |a: [u64; 3], b: [u64; 3]| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
     fp.par_iter()
         .map(|f| {
             let k2 = (opacity_cutoff_m2(f[5]) + OPACITY_M2_MARGIN).min(f64::from(CUTOFF_M2));
-            (
+            [
                 quad_pixels(f, 9.0, FORMER_QUAD_MARGIN_PX, w, h),
                 quad_pixels(f, k2, QUAD_MARGIN_PX, w, h),
-            )
+            ]
         })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+        .reduce(|| [[0; 3]; 2], |a, b| [add(a[0], b[0]), add(a[1], b[1])])
 }
 
 /// The real scenes, framed: measured fragment-shader invocations of the former quads (3σ,
@@ -77,15 +90,17 @@ pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)
     }
     let (w, h) = b.size;
     println!(
-        "\n{:>7} | {:>8} | {:>13} | {:>13} | {:>9} | {:>15} | {:>15} | {:>9}",
+        "\n{:>7} | {:>8} | {:>12} | {:>12} | {:>8} | {:>13} | {:>13} | {:>9} | {:>9} | {:>9}",
         "scene",
         "splats",
         "frags former",
         "frags new",
         "measured",
-        "pred. former",
-        "pred. new",
-        "predicted"
+        "4×4 former",
+        "4×4 new",
+        "pred. 4×4",
+        "pred. 2×2",
+        "pred. px"
     );
     for name in ["biker", "guitar", "fox", "tower", "fruit"] {
         let Some((cloud, cam, target)) = scene(name, w, h, scale) else {
@@ -96,24 +111,28 @@ pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)
         let full = b.run(&cloud, &bounds, &cam, target, PathKind::Cull);
         let k = b.run(&cloud, &bounds, &cam, target, PathKind::Extent);
         // The same cameras as the measured frames (median of the per-frame predictions).
-        let (mut pf, mut pk): (Vec<u64>, Vec<u64>) = (1..=b.frames)
+        let mut per_frame: Vec<[[u64; 3]; 2]> = (1..=b.frames)
             .map(|f| {
                 let c = super::orbit(&cam, target, 0.004 * f as f32);
                 predicted(&footprints(&cloud, &c, &RenderOptions::default()), w, h)
             })
-            .unzip();
-        let (p_full, p_k) = (super::median(&mut pf), super::median(&mut pk));
+            .collect();
+        per_frame.sort();
+        let [[px_f, q_f, b_f], [px_k, q_k, b_k]] = per_frame[per_frame.len() / 2];
         let (m_full, m_k) = (full.fragments.unwrap(), k.fragments.unwrap());
+        let pct = |a: u64, b: u64| 100.0 * a as f64 / b as f64;
         println!(
-            "{:>7} | {:>8} | {:>13} | {:>13} | {:>8.1}% | {:>15} | {:>15} | {:>8.1}%",
+            "{:>7} | {:>8} | {:>12} | {:>12} | {:>7.1}% | {:>13} | {:>13} | {:>8.1}% | {:>8.1}% | {:>8.1}%",
             name,
             cloud.len(),
             m_full,
             m_k,
-            100.0 * m_k as f64 / m_full as f64,
-            p_full,
-            p_k,
-            100.0 * p_k as f64 / p_full as f64
+            pct(m_k, m_full),
+            b_f,
+            b_k,
+            pct(b_k, b_f),
+            pct(q_k, q_f),
+            pct(px_k, px_f)
         );
     }
 }
