@@ -1,20 +1,34 @@
-//! Frame-time benchmark of the GL backend on the headless context (llvmpipe here), split into
-//! sort / upload / draw, for 100k and 1M splats at 1280×720.
+//! Frame-time benchmark of the GL backend on the headless context (llvmpipe here): per scene
+//! and view, the former draw path against each new step **in the same run**.
 //!
-//! Each size runs twice: blending directly in the `RGBA8` framebuffer, and in an `RGBA16F`
-//! [`OffscreenTarget`] plus its resolve pass (the draw column then includes the resolve).
+//! Scenes (`SPLATGL_BENCH_SCENES`, default `biker,1m,4m`): `biker` = the real 152,746-splat
+//! `playcanvas_biker.compressed.ply` (framed as the CLI frames PLY scenes), `1m` = a generated
+//! 1M-splat SH-3 cloud, `4m` = a generated 4M-splat SH-0 cloud (`scene::random_cloud` in
+//! [-1, 1]³, scales × 0.2·(10⁵/n)^(1/3)·`SPLATGL_BENCH_SCALE`, seen from 3.2 units with a
+//! 50° vertical field of view). Views: `full` (everything in view) and `half` (the camera
+//! turned, by bisection on the CPU cull, until about half the splats are in view).
 //!
-//! `cargo bench --bench gl` (set `SPLATGL_BENCH_FRAMES`, default 5, and `SPLATGL_BENCH_SIZES`,
-//! default `100000,1000000`, and `SPLATGL_BENCH_SCALE`, default 1, a factor on the splat scales). A short, plain timing loop rather than criterion: one 1M-splat
-//! frame on llvmpipe takes long enough that criterion's minimum sample counts would make the
-//! run minutes long. Each phase ends with `glFinish`, so GPU work is attributed to it.
+//! Paths: `former` = every splat sorted and drawn, 3σ quads, each quad corner doing the
+//! per-splat maths (the path before issue 15); `cull` = the same draw of only the splats the
+//! cull keeps; `extent` = also opacity-aware quads; `new` = also the transform-feedback
+//! pre-pass (the default path, `Pipeline::Auto`). All four draw the same image.
+//! `SPLATGL_BENCH_PATHS` (default `former,cull,extent,new`) runs some of them only.
 //!
-//! `draw CPU ms` is the process's CPU time (all threads) during the draw: on a machine shared
-//! with other jobs it moves far less than wall time.
+//! Columns: splats drawn (instances), fragment-shader invocations
+//! (`GL_FRAGMENT_SHADER_INVOCATIONS` of `GL_ARB_pipeline_statistics_query` in a desktop
+//! context where the driver has it, else `GL_SAMPLES_PASSED`, else none on ES), sort ms
+//! (cull + keys + sort), draw ms (wall, `glFinish`ed) and draw CPU ms (all threads, less
+//! disturbed by other jobs), frame ms and frames/s. Medians of `SPLATGL_BENCH_FRAMES`
+//! (default 5) frames after one warm-up; the camera orbits a little every frame so every
+//! frame sorts anew. `SPLATGL_BENCH_SIZE` (default `1280x720`) sets the framebuffer.
 //!
-//! Scene: `scene::random_cloud(n, 3, 1.0, seed)` (means uniform in [-1, 1]³, SH degree 3)
-//! with scales × 0.2·(10⁵/n)^(1/3), so the covered screen area is about the same for both sizes;
-//! camera at distance 3.2, 50° vertical fov.
+//! Then: the predicted fragment ratio of the opacity-aware quads on the real scenes (pixel
+//! centres inside each splat's quad rectangle with k and with 3, counted on the CPU from the
+//! reference's projection) against the measured invocation ratio; and the pre-pass crossover
+//! (`SPLATGL_BENCH_CROSSOVER`, default `10,100,1000,10000,100000` splats, SH 3, direct vs
+//! pre-pass; `none` skips it). `SPLATGL_BENCH_PREDICT=0` skips the prediction table.
+//!
+//! `cargo bench --bench gl`; `scripts/bench-gpu.sh` runs it at 1920×1080 with 1M and 4M.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -25,12 +39,15 @@ use common::gl::or_skip;
 use glam::Vec3;
 use glow::HasContext;
 use splatgl::camera::Camera;
-use splatgl::gl::{ColorFormat, DistanceSorter, OffscreenTarget, ReadbackTarget, SplatRenderer};
-use splatgl::headless::HeadlessContext;
-use splatgl::scene;
+use splatgl::cull::{CullBounds, visible_into};
+use splatgl::gl::{
+    ColorFormat, DistanceSorter, DrawPath, Pipeline, ReadbackTarget, SplatRenderer,
+    frustum_for_camera,
+};
+use splatgl::headless::{GlApi, HeadlessContext};
+use splatgl::{SplatCloud, scene};
 
-/// CPU time of the whole process (all threads, so llvmpipe's rasterizer threads count), which
-/// is far less disturbed than wall time when other jobs share the machine.
+/// CPU time of the whole process (all threads, so llvmpipe's threads count).
 fn cpu_time() -> Duration {
     let mut u = std::mem::MaybeUninit::<libc::rusage>::zeroed();
     // SAFETY: getrusage writes a rusage struct into the valid, writable pointer it is given.
@@ -42,8 +59,8 @@ fn cpu_time() -> Duration {
     tv(u.ru_utime) + tv(u.ru_stime)
 }
 
-fn median(v: &mut [Duration]) -> Duration {
-    v.sort();
+fn median<T: Copy + PartialOrd>(v: &mut [T]) -> T {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
     v[v.len() / 2]
 }
 
@@ -51,125 +68,433 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-fn main() {
-    // `cargo test --all-targets` runs bench binaries without `--bench`: then only smoke-test
-    // the code path on a tiny cloud instead of timing 1M splats in a debug build.
-    let smoke = !std::env::args().any(|a| a == "--bench");
-    let frames: usize = std::env::var("SPLATGL_BENCH_FRAMES")
+fn env<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(5)
-        .max(1);
-    let sizes: Vec<usize> = std::env::var("SPLATGL_BENCH_SIZES")
-        .unwrap_or_else(|_| "100000,1000000".into())
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect();
-    let (frames, sizes) = if smoke {
-        (1, vec![1000])
-    } else {
-        (frames, sizes)
-    };
-    // Extra factor on the splat scales (e.g. 0.01: sub-pixel splats, to see the vertex cost).
-    let scale_factor: f32 = std::env::var("SPLATGL_BENCH_SCALE")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1.0);
-    let Some(ctx) = or_skip(HeadlessContext::new(), "headless context") else {
-        return;
-    };
-    let gl = ctx.gl();
-    println!("context: {}", ctx.describe());
-    let (w, h) = (1280u32, 720u32);
-    // An RGBA8 framebuffer of the frame size, bound for the whole benchmark.
-    let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8, None).unwrap();
-    frame.bind(gl).unwrap();
-    let mut renderer = SplatRenderer::new(gl).unwrap();
-    let mut offscreen = OffscreenTarget::new(gl, w, h).unwrap();
-    let mut sorter = DistanceSorter::default();
-    let mut order = Vec::new();
-    println!(
-        "{:>9} | {:>8} | {:>9} | {:>9} | {:>9} | {:>12} | {:>9} | {:>12} | {:>10}",
-        "splats",
-        "target",
-        "sort ms",
-        "upload ms",
-        "draw ms",
-        "draw CPU ms",
-        "frame ms",
-        "bytes/frame",
-        "upload once"
-    );
-    for (n, float_target) in sizes.iter().flat_map(|&n| [(n, false), (n, true)]) {
-        let mut cloud = scene::random_cloud(n, 3, 1.0, 1234);
-        let k = scale_factor * 0.2 * (1e5 / n as f32).cbrt();
-        for s in &mut cloud.scales {
-            *s = s.map(|v| v * k);
+        .unwrap_or(default)
+}
+
+/// What the fragment query counts here.
+#[derive(Clone, Copy, PartialEq)]
+enum Counter {
+    Invocations,
+    SamplesPassed,
+    None,
+}
+
+impl Counter {
+    fn target(self) -> Option<u32> {
+        match self {
+            Counter::Invocations => Some(0x82F4), // GL_FRAGMENT_SHADER_INVOCATIONS
+            Counter::SamplesPassed => Some(glow::SAMPLES_PASSED),
+            Counter::None => None,
         }
-        let t = Instant::now();
-        renderer.upload(gl, &cloud).unwrap();
-        // SAFETY: glFinish has no preconditions.
-        unsafe { gl.finish() };
-        let upload_once = t.elapsed();
-        let (mut ts, mut tu, mut td, mut tc) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for f in 0..frames + 1 {
-            // Orbit a little so every frame sorts a new order.
-            let a = 0.05 * f as f32;
-            let eye = Vec3::new(3.2 * a.sin(), 0.4, 3.2 * a.cos());
-            let cam = Camera::look_at(eye, Vec3::ZERO, Vec3::Y, 50f32.to_radians(), w, h);
-            // SAFETY: clearing the bound FBO.
+    }
+}
+
+/// The four paths compared.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum PathKind {
+    Former,
+    Cull,
+    Extent,
+    New,
+    /// The pre-pass whatever the count (crossover measurement).
+    PrePass,
+}
+
+impl PathKind {
+    const ALL: [PathKind; 4] = [
+        PathKind::Former,
+        PathKind::Cull,
+        PathKind::Extent,
+        PathKind::New,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            PathKind::Former => "former",
+            PathKind::Cull => "cull",
+            PathKind::Extent => "extent",
+            PathKind::New => "new",
+            PathKind::PrePass => "pre-pass",
+        }
+    }
+
+    fn draw_path(self) -> DrawPath {
+        let with = |pipeline| DrawPath {
+            pipeline,
+            former_quads: false,
+        };
+        match self {
+            PathKind::Former | PathKind::Cull => DrawPath::FORMER,
+            PathKind::Extent => with(Pipeline::Direct),
+            PathKind::New => DrawPath::default(),
+            PathKind::PrePass => with(Pipeline::PrePass),
+        }
+    }
+
+    fn culls(self) -> bool {
+        self != PathKind::Former
+    }
+}
+
+/// Medians of one (scene, view, path).
+#[derive(Clone, Copy, Default)]
+struct Row {
+    drawn: usize,
+    fragments: Option<u64>,
+    sort: f64,
+    draw: f64,
+    draw_cpu: f64,
+    prepass: bool,
+}
+
+impl Row {
+    fn frame(&self) -> f64 {
+        self.sort + self.draw
+    }
+}
+
+struct Bench<'a> {
+    gl: &'a glow::Context,
+    renderer: SplatRenderer,
+    sorter: DistanceSorter,
+    order: Vec<u32>,
+    query: Option<(u32, glow::Query)>,
+    frames: usize,
+    size: (u32, u32),
+}
+
+impl Bench<'_> {
+    /// Runs `frames` (+ 1 warm-up) frames of `cloud` from `cam` orbiting by `step` radians per
+    /// frame around `target`, by `path`.
+    fn run(
+        &mut self,
+        cloud: &SplatCloud,
+        bounds: &CullBounds,
+        cam: &Camera,
+        target: Vec3,
+        path: PathKind,
+    ) -> Row {
+        let gl = self.gl;
+        self.renderer.set_draw_path(gl, path.draw_path()).unwrap();
+        let (w, h) = self.size;
+        let mut rows = Vec::new();
+        for f in 0..=self.frames {
+            let cam = orbit(cam, target, 0.004 * f as f32);
+            // SAFETY: clearing the bound framebuffer, then waiting for the GL.
             unsafe {
                 gl.clear_color(0.0, 0.0, 0.0, 0.0);
                 gl.clear(glow::COLOR_BUFFER_BIT);
                 gl.finish();
             }
             let t0 = Instant::now();
-            sorter.sort(&cloud.positions, cam.eye(), &mut order);
-            let t1 = Instant::now();
-            renderer.set_order(gl, &order).unwrap();
-            // SAFETY: glFinish has no preconditions.
-            unsafe { gl.finish() };
-            let t2 = Instant::now();
-            let c2 = cpu_time();
-            if float_target {
-                offscreen.begin(gl, [0.0; 4]).unwrap();
-                renderer.draw_current(gl, &cam).unwrap();
-                offscreen.resolve(gl, false).unwrap();
+            if path.culls() {
+                let frustum = frustum_for_camera(&cam, [0, 0, w as i32, h as i32]);
+                let p = &cloud.positions;
+                self.sorter
+                    .sort_visible(p, bounds, &frustum, cam.eye(), &mut self.order);
             } else {
-                renderer.draw_current(gl, &cam).unwrap();
+                self.sorter
+                    .sort(&cloud.positions, cam.eye(), &mut self.order);
             }
+            self.renderer.set_order(gl, &self.order).unwrap();
             // SAFETY: glFinish has no preconditions.
             unsafe { gl.finish() };
-            let t3 = Instant::now();
-            let c3 = cpu_time();
+            let (t1, c1) = (Instant::now(), cpu_time());
+            // SAFETY: a query of this context around one draw.
+            unsafe {
+                if let Some((target, q)) = self.query {
+                    gl.begin_query(target, q);
+                }
+            }
+            self.renderer.draw_current(gl, &cam).unwrap();
+            // SAFETY: ends the query begun above; glFinish.
+            let fragments = unsafe {
+                let r = self.query.map(|(target, q)| {
+                    gl.end_query(target);
+                    u64::from(gl.get_query_parameter_u32(q, glow::QUERY_RESULT))
+                });
+                gl.finish();
+                r
+            };
+            let (t2, c2) = (Instant::now(), cpu_time());
             if f > 0 {
-                // Frame 0 warms up (shader variants, caches).
-                ts.push(t1 - t0);
-                tu.push(t2 - t1);
-                td.push(t3 - t2);
-                tc.push(c3 - c2);
+                rows.push(Row {
+                    drawn: self.order.len(),
+                    fragments,
+                    sort: ms(t1 - t0),
+                    draw: ms(t2 - t1),
+                    draw_cpu: ms(c2 - c1),
+                    prepass: self.renderer.last_draw_used_prepass(),
+                });
             }
         }
-        let (s, u, d, dc) = (
-            median(&mut ts),
-            median(&mut tu),
-            median(&mut td),
-            median(&mut tc),
-        );
+        let pick = |f: fn(&Row) -> f64| median(&mut rows.iter().map(f).collect::<Vec<_>>());
+        Row {
+            drawn: pick(|r| r.drawn as f64) as usize,
+            fragments: rows[0].fragments.map(|_| {
+                median(
+                    &mut rows
+                        .iter()
+                        .map(|r| r.fragments.unwrap())
+                        .collect::<Vec<_>>(),
+                )
+            }),
+            sort: pick(|r| r.sort),
+            draw: pick(|r| r.draw),
+            draw_cpu: pick(|r| r.draw_cpu),
+            prepass: rows[0].prepass,
+        }
+    }
+}
+
+/// `cam` moved by `angle` radians on a circle about the vertical through `target`, turned
+/// with it (so `target` stays where it was in the image).
+fn orbit(cam: &Camera, target: Vec3, angle: f32) -> Camera {
+    let eye = cam.eye();
+    let rot = glam::Quat::from_rotation_y(angle);
+    let new_eye = target + rot * (eye - target);
+    let forward = cam.world_to_camera.row(2).truncate();
+    let up = -cam.world_to_camera.row(1).truncate();
+    let fov = 2.0 * (0.5 * cam.height as f32 / cam.fy).atan();
+    let mut c = Camera::look_at(
+        new_eye,
+        new_eye + rot * forward,
+        up,
+        fov,
+        cam.width,
+        cam.height,
+    );
+    c.near = cam.near;
+    c.far = cam.far;
+    c
+}
+
+/// `cam` turned about its own up axis until about half of `cloud` is in view (bisection on
+/// the CPU cull's visible count).
+fn half_view(cam: &Camera, cloud: &SplatCloud, bounds: &CullBounds) -> Camera {
+    let eye = cam.eye();
+    let seen = |c: &Camera| {
+        let f = frustum_for_camera(c, [0, 0, c.width as i32, c.height as i32]);
+        visible_into(&f, &cloud.positions, bounds, &mut Vec::new())
+    };
+    let turned = |a: f32| orbit(cam, eye, a);
+    let (mut lo, mut hi) = (0.0f32, std::f32::consts::PI);
+    let target = seen(cam) / 2;
+    for _ in 0..20 {
+        let mid = 0.5 * (lo + hi);
+        if seen(&turned(mid)) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    turned(0.5 * (lo + hi))
+}
+
+/// The bench scenes: name, cloud, camera, orbit target.
+fn scene(name: &str, w: u32, h: u32, scale: f32) -> Option<(SplatCloud, Camera, Vec3)> {
+    let fov = 50f32.to_radians();
+    let generated = |n: usize, degree: u8| {
+        let mut cloud = scene::random_cloud(n, degree, 1.0, 1234);
+        let k = scale * 0.2 * (1e5 / n as f32).cbrt();
+        for s in &mut cloud.scales {
+            *s = s.map(|v| v * k);
+        }
+        let cam = Camera::look_at(Vec3::new(0.0, 0.4, 3.2), Vec3::ZERO, Vec3::Y, fov, w, h);
+        (cloud, cam, Vec3::ZERO)
+    };
+    Some(match name {
+        "biker" | "guitar" | "fox" | "tower" | "fruit" => {
+            let file = match name {
+                "biker" => "playcanvas_biker.compressed.ply",
+                "guitar" => "playcanvas_guitar.compressed.ply",
+                "fox" => "mujoco_warp_fox_sh0.ply",
+                "tower" => "sharpgltf_tower_legacy_spz_v2.glb",
+                _ => "supersplat_fruit_drops_minimal_sh3.ply",
+            };
+            let cloud = splatgl::load::load_path(&common::real(file)?, &Default::default())
+                .ok()?
+                .cloud;
+            let (fwd, up) = if name == "tower" {
+                (Vec3::new(0.0, -0.35, -1.0), Vec3::Y)
+            } else {
+                (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y)
+            };
+            let cam = Camera::frame_points_along(&cloud.positions, fwd, up, fov, w, h)?;
+            let target = cam.eye() + cam.world_to_camera.inverse().z_axis.truncate();
+            (cloud, cam, target)
+        }
+        "1m" => generated(1_000_000, 3),
+        "4m" => generated(4_000_000, 0),
+        other => {
+            let n: usize = other.trim_end_matches(['k', 'K']).parse().ok()?;
+            generated(n * if other.ends_with(['k', 'K']) { 1000 } else { 1 }, 3)
+        }
+    })
+}
+
+#[path = "gl/predict.rs"]
+mod predict;
+
+fn main() {
+    // `cargo test --all-targets` runs bench binaries without `--bench`: then only smoke-test
+    // the code paths on a small cloud.
+    let smoke = !std::env::args().any(|a| a == "--bench");
+    let frames = if smoke {
+        1
+    } else {
+        env("SPLATGL_BENCH_FRAMES", 5usize).max(1)
+    };
+    let size: String = env("SPLATGL_BENCH_SIZE", "1280x720".to_owned());
+    let (w, h) = size
+        .split_once('x')
+        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
+        .unwrap_or((1280u32, 720u32));
+    let scale: f32 = env("SPLATGL_BENCH_SCALE", 1.0);
+    let paths: String = env("SPLATGL_BENCH_PATHS", "former,cull,extent,new".to_owned());
+    let scenes: String = if smoke {
+        "5000".into()
+    } else {
+        env("SPLATGL_BENCH_SCENES", "biker,1m,4m".to_owned())
+    };
+    let crossover: String = if smoke {
+        "none".into()
+    } else {
+        env(
+            "SPLATGL_BENCH_CROSSOVER",
+            "10,100,1000,10000,100000".to_owned(),
+        )
+    };
+    // A desktop context where it counts fragment-shader invocations; else ES.
+    let desktop = HeadlessContext::with_api(GlApi::DesktopCore33).ok();
+    let stats = desktop.as_ref().is_some_and(|c| {
+        c.gl()
+            .supported_extensions()
+            .contains("GL_ARB_pipeline_statistics_query")
+    });
+    let (ctx, counter) = match desktop {
+        Some(c) if stats => (c, Counter::Invocations),
+        Some(c) => (c, Counter::SamplesPassed),
+        None => match or_skip(HeadlessContext::new(), "headless context") {
+            Some(c) => (c, Counter::None),
+            None => return,
+        },
+    };
+    let gl = ctx.gl();
+    println!("context: {}", ctx.describe());
+    println!(
+        "fragments counted by: {}",
+        match counter {
+            Counter::Invocations =>
+                "GL_FRAGMENT_SHADER_INVOCATIONS (ARB_pipeline_statistics_query)",
+            Counter::SamplesPassed => "GL_SAMPLES_PASSED (no pipeline statistics here)",
+            Counter::None => "nothing (ES context)",
+        }
+    );
+    println!("framebuffer {w}×{h} RGBA8, {frames} frames (median) after a warm-up\n");
+    let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8, None).unwrap();
+    frame.bind(gl).unwrap();
+    // SAFETY: creating a query object on the current context.
+    let query = counter
+        .target()
+        .map(|t| (t, unsafe { gl.create_query().unwrap() }));
+    let mut b = Bench {
+        gl,
+        renderer: SplatRenderer::new(gl).unwrap(),
+        sorter: DistanceSorter::default(),
+        order: Vec::new(),
+        query,
+        frames,
+        size: (w, h),
+    };
+    println!(
+        "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8} | {:>9} | {:>11} | {:>9} | {:>7} | pre-pass",
+        "scene",
+        "view",
+        "path",
+        "drawn",
+        "fragments",
+        "sort ms",
+        "draw ms",
+        "draw CPU ms",
+        "frame ms",
+        "frame/s",
+    );
+    let mut summary = Vec::new();
+    for name in scenes.split(',').map(str::trim) {
+        let Some((cloud, cam, target)) = scene(name, w, h, scale) else {
+            println!("{name}: not available (skipped)");
+            continue;
+        };
+        b.renderer.upload(gl, &cloud).unwrap();
+        let bounds = CullBounds::new(&cloud);
+        let half = half_view(&cam, &cloud, &bounds);
+        for (view, c) in [("full", cam), ("half", half)] {
+            let mut rows = Vec::new();
+            for path in PathKind::ALL {
+                if !paths.split(',').any(|p| p.trim() == path.name()) {
+                    rows.push(Row::default());
+                    continue;
+                }
+                let r = b.run(&cloud, &bounds, &c, target, path);
+                println!(
+                    "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8.2} | {:>9.1} | {:>11.1} | {:>9.1} | {:>7.2} | {}",
+                    name,
+                    view,
+                    path.name(),
+                    r.drawn,
+                    r.fragments.map_or("-".into(), |f| f.to_string()),
+                    r.sort,
+                    r.draw,
+                    r.draw_cpu,
+                    r.frame(),
+                    1e3 / r.frame(),
+                    if r.prepass { "yes" } else { "no" }
+                );
+                rows.push(r);
+            }
+            summary.push((name.to_owned(), view, cloud.len(), rows));
+        }
+    }
+    print_summary(&summary);
+    if env("SPLATGL_BENCH_PREDICT", 1u8) != 0 && !smoke {
+        predict::fragment_table(&mut b, &summary, scale);
+    }
+    predict::crossover(&mut b, &crossover, scale);
+    b.renderer.destroy(gl);
+    frame.destroy(gl);
+}
+
+/// Speed-ups of the new path over the former one, split into its steps.
+fn print_summary(summary: &[(String, &str, usize, Vec<Row>)]) {
+    println!(
+        "\n{:>7} | {:>4} | {:>9} | {:>7} | {:>14} | {:>14} | {:>16} | {:>13}",
+        "scene",
+        "view",
+        "splats",
+        "in view",
+        "draw: cull ×",
+        "extent ×",
+        "pre-pass ×",
+        "new/former"
+    );
+    for (name, view, n, rows) in summary {
+        let [former, cull, extent, new] = [rows[0], rows[1], rows[2], rows[3]];
         println!(
-            "{:>9} | {:>8} | {:>9.2} | {:>9.2} | {:>9.2} | {:>12.2} | {:>9.2} | {:>12} | {:>8.0}ms",
+            "{:>7} | {:>4} | {:>9} | {:>6.1}% | {:>14.2} | {:>14.2} | {:>16.2} | {:>6.2}× ({:.2}× frame)",
+            name,
+            view,
             n,
-            if float_target { "RGBA16F" } else { "RGBA8" },
-            ms(s),
-            ms(u),
-            ms(d),
-            ms(dc),
-            ms(s + u + d),
-            4 * order.len(),
-            ms(upload_once)
+            100.0 * new.drawn as f64 / *n as f64,
+            former.draw / cull.draw,
+            cull.draw / extent.draw,
+            extent.draw / new.draw,
+            former.draw / new.draw,
+            former.frame() / new.frame(),
         );
     }
-    renderer.destroy(gl);
-    offscreen.destroy(gl);
-    frame.destroy(gl);
 }

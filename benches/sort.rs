@@ -1,6 +1,7 @@
 //! Splat sorting benchmarks: ours vs `sort_unstable_by`, rayon `par_sort_unstable_by` and the
 //! `rdst` radix crate on the same keys, N = 100k / 1M / 4M, uniform and clustered scenes; the
-//! whole per-frame cost at 1M; a memory-bandwidth baseline; and (printed once, not timed) the
+//! whole per-frame cost at 1M, full and culled (`sort_visible`, all and about half in view);
+//! a memory-bandwidth baseline; and (printed once, not timed) the
 //! order error of the quantized modes.
 //!
 //! Run: `cargo bench --bench sort` (filter with e.g. `-- 1000000`).
@@ -9,9 +10,12 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use glam::Vec3;
 use rayon::prelude::*;
 use rdst::{RadixKey, RadixSort};
-use splatgl::sort::{Precision, Sorter, far_first_key, squared_distance};
+use splatgl::camera::Camera;
+use splatgl::cull::{CullBounds, Frustum, visible_into};
+use splatgl::sort::{Precision, SortRequest, Sorter, far_first_key, squared_distance};
 
 use splatgl::scene::Rng;
 
@@ -208,6 +212,52 @@ fn per_frame(c: &mut Criterion) {
                 })
             },
         );
+        // The culled sort (`Sorter::sort_visible`): a camera at the scene's eye seeing all of
+        // it, and one turned until about half is in view; and the cull pass alone.
+        let mut bounds = CullBounds::from_radii(vec![0.05; n]);
+        bounds.set_extent(&scene.positions);
+        let eye = Vec3::from_array(scene.eye);
+        let turned = |a: f32| {
+            let dir = glam::Quat::from_rotation_y(a) * (-eye);
+            Camera::look_at(eye, eye + dir, Vec3::Y, 1.0, 1280, 720)
+        };
+        let mut ids = Vec::new();
+        let mut seen = |a: f32| {
+            let f = Frustum::from_camera(&turned(a), 0.2);
+            visible_into(&f, &scene.positions, &bounds, &mut ids)
+        };
+        let (mut lo, mut hi) = (0.0f32, std::f32::consts::PI);
+        let all = seen(0.0);
+        for _ in 0..20 {
+            let mid = 0.5 * (lo + hi);
+            if seen(mid) > all / 2 {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        let wide = Camera::look_at(eye, Vec3::ZERO, Vec3::Y, 2.4, 1280, 720);
+        for cam in [wide, turned(lo)] {
+            let frustum = Frustum::from_camera(&cam, 0.2);
+            let m = visible_into(&frustum, &scene.positions, &bounds, &mut ids);
+            let share = format!("{:.0}% in view", 100.0 * m as f64 / n as f64);
+            let what = format!("{}/cull pass, {share}", scene.name);
+            g.bench_function(BenchmarkId::new(what, n), |b| {
+                b.iter(|| black_box(visible_into(&frustum, &scene.positions, &bounds, &mut ids)))
+            });
+            let what = format!("{}/culled per-frame, {share}", scene.name);
+            g.bench_function(BenchmarkId::new(what, n), |b| {
+                b.iter(|| {
+                    frame = frame.wrapping_add(1);
+                    let mut e = scene.eye;
+                    e[0] += frame as f32 * 1e-3;
+                    let r = SortRequest::distance(e);
+                    let order = sorter.sort_visible(&scene.positions, &bounds, &frustum, &r);
+                    upload[..order.len()].copy_from_slice(order);
+                    black_box(upload[order.len() / 2])
+                })
+            });
+        }
     }
     // Bandwidth baselines: one 2-thread copy of 1M u64 (one radix pass moves as much:
     // 8 MB read + 8 MB written) and one random scatter of the same.

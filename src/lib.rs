@@ -4,7 +4,7 @@
 //! `KHR_gaussian_splatting` (Release Candidate).
 //!
 //! Data flow, one module per stage: [`load`] (glTF / PLY / SPZ / .splat / .ksplat / SOG →
-//! [`SplatCloud`], with its [`cloud`] metadata) → [`sort`] → `gl` (draw; `headless` drives it without a window) with
+//! [`SplatCloud`], with its [`cloud`] metadata) → [`cull`] → [`sort`] → `gl` (draw; `headless` drives it without a window) with
 //! the CPU [`reference`](mod@reference) rasterizer beside it, [`compare`] for image comparison, [`image`] for
 //! PNG / PFM files and [`write`](mod@write) for glTF / PLY output. [`camera`] holds the camera model,
 //! [`profile`] every number of the rendering profile and [`sh`] the spherical harmonics.
@@ -16,6 +16,7 @@ pub mod cloud;
 pub mod compare;
 pub mod conformance;
 pub mod convert;
+pub mod cull;
 // Covariance algebra behind the loader's node transforms: public for the node-transform tests,
 // not part of the documented API (`SplatCloud::covariance` is the user-facing form).
 #[doc(hidden)]

@@ -77,9 +77,44 @@ pub const CUTOFF_M2: f32 = 9.0;
 pub const ALPHA_MAX: f32 = 0.99;
 /// Contributions with α below this are skipped (3DGS `alpha < 1/255`).
 pub const ALPHA_MIN: f32 = 1.0 / 255.0;
+/// Added to the opacity-aware Mahalanobis² bound ([`opacity_cutoff_m2`]) wherever a bound
+/// must contain every pixel whose α can pass the [`ALPHA_MIN`] test: the reference's
+/// early-out before the exponential and the GL quad. Covers the rounding of `ln` and `exp`
+/// (≤ 10⁻⁵ in m² for any GLSL ES 3.00 implementation, exactly 0 in the f64 reference).
+pub const OPACITY_M2_MARGIN: f64 = 1e-3;
+
+/// The opacity-aware extent (`docs/rendering-profile.md` §3 "extent"): the Mahalanobis²
+/// `2·ln(opacity / ALPHA_MIN)` beyond which `min(ALPHA_MAX, opacity·exp(−½m²))` is below
+/// [`ALPHA_MIN`] (because `ALPHA_MAX ≥ ALPHA_MIN`), capped at [`CUTOFF_M2`]. NaN or −∞ for
+/// opacities the α test rejects everywhere (NaN, ≤ 0); ≥ [`CUTOFF_M2`] (so the cap) for
+/// opacities ≥ 0.0353 = ALPHA_MIN·e^4.5.
+pub fn opacity_cutoff_m2(opacity: f32) -> f64 {
+    let m2 = 2.0 * (f64::from(opacity) / f64::from(ALPHA_MIN)).ln();
+    // Written so that NaN stays NaN (`f64::min` would turn it into the cap).
+    if m2 > f64::from(CUTOFF_M2) {
+        f64::from(CUTOFF_M2)
+    } else {
+        m2
+    }
+}
+
 /// Splats whose camera-space depth is ≤ max(this, camera near) are culled (3DGS `in_frustum`),
 /// in scene units. `reference::RenderOptions::near_cull` overrides it for the reference.
 pub const NEAR_CULL: f64 = 0.2;
+
+/// The GL quad: the rectangle along Σ''s eigenvectors with half-axes
+/// `QUAD_AXIS_FACTOR·√(k²λᵢ) + QUAD_MARGIN_PX` (capped by the 3DGS radius), i.e. 2 % and
+/// ⅛ px beyond the bounding rectangle of the ellipse m² ≤ k². Any quad that contains every
+/// pixel centre the fragment test can pass gives the same image; the margins cover the f32
+/// eigen-decomposition (≪ 2 %) and the rasterizer's vertex snapping (≤ 1/32 px at the 4
+/// sub-pixel bits GLES 3.0 guarantees; llvmpipe has 8).
+pub const QUAD_AXIS_FACTOR: f64 = 1.02;
+/// See [`QUAD_AXIS_FACTOR`] (pixels).
+pub const QUAD_MARGIN_PX: f64 = 0.125;
+/// The quad margin before the opacity-aware extent (pixels): what the erratum variants and
+/// the benchmarks' "former" path draw with.
+#[doc(hidden)]
+pub const FORMER_QUAD_MARGIN_PX: f64 = 0.5;
 
 // ---------------------------------------------------------------------------------------------
 // §8 GPU data layout (the GL backend's textures; docs/gl-backend.md "Data layout")
@@ -122,6 +157,39 @@ mod tests {
         let power = SRGB_SCALE * t.powf(1.0 / SRGB_GAMMA) - SRGB_OFFSET;
         assert!((SRGB_LINEAR_SLOPE * t - power).abs() < 1e-6);
         assert!((srgb_decode(SRGB_DECODE_THRESHOLD) - t).abs() < 1e-6);
+    }
+
+    #[test]
+    fn opacity_cutoff_is_where_alpha_meets_the_threshold() {
+        for o in [
+            0.004_f32,
+            0.01,
+            0.02,
+            0.0353,
+            0.1,
+            0.5,
+            0.99,
+            1.0,
+            7.0,
+            f32::INFINITY,
+        ] {
+            let m2 = opacity_cutoff_m2(o);
+            assert!(m2 <= f64::from(CUTOFF_M2), "{o}: {m2}");
+            if m2 < f64::from(CUTOFF_M2) {
+                // Exactly at the bound α = ALPHA_MIN (below the cap ALPHA_MAX).
+                let alpha = (f64::from(o) * (-0.5 * m2).exp()).min(f64::from(ALPHA_MAX));
+                assert!(
+                    (alpha / f64::from(ALPHA_MIN) - 1.0).abs() < 1e-12,
+                    "{o}: {alpha}"
+                );
+            }
+        }
+        assert_eq!(opacity_cutoff_m2(1.0), f64::from(CUTOFF_M2));
+        assert!(opacity_cutoff_m2(0.03) < f64::from(CUTOFF_M2));
+        assert!(opacity_cutoff_m2(f32::NAN).is_nan());
+        assert!(opacity_cutoff_m2(-1.0).is_nan());
+        assert_eq!(opacity_cutoff_m2(0.0), f64::NEG_INFINITY);
+        assert!(opacity_cutoff_m2(ALPHA_MIN * 0.5) < 0.0);
     }
 
     #[test]

@@ -16,8 +16,8 @@ use glow::HasContext;
 use host_state::{Host, Piece, pieces, query_all};
 use splatgl::gl::state::{Contexts, LEFT_WITHOUT_RESTORE, Left, LeftValue};
 use splatgl::gl::{
-    ColorFormat, DepthFormat, DepthFunc, DrawSettings, ReadbackTarget, SplatRenderer, SplatScene,
-    sort_back_to_front,
+    ColorFormat, DepthFormat, DepthFunc, DrawPath, DrawSettings, Pipeline, ReadbackTarget,
+    SplatRenderer, SplatScene, sort_back_to_front,
 };
 
 const APIS: [GlApi; 3] = [GlApi::Gles3, GlApi::DesktopCore33, GlApi::DesktopCompat];
@@ -59,14 +59,33 @@ fn every_call(gl: &glow::Context, settings: DrawSettings) {
     let (view, proj) = (cam.gl_view(), cam.gl_projection());
     r.draw_with_matrices(gl, view, proj, [3, 4, 50, 60], &order)
         .unwrap();
-    r.destroy(gl);
-    let mut s = SplatScene::new(gl).unwrap();
-    *s.settings_mut() = settings;
-    let model = Mat4::from_rotation_y(0.5) * Mat4::from_scale(Vec3::new(1.0, 1.5, 0.7));
-    s.upload(gl, &[(&cloud, Mat4::IDENTITY), (&other, model)])
+    // The same through the transform-feedback pre-pass (its program, vertex arrays,
+    // transform-feedback object and rasterizer discard), created after the upload.
+    r.set_draw_path(gl, prepass()).unwrap();
+    r.draw_current(gl, &cam).unwrap();
+    assert!(r.last_draw_used_prepass());
+    r.draw_with_matrices(gl, view, proj, [3, 4, 50, 60], &order)
         .unwrap();
-    s.draw(gl, &cam).unwrap();
-    s.destroy(gl);
+    r.destroy(gl);
+    for path in [DrawPath::default(), prepass()] {
+        let mut s = SplatScene::new(gl).unwrap();
+        *s.settings_mut() = settings;
+        s.set_draw_path(gl, path).unwrap();
+        let model = Mat4::from_rotation_y(0.5) * Mat4::from_scale(Vec3::new(1.0, 1.5, 0.7));
+        s.upload(gl, &[(&cloud, Mat4::IDENTITY), (&other, model)])
+            .unwrap();
+        s.draw(gl, &cam).unwrap();
+        assert_eq!(s.renderer().last_draw_used_prepass(), path == prepass());
+        s.destroy(gl);
+    }
+}
+
+/// The draw path that always runs the transform-feedback pre-pass.
+fn prepass() -> DrawPath {
+    DrawPath {
+        pipeline: Pipeline::PrePass,
+        ..DrawPath::default()
+    }
 }
 
 /// What `piece` must read after the calls without restore: the documented value where
@@ -77,6 +96,8 @@ fn expected_without_restore(p: &Piece, host: &Host, before: &[f64], s: &DrawSett
         Contexts::Desktop => host.api != GlApi::Gles3,
         Contexts::Compatibility => host.api == GlApi::DesktopCompat,
         Contexts::SrgbSwitch => host.srgb_switch,
+        // ES 3.x and desktop GL ≥ 4.0: every context Mesa gives.
+        Contexts::TransformFeedbackObjects => true,
         _ => unreachable!(),
     };
     let Some(l) = LEFT_WITHOUT_RESTORE
@@ -249,9 +270,17 @@ fn hostile_inherited_state_does_not_change_the_splats() {
     let cam = look_at_fov_deg(Vec3::new(0.3, 0.2, 3.0), Vec3::ZERO, 50.0, 64, 64);
     // An sRGB target: a host's GL_FRAMEBUFFER_SRGB would re-encode srgb_rec709 colours.
     let target = ReadbackTarget::new(gl, 64, 64, ColorFormat::Srgb8Alpha8, None).unwrap();
-    for restore in [false, true] {
+    // SAFETY: a transform-feedback object of the host's (bound, never active).
+    let host_tf = unsafe { gl.create_transform_feedback().unwrap() };
+    let mut first_clean: Option<Image> = None;
+    let runs = [false, true].map(|restore| (restore, DrawPath::default()));
+    for (restore, path) in runs
+        .into_iter()
+        .chain([(false, prepass()), (true, prepass())])
+    {
         let mut r = SplatRenderer::new(gl).unwrap();
         r.settings_mut().restore_state = restore;
+        r.set_draw_path(gl, path).unwrap();
         r.upload(gl, &cloud).unwrap();
         let clean = render_with(gl, &target, (&mut r, &cloud), &cam, || {});
         // SAFETY: host state changes with valid enums of a compatibility context.
@@ -270,9 +299,12 @@ fn hostile_inherited_state_does_not_change_the_splats() {
             gl.enable(glow::SAMPLE_ALPHA_TO_COVERAGE);
             gl.enable(glow::FRAMEBUFFER_SRGB);
             gl.enable(glow::DEPTH_TEST); // no depth buffer: always passes
+            gl.bind_transform_feedback(glow::TRANSFORM_FEEDBACK, Some(host_tf));
         });
+        assert_eq!(r.last_draw_used_prepass(), path == prepass());
         // SAFETY: back to the defaults for the next clear.
         unsafe {
+            gl.bind_transform_feedback(glow::TRANSFORM_FEEDBACK, None);
             gl.color_mask(true, true, true, true);
             gl.polygon_mode(glow::FRONT_AND_BACK, glow::FILL);
             for cap in [
@@ -295,10 +327,17 @@ fn hostile_inherited_state_does_not_change_the_splats() {
         );
         assert!(
             clean == hostile,
-            "restore {restore}: hostile state changed the splats"
+            "restore {restore}, {path:?}: hostile state changed the splats"
+        );
+        let first = first_clean.get_or_insert_with(|| clean.clone());
+        assert!(
+            *first == clean,
+            "{path:?}: the pre-pass draws the same image"
         );
         r.destroy(gl);
     }
+    // SAFETY: deleting the host's object created above.
+    unsafe { gl.delete_transform_feedback(host_tf) };
 }
 
 #[test]

@@ -573,3 +573,94 @@ fn long_thin_needles() {
         MAX_ERR_DENSE,
     );
 }
+
+/// Renders `cloud` from `cam` by the former path (3σ quads, every splat, direct vertex stage)
+/// and by each new one (opacity-aware quads; culled before the sort; direct or through the
+/// transform-feedback pre-pass), both targets; returns, per new path, the pixels (RGBA8
+/// channels) that differ from the former path's and the largest difference (in 1/255).
+fn differences_from_the_former_path(
+    r: &mut HeadlessRenderer,
+    cloud: &SplatCloud,
+    cam: &Camera,
+) -> Vec<(&'static str, usize, f32)> {
+    use splatgl::gl::{DrawPath, Pipeline};
+    r.upload(cloud).unwrap();
+    let mut out = Vec::new();
+    for opts in both_targets() {
+        r.set_path(DrawPath::FORMER, false).unwrap();
+        let former = r.render(cam, &opts).unwrap();
+        assert!(!r.renderer().last_draw_used_prepass());
+        let covered = former.pixels.iter().filter(|p| p[3] > 0.1).count();
+        out.push(("covered pixels", covered, 0.0));
+        let extent = |pipeline| DrawPath {
+            pipeline,
+            former_quads: false,
+        };
+        for (name, path, cull) in [
+            ("opacity-aware quads", extent(Pipeline::Direct), false),
+            ("culled", DrawPath::FORMER, true),
+            ("pre-pass", extent(Pipeline::PrePass), false),
+            ("all (default)", DrawPath::default(), true),
+        ] {
+            r.set_path(path, cull).unwrap();
+            let img = r.render(cam, &opts).unwrap();
+            let prepass = r.renderer().last_draw_used_prepass();
+            match path.pipeline {
+                Pipeline::Direct => assert!(!prepass, "{name}: drawn directly"),
+                Pipeline::PrePass => assert!(prepass, "{name}: through the pre-pass"),
+                _ => {}
+            }
+            let diff = former
+                .pixels
+                .iter()
+                .flatten()
+                .zip(img.pixels.iter().flatten())
+                .map(|(a, b)| (a - b).abs() * 255.0)
+                .filter(|d| *d > 0.0);
+            let (n, max) = diff.fold((0, 0.0f32), |(n, m), d| (n + 1, m.max(d)));
+            out.push((name, n, max));
+        }
+    }
+    r.set_path(DrawPath::default(), true).unwrap();
+    out
+}
+
+/// The opacity-aware quads, the cull before the sort and the pre-pass change no pixel of
+/// the GL image of the real scenes (framed, and from inside with about half in view).
+#[test]
+fn new_draw_paths_leave_real_scenes_bit_identical() {
+    let Some(paths) = real_files() else { return };
+    let Some(mut r) = headless() else { return };
+    let (mut checked, mut covered_views) = (0, 0);
+    for path in paths {
+        let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
+            continue;
+        };
+        let cloud = l.cloud;
+        if cloud.len() < 1000 {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let (fwd, up) = (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y);
+        let framed = Camera::frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120).unwrap();
+        let centre = Vec3::from_array(cloud.bounds().unwrap().center());
+        let inside = Camera::look_at(centre, centre + Vec3::X, up, 1.2, 160, 120);
+        for (view, cam) in [("framed", framed), ("inside", inside)] {
+            let diffs = differences_from_the_former_path(&mut r, &cloud, &cam);
+            eprintln!("{name} {view}: {diffs:?}");
+            for (what, n, max) in diffs {
+                if what == "covered pixels" {
+                    covered_views += usize::from(n > 160 * 120 / 20);
+                    continue;
+                }
+                assert_eq!(n, 0, "{name} {view} {what}: max {max}/255");
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked >= 3, "the real scenes must be there");
+    assert!(
+        covered_views >= 2 * checked,
+        "most views show their scene: {covered_views}"
+    );
+}

@@ -635,3 +635,116 @@ fn degenerate_cameras_do_not_panic() {
         assert_eq!(img.pixels.len(), (w * h) as usize);
     }
 }
+
+/// Bit patterns of an image's pixels (f32 equality would let −0 = +0 and NaN ≠ NaN pass).
+fn pixel_bits(img: &Image) -> Vec<u32> {
+    img.pixels.iter().flatten().map(|v| v.to_bits()).collect()
+}
+
+/// Renders with the former rules (3σ boxes, every splat projected and sorted), the
+/// opacity-aware boxes alone, and the default (opacity-aware boxes, culled before the sort);
+/// asserts the images are bit-identical and returns the tile entries of the first two.
+fn same_image_by_every_path(what: &str, cloud: &SplatCloud, cam: &Camera) -> (usize, usize) {
+    use splatgl::reference::{Extent, Path, render_with_path};
+    let o = opts();
+    let (full, full_stats) = render_with_path(cloud, cam, &o, Path::FULL);
+    let extent_only = Path {
+        extent: Extent::OpacityAware,
+        cull: false,
+    };
+    let (boxed, boxed_stats) = render_with_path(cloud, cam, &o, extent_only);
+    let (culled, culled_stats) = render_with_path(cloud, cam, &o, Path::default());
+    assert_eq!(
+        pixel_bits(&full),
+        pixel_bits(&boxed),
+        "{what}: opacity-aware boxes"
+    );
+    assert_eq!(
+        pixel_bits(&full),
+        pixel_bits(&culled),
+        "{what}: culled before the sort"
+    );
+    assert_eq!(
+        boxed_stats.visible, culled_stats.visible,
+        "{what}: the cull keeps every splat whose box touches the image"
+    );
+    assert!(
+        boxed_stats.tile_entries <= full_stats.tile_entries,
+        "{what}"
+    );
+    (full_stats.tile_entries, boxed_stats.tile_entries)
+}
+
+/// The opacity-aware pixel box and the cull before the sort change no bit of the reference
+/// image on the real scenes, from outside (framed) and from inside (about half the scene in
+/// view), while the boxes really shrink and the cull really removes splats.
+#[test]
+fn opacity_aware_extent_and_cull_leave_real_scenes_bit_identical() {
+    use splatgl::cull::{CullBounds, Frustum, visible_into};
+    let Some(paths) = real_files() else { return };
+    let mut checked = 0;
+    for path in paths {
+        let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
+            continue;
+        };
+        let cloud = l.cloud;
+        if cloud.len() < 1000 {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let (fwd, up) = (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y);
+        let framed = Camera::frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120).unwrap();
+        // From the scene's centre, looking sideways: roughly half the scene in view.
+        let centre = Vec3::from_array(cloud.bounds().unwrap().center());
+        let inside = Camera::look_at(centre, centre + Vec3::X, up, 1.2, 160, 120);
+        let bounds = CullBounds::new(&cloud);
+        let mut ids = Vec::new();
+        let frustum = Frustum::from_camera(&inside, 0.2);
+        let seen = visible_into(&frustum, &cloud.positions, &bounds, &mut ids);
+        assert!(seen < cloud.len(), "{name}: the inside view culls nothing");
+        let (a, b) = same_image_by_every_path(&format!("{name} framed"), &cloud, &framed);
+        let (c, d) = same_image_by_every_path(&format!("{name} inside"), &cloud, &inside);
+        eprintln!(
+            "{name}: {} splats, {seen} in the inside view; tile entries framed {a} → {b}, inside {c} → {d}",
+            cloud.len()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 3, "the real scenes must be there");
+}
+
+/// The same on synthetic worst cases: low opacities (small k), long needles (where the f32
+/// rounding bound takes over), splats across the image border and the near plane.
+#[test]
+fn opacity_aware_extent_is_exact_for_needles_low_opacity_and_borders() {
+    let mut cloud = random_cloud(3000, 1, 1.0, 77);
+    let mut rng = common::Rng::new(5);
+    for i in 0..cloud.len() {
+        cloud.opacities[i] = [0.004, 0.0045, 0.01, 0.03, 0.2, 1.0, 7.0][i % 7];
+        if i % 5 == 0 {
+            let len = rng.range(0.5, 3.5);
+            cloud.scales[i] = [len, 0.0005, 0.002];
+        }
+    }
+    let cams = [
+        scene_camera(96, 72),
+        look_at_focal_px(
+            Vec3::new(0.0, 0.0, 1.1),
+            Vec3::new(2.0, 0.3, 0.0),
+            60.0,
+            96,
+            72,
+        ),
+        look_at_focal_px(
+            Vec3::new(0.3, 0.2, 0.0),
+            Vec3::new(0.0, 0.0, -3.0),
+            200.0,
+            96,
+            72,
+        ),
+    ];
+    for (k, cam) in cams.iter().enumerate() {
+        let (full, boxed) = same_image_by_every_path(&format!("camera {k}"), &cloud, cam);
+        assert!(boxed < full, "camera {k}: boxes shrink ({full} → {boxed})");
+    }
+}

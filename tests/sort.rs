@@ -9,6 +9,9 @@ use std::cmp::Ordering;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering as AtOrd};
 
+use glam::Vec3;
+use splatgl::camera::Camera;
+use splatgl::cull::{CullBounds, Frustum};
 use splatgl::sort::{
     AsyncSorter, Outcome, Precision, Reuse, SortMode, SortRequest, Sorter, quantized_bucket_width,
     squared_distance, view_depth,
@@ -594,8 +597,13 @@ fn warm_sorter_allocates_nothing() {
         quant.sort_by_distance(&positions, [0.0; 3]);
         ALLOCS.store(0, AtOrd::SeqCst);
         ARMED.store(true, AtOrd::SeqCst);
+        let (bounds, frustum) = culled_view(&positions);
+        let request = SortRequest::distance([0.0, 1.0, -3.0]);
+        full.sort_visible(&positions, &bounds, &frustum, &request);
+        ALLOCS.store(0, AtOrd::SeqCst);
         for i in 0..5 {
             let eye = [i as f32, 1.0, -3.0];
+            full.sort_visible(&positions, &bounds, &frustum, &SortRequest::distance(eye));
             full.sort_by_distance(&positions, eye);
             full.sort_by_view_depth(&positions[..1000], eye, [0.0, 0.0, 1.0]);
             full.sort_keys(&keys);
@@ -612,4 +620,136 @@ fn quantized_sort_puts_infinities_at_the_ends() {
     let mut s = Sorter::new().with_precision(Precision::Quantized { bits: 16 });
     assert_eq!(s.sort_keys(&[1.0, f32::INFINITY]), &[1, 0]);
     assert_eq!(s.sort_keys(&[f32::NEG_INFINITY, 1.0]), &[1, 0]);
+}
+
+// ---------------------------------------------------------------- culled sorts
+
+/// Cull radii (a few never visible) and a camera's frustum for `positions` (±10 cube): the
+/// camera at (0, 1, −15) looks at (6, 0, 0), so part of the cube is out of view.
+fn culled_view(positions: &[[f32; 3]]) -> (CullBounds, Frustum) {
+    let radii = (0..positions.len())
+        .map(|i| {
+            if i % 97 == 0 {
+                -1.0
+            } else {
+                (i % 11) as f32 * 0.05
+            }
+        })
+        .collect();
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 1.0, -15.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        Vec3::Y,
+        0.7,
+        320,
+        200,
+    );
+    (
+        CullBounds::from_radii(radii),
+        Frustum::from_camera(&cam, 0.2),
+    )
+}
+
+/// The culled order is the full order with the culled splats left out (same keys, same
+/// ties), for every mode and precision, and its reuse only fires for the same frustum.
+#[test]
+fn visible_sort_is_the_full_order_filtered() {
+    let mut rng = Rng::new(41);
+    let mut positions = random_positions(&mut rng, 90_000, 10.0);
+    // Ties: duplicates of earlier means.
+    for i in (0..positions.len()).step_by(13) {
+        positions[i] = positions[i / 2];
+    }
+    positions[5] = [f32::NAN, 0.0, 0.0];
+    let (bounds, frustum) = culled_view(&positions);
+    let visible: Vec<bool> = positions
+        .iter()
+        .zip(bounds.radii())
+        .map(|(p, r)| frustum.may_see(*p, *r))
+        .collect();
+    let seen = visible.iter().filter(|v| **v).count();
+    assert!(seen > 10_000 && seen < 80_000, "{seen}");
+    let eye = [0.0, 1.0, -15.0];
+    let forward = [0.37, -0.06, 0.93];
+    for precision in [Precision::Full, Precision::Quantized { bits: 16 }] {
+        for (mode, request) in [
+            (SortMode::Distance, SortRequest::distance(eye)),
+            (
+                SortMode::ViewDepth,
+                SortRequest {
+                    mode: SortMode::ViewDepth,
+                    eye,
+                    forward,
+                },
+            ),
+        ] {
+            let mut s = Sorter::new().with_precision(precision);
+            let culled = s
+                .sort_visible(&positions, &bounds, &frustum, &request)
+                .to_vec();
+            assert_eq!(culled.len(), seen);
+            if precision == Precision::Full {
+                let full = match mode {
+                    SortMode::Distance => Sorter::new().sort_by_distance(&positions, eye).to_vec(),
+                    SortMode::ViewDepth => Sorter::new()
+                        .sort_by_view_depth(&positions, eye, forward)
+                        .to_vec(),
+                };
+                let want: Vec<u32> = full.into_iter().filter(|&i| visible[i as usize]).collect();
+                assert_eq!(culled, want, "{mode:?}");
+            } else {
+                let mut sorted = culled.clone();
+                sorted.sort();
+                let want: Vec<u32> = (0..positions.len() as u32)
+                    .filter(|&i| visible[i as usize])
+                    .collect();
+                assert_eq!(sorted, want, "{mode:?} quantized: the visible set");
+            }
+        }
+    }
+    // Reuse: the same request and frustum reuse; another frustum (same eye) sorts again.
+    let mut s = Sorter::new().with_reuse(Reuse::MotionBound);
+    let request = SortRequest::distance(eye);
+    let first = s
+        .sort_visible(&positions, &bounds, &frustum, &request)
+        .to_vec();
+    s.sort_visible(&positions, &bounds, &frustum, &request);
+    assert_eq!(s.last_outcome(), Outcome::ReusedSameView);
+    let cam = Camera::look_at(Vec3::from_array(eye), Vec3::ZERO, Vec3::Y, 0.7, 320, 200);
+    let other = Frustum::from_camera(&cam, 0.2);
+    let second = s
+        .sort_visible(&positions, &bounds, &other, &request)
+        .to_vec();
+    assert_eq!(s.last_outcome(), Outcome::Sorted);
+    assert_ne!(first, second);
+    // A full sort after a culled one does not reuse it.
+    s.sort_by_distance(&positions, eye);
+    assert_eq!(s.last_outcome(), Outcome::Sorted);
+    assert_eq!(s.order().len(), positions.len());
+}
+
+/// The background sorter culls like `Sorter::sort_visible` when it has the bounds, and
+/// keeps sorting everything for plain requests (and without bounds).
+#[test]
+fn async_sorter_culls_with_bounds() {
+    let mut rng = Rng::new(43);
+    let positions = random_positions(&mut rng, 50_000, 10.0);
+    let (bounds, frustum) = culled_view(&positions);
+    let request = SortRequest::distance([0.0, 1.0, -15.0]);
+    let want = Sorter::new()
+        .sort_visible(&positions, &bounds, &frustum, &request)
+        .to_vec();
+    let shared: Arc<[[f32; 3]]> = positions.clone().into();
+    let mut bg = AsyncSorter::with_bounds(shared.clone(), Arc::new(bounds), Sorter::new()).unwrap();
+    let g = bg.request_visible(request, frustum);
+    let frame = bg.wait_for(g).unwrap();
+    assert_eq!(frame.order(), &want[..]);
+    assert_eq!(frame.frustum(), Some(frustum));
+    let g = bg.request(request);
+    let frame = bg.wait_for(g).unwrap();
+    assert_eq!(frame.order().len(), positions.len());
+    assert_eq!(frame.frustum(), None);
+    let mut plain = AsyncSorter::new(shared, Sorter::new()).unwrap();
+    let g = plain.request_visible(request, frustum);
+    assert_eq!(plain.wait_for(g).unwrap().order().len(), positions.len());
 }

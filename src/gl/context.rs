@@ -27,6 +27,9 @@ pub(crate) struct ContextInfo {
     /// `GL_FRAMEBUFFER_SRGB` can be switched: desktop GL, or ES with
     /// `GL_EXT_sRGB_write_control`.
     pub(crate) srgb_switch: bool,
+    /// Transform-feedback objects exist (`glBindTransformFeedback`): ES 3.x, desktop GL ≥ 4.0
+    /// or `GL_ARB_transform_feedback2`. The pre-pass needs them.
+    pub(crate) tf_objects: bool,
 }
 
 impl ContextInfo {
@@ -72,9 +75,11 @@ impl ContextInfo {
             }
         };
         let srgb_switch = !es || fault::has_extension(gl, "GL_EXT_sRGB_write_control");
+        let tf_objects = es || major >= 4 || fault::has_extension(gl, "GL_ARB_transform_feedback2");
         Ok(ContextInfo {
             profile,
             srgb_switch,
+            tf_objects,
         })
     }
 }

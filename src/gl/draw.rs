@@ -6,7 +6,8 @@ use glam::Mat4;
 use glow::HasContext;
 
 use super::GlError;
-use super::renderer::{DrawSettings, SplatRenderer};
+use super::prepass::PREPASS_MIN_SPLATS;
+use super::renderer::{DrawSettings, Pipeline, SplatRenderer};
 use super::state::{self, DrawState};
 use super::view::ViewParams;
 use crate::camera::Camera;
@@ -102,9 +103,22 @@ impl SplatRenderer {
             return Err(GlError::NotUploaded);
         };
         let space = settings.color_space.unwrap_or(self.color_space);
+        let prepass = self.prepass.as_ref().filter(|p| {
+            let n = self.instances;
+            n <= p.capacity()
+                && match self.path.pipeline {
+                    Pipeline::Direct => false,
+                    Pipeline::PrePass => true,
+                    Pipeline::Auto => n >= PREPASS_MIN_SPLATS,
+                }
+        });
+        let (program, vao) = match prepass {
+            Some(p) => (p.quad, p.quad_vao),
+            None => (self.program, self.vao),
+        };
         let want = DrawState {
-            program: self.program,
-            vao: self.vao,
+            program,
+            vao,
             textures: [tex.geometry, tex.sh],
             blend_src: if self.errata.g_src_alpha_blend {
                 glow::SRC_ALPHA
@@ -116,10 +130,22 @@ impl SplatRenderer {
             srgb: space == ColorSpace::LinRec709Display,
         };
         let (saved, entered) = state::draw::enter(gl, self.ctx, &want, settings.restore_state);
-        self.set_uniforms(gl, view, settings);
+        match prepass {
+            Some(p) if self.instances > 0 => {
+                // Per-splat maths once per splat into the records, then the quads read them.
+                p.bind(gl);
+                self.set_uniforms(gl, &p.prep_uniforms, view, settings);
+                p.capture(gl, self.instances);
+            }
+            _ => self.set_uniforms(gl, &self.uniforms, view, settings),
+        }
+        self.used_prepass
+            .set(prepass.is_some() && self.instances > 0);
         if self.instances > 0 {
-            // SAFETY: draws `instances` instances of the bound VAO, which `set_order` bounded
-            // by the order buffer's size; the shader culls any index past the uploaded splats.
+            // SAFETY: draws `instances` instances of the bound VAO: the direct one reads the
+            // order buffer, which `set_order` bounded by its size (the shader culls any index
+            // past the uploaded splats); the quad one reads as many records, captured just
+            // above (`instances ≤ capacity`).
             unsafe { gl.draw_arrays_instanced(glow::TRIANGLE_STRIP, 0, 4, self.instances as i32) };
         }
         let left = state::draw::leave(gl, self.ctx, saved);
@@ -128,44 +154,5 @@ impl SplatRenderer {
             sets: entered.sets + left.sets,
         });
         Ok(())
-    }
-
-    /// Every uniform of one draw, in one place (the program is bound).
-    fn set_uniforms(&self, gl: &glow::Context, view: &ViewParams, settings: &DrawSettings) {
-        let u = &self.uniforms;
-        let tex = self.textures.as_ref().expect("checked by draw_view");
-        let degree = settings
-            .sh_degree
-            .unwrap_or(self.cloud_degree)
-            .min(self.cloud_degree);
-        let [vx, vy, vw, vh] = view.viewport.map(|v| v as f32);
-        let m = &self.models;
-        // SAFETY: sets uniforms of the bound splat program with values of the declared types;
-        // the model arrays hold MAX_CLOUDS entries, as declared.
-        unsafe {
-            let mat = |l, m: &Mat4| gl.uniform_matrix_4_f32_slice(l, false, &m.to_cols_array());
-            mat(u.u_view_matrix.as_ref(), &view.view);
-            mat(u.u_projection_matrix.as_ref(), &view.projection);
-            let (f, t, e) = (view.focal, view.tan_half_fov, view.eye);
-            gl.uniform_2_f32(u.u_focal_length.as_ref(), f.x, f.y);
-            gl.uniform_2_f32(u.u_tan_half_fov.as_ref(), t.x, t.y);
-            gl.uniform_3_f32(u.u_camera_position.as_ref(), e.x, e.y, e.z);
-            gl.uniform_4_f32(u.u_viewport.as_ref(), vx, vy, vw, vh);
-            gl.uniform_1_f32(u.u_cull_depth.as_ref(), view.cull_depth);
-            gl.uniform_1_i32(u.u_sh_degree.as_ref(), i32::from(degree));
-            gl.uniform_1_i32(u.u_sh_texels.as_ref(), tex.sh_texels as i32);
-            let fetch = crate::profile::sh_texels(degree);
-            gl.uniform_1_i32(u.u_sh_fetch_texels.as_ref(), fetch as i32);
-            gl.uniform_1_i32(u.u_splat_count.as_ref(), tex.len as i32);
-            gl.uniform_1_i32(u.u_geometry.as_ref(), 0);
-            gl.uniform_1_i32(u.u_sh.as_ref(), 1);
-            gl.uniform_1_i32(u.u_model_count.as_ref(), m.count as i32);
-            if m.count > 0 {
-                let rows = bytemuck::cast_slice(&m.rows[..m.count]);
-                gl.uniform_4_f32_slice(u.u_model_rows.as_ref(), rows);
-                let sh = bytemuck::cast_slice(&m.sh_rotation[..m.count]);
-                gl.uniform_matrix_3_f32_slice(u.u_sh_rotation.as_ref(), false, sh);
-            }
-        }
     }
 }

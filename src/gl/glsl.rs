@@ -10,9 +10,17 @@ use super::context::{ContextInfo, Profile};
 use super::data::TextureLayout;
 use crate::profile;
 
-/// Vertex stage of the splat program.
+/// Vertex stage of the splat program (direct path).
 pub(crate) const SPLAT_VERT: &str = include_str!("../../glsl/splat.vert");
-/// Spherical-harmonics colour, spliced into the vertex stage at `//@include sh.glsl`.
+/// The per-splat maths, spliced into the vertex stages at `//@include splat_project.glsl`.
+pub(crate) const SPLAT_PROJECT_GLSL: &str = include_str!("../../glsl/splat_project.glsl");
+/// Vertex stage of the transform-feedback pre-pass.
+pub(crate) const SPLAT_PREP_VERT: &str = include_str!("../../glsl/splat_prep.vert");
+/// Vertex stage of the splat program after the pre-pass.
+pub(crate) const SPLAT_QUAD_VERT: &str = include_str!("../../glsl/splat_quad.vert");
+/// Fragment stage of the pre-pass (never runs: the rasterizer is discarded).
+pub(crate) const DISCARD_FRAG: &str = include_str!("../../glsl/discard.frag");
+/// Spherical-harmonics colour, spliced into the per-splat maths at `//@include sh.glsl`.
 pub(crate) const SH_GLSL: &str = include_str!("../../glsl/sh.glsl");
 /// Fragment stage of the splat program.
 pub(crate) const SPLAT_FRAG: &str = include_str!("../../glsl/splat.frag");
@@ -92,6 +100,9 @@ impl Errata {
                 s.push_str(&format!("#define {name}\n"));
             }
         }
+        if *self != Errata::default() {
+            s.push_str("#define FORMER_QUADS\n");
+        }
         s
     }
 }
@@ -114,6 +125,13 @@ pub(crate) fn defines(layout: &TextureLayout) -> String {
     def("CUTOFF_M2", f32_lit(profile::CUTOFF_M2 as f64));
     def("ALPHA_MAX", f32_lit(profile::ALPHA_MAX as f64));
     def("ALPHA_MIN", f32_lit(profile::ALPHA_MIN as f64));
+    def("OPACITY_M2_MARGIN", f32_lit(profile::OPACITY_M2_MARGIN));
+    def("QUAD_AXIS_FACTOR", f32_lit(profile::QUAD_AXIS_FACTOR));
+    def("QUAD_MARGIN_PX", f32_lit(profile::QUAD_MARGIN_PX));
+    def(
+        "FORMER_QUAD_MARGIN_PX",
+        f32_lit(profile::FORMER_QUAD_MARGIN_PX),
+    );
     def("FOV_CLAMP", f32_lit(profile::JACOBIAN_CLAMP));
     def("SH_DC_BIAS", f32_lit(profile::SH_DC_BIAS));
     def("SH_C0", float_lit(SH_C0));
@@ -151,7 +169,7 @@ pub(crate) fn defines(layout: &TextureLayout) -> String {
 }
 
 /// Assembles one stage: version line, precision, defines (see [`defines`]), then the file (with
-/// `//@include sh.glsl` replaced by [`SH_GLSL`]).
+/// `//@include splat_project.glsl` and `//@include sh.glsl` replaced by those files).
 pub(crate) fn assemble(
     version: GlslVersion,
     errata: &Errata,
@@ -171,7 +189,8 @@ pub(crate) fn assemble(
         version.line(),
         defines(layout),
         errata.defines(),
-        body.replace("//@include sh.glsl", SH_GLSL)
+        body.replace("//@include splat_project.glsl", SPLAT_PROJECT_GLSL)
+            .replace("//@include sh.glsl", SH_GLSL)
     )
 }
 
@@ -191,8 +210,12 @@ mod tests {
     use std::collections::BTreeMap;
 
     /// The GLSL sources, by file name.
-    const SOURCES: [(&str, &str); 5] = [
+    const SOURCES: [(&str, &str); 9] = [
         ("splat.vert", SPLAT_VERT),
+        ("splat_project.glsl", SPLAT_PROJECT_GLSL),
+        ("splat_prep.vert", SPLAT_PREP_VERT),
+        ("splat_quad.vert", SPLAT_QUAD_VERT),
+        ("discard.frag", DISCARD_FRAG),
         ("sh.glsl", SH_GLSL),
         ("splat.frag", SPLAT_FRAG),
         ("resolve.vert", RESOLVE_VERT),
@@ -224,6 +247,13 @@ mod tests {
             ("CUTOFF_M2".into(), profile::CUTOFF_M2 as f64),
             ("ALPHA_MAX".into(), profile::ALPHA_MAX as f64),
             ("ALPHA_MIN".into(), profile::ALPHA_MIN as f64),
+            ("OPACITY_M2_MARGIN".into(), profile::OPACITY_M2_MARGIN),
+            ("QUAD_AXIS_FACTOR".into(), profile::QUAD_AXIS_FACTOR),
+            ("QUAD_MARGIN_PX".into(), profile::QUAD_MARGIN_PX),
+            (
+                "FORMER_QUAD_MARGIN_PX".into(),
+                profile::FORMER_QUAD_MARGIN_PX,
+            ),
             ("FOV_CLAMP".into(), profile::JACOBIAN_CLAMP),
             ("SH_DC_BIAS".into(), profile::SH_DC_BIAS),
             ("SH_C0".into(), SH_C0),

@@ -53,6 +53,7 @@ mod error;
 pub mod fault;
 mod glsl;
 mod objects;
+mod prepass;
 mod program;
 mod readback;
 mod renderer;
@@ -60,18 +61,23 @@ mod scene;
 mod sort;
 pub mod state;
 mod target;
+mod uniforms;
 mod view;
 
 pub use error::GlError;
 pub(crate) use error::check_error;
 #[doc(hidden)]
 pub use glsl::Errata;
+pub use prepass::PREPASS_MIN_SPLATS;
 #[doc(hidden)]
 pub use program::build_program;
 pub use readback::{ColorFormat, DepthFormat, ReadbackTarget};
 pub use renderer::{DepthFunc, DrawSettings, SplatRenderer};
+#[doc(hidden)]
+pub use renderer::{DrawPath, Pipeline};
 pub use scene::SplatScene;
 pub use sort::{DistanceSorter, sort_back_to_front};
 #[doc(hidden)]
 pub use state::StateCalls;
 pub use target::OffscreenTarget;
+pub use view::{frustum_for_camera, frustum_for_matrices};

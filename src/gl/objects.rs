@@ -74,6 +74,7 @@ pub(crate) enum GlObject {
     Renderbuffer(glow::Renderbuffer),
     Buffer(glow::Buffer),
     VertexArray(glow::VertexArray),
+    TransformFeedback(glow::TransformFeedback),
 }
 
 impl GlObject {
@@ -90,6 +91,7 @@ impl GlObject {
                 GlObject::Renderbuffer(o) => gl.delete_renderbuffer(o),
                 GlObject::Buffer(o) => gl.delete_buffer(o),
                 GlObject::VertexArray(o) => gl.delete_vertex_array(o),
+                GlObject::TransformFeedback(o) => gl.delete_transform_feedback(o),
             }
         }
     }
@@ -185,6 +187,8 @@ creators! {
     buffer: Buffer = create_buffer, "buffer";
     /// A new vertex array.
     vertex_array: VertexArray = create_vertex_array, "vertex array";
+    /// A new transform-feedback object.
+    transform_feedback: TransformFeedback = create_transform_feedback, "transform feedback";
 }
 
 impl Drop for Creating<'_> {

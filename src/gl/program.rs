@@ -30,6 +30,18 @@ pub(crate) fn build_program_in(
     vertex: &str,
     fragment: &str,
 ) -> Result<glow::Program, GlError> {
+    build_program_with_feedback(objects, name, vertex, fragment, &[])
+}
+
+/// [`build_program_in`], capturing the vertex outputs `varyings` (interleaved, in that order)
+/// by transform feedback when not empty.
+pub(crate) fn build_program_with_feedback(
+    objects: &mut Creating<'_>,
+    name: &str,
+    vertex: &str,
+    fragment: &str,
+    varyings: &[&str],
+) -> Result<glow::Program, GlError> {
     let gl = objects.gl();
     let program = objects.program()?;
     // Dropped (so deleted) on every path out of this function, after being detached.
@@ -57,6 +69,9 @@ pub(crate) fn build_program_in(
             }
             gl.attach_shader(program, shader);
             attached.push(shader);
+        }
+        if !varyings.is_empty() {
+            gl.transform_feedback_varyings(program, varyings, glow::INTERLEAVED_ATTRIBS);
         }
         gl.link_program(program);
         for &s in &attached {

@@ -3,7 +3,7 @@
 
 use std::cell::Cell;
 
-use glam::{DMat3, Mat4};
+use glam::Mat4;
 use glow::HasContext;
 
 use super::GlError;
@@ -13,8 +13,10 @@ use super::error::ErrorScope;
 use super::fault;
 use super::glsl::{self, Errata, GlslVersion};
 use super::objects::{Creating, Owned};
+use super::prepass::{PREPASS_MIN_SPLATS, PrePass, Sources};
 use super::program;
 use super::state::{Bindings, StateCalls};
+use super::uniforms::{Models, Uniforms};
 use crate::cloud::{ColorSpace, SplatCloud};
 
 /// The depth comparison of [`DrawSettings::depth_func`] (the host's convention: `Less` /
@@ -79,71 +81,39 @@ impl Default for DrawSettings {
     }
 }
 
-/// Declares `Uniforms`, one location per uniform the renderer sets, each field named exactly
-/// like its GLSL uniform (so the two cannot get out of step).
-macro_rules! uniforms {
-    ($($name:ident),* $(,)?) => {
-        /// The locations of the uniforms the renderer sets.
-        #[derive(Debug)]
-        pub(super) struct Uniforms {
-            $(pub(super) $name: Option<glow::UniformLocation>,)*
-        }
+/// Which way the renderer computes the per-splat maths. **For the benchmarks and the tests
+/// that compare the paths** (hidden from the documented API): every path draws the same image.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Pipeline {
+    /// The pre-pass from [`PREPASS_MIN_SPLATS`] splats drawn on, else direct (the default).
+    #[default]
+    Auto,
+    /// Every quad corner runs the per-splat maths (the path before the pre-pass).
+    Direct,
+    /// Always the transform-feedback pre-pass (where the context has transform-feedback
+    /// objects and no erratum is switched in; else direct).
+    PrePass,
+}
 
-        impl Uniforms {
-            /// Looks them up; for the correct program (`check`), a debug build asserts that
-            /// they all exist.
-            fn new(gl: &glow::Context, program: glow::Program, check: bool) -> Self {
-                let names = [$(stringify!($name)),*];
-                let [$($name),*] = program::uniform_locations(gl, program, "splat", names, check);
-                Uniforms { $($name),* }
-            }
-        }
+/// The renderer's draw path (hidden, see [`Pipeline`]).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DrawPath {
+    /// Direct, pre-pass, or chosen by the splat count.
+    pub pipeline: Pipeline,
+    /// The former quads: the 3σ ellipse's rectangle whatever the opacity, with the former
+    /// 0.5 px margin ([`crate::profile::FORMER_QUAD_MARGIN_PX`]), instead of the
+    /// opacity-aware extent and [`crate::profile::QUAD_MARGIN_PX`].
+    pub former_quads: bool,
+}
+
+impl DrawPath {
+    /// The path before the opacity-aware extent and the pre-pass.
+    pub const FORMER: DrawPath = DrawPath {
+        pipeline: Pipeline::Direct,
+        former_quads: true,
     };
-}
-
-uniforms! {
-    u_geometry, u_sh, u_sh_texels, u_sh_fetch_texels, u_sh_degree, u_view_matrix,
-    u_projection_matrix, u_focal_length, u_tan_half_fov, u_camera_position, u_viewport,
-    u_cull_depth, u_splat_count, u_model_count, u_model_rows, u_sh_rotation,
-}
-
-/// The model matrices of the uploaded clouds, as the shader reads them: rows 0..2 of each
-/// affine matrix and the transposed polar rotation (world → model directions, for the SH).
-/// `count == 0`: every model is the identity (the shader skips the transform).
-#[derive(Debug, Clone)]
-pub(super) struct Models {
-    pub(super) rows: [[f32; 12]; SplatScene::MAX_CLOUDS],
-    pub(super) sh_rotation: [[f32; 9]; SplatScene::MAX_CLOUDS],
-    pub(super) count: usize,
-}
-
-use super::SplatScene;
-
-impl Models {
-    const IDENTITY: Models = Models {
-        rows: [[0.0; 12]; SplatScene::MAX_CLOUDS],
-        sh_rotation: [[0.0; 9]; SplatScene::MAX_CLOUDS],
-        count: 0,
-    };
-
-    /// The uniforms for `models` (finite affine matrices, at most `MAX_CLOUDS`).
-    pub(super) fn set(&mut self, models: &[Mat4]) {
-        if models.iter().all(|m| *m == Mat4::IDENTITY) {
-            self.count = 0;
-            return;
-        }
-        for (k, m) in models.iter().enumerate() {
-            let rows = [m.row(0), m.row(1), m.row(2)];
-            for (r, row) in rows.iter().enumerate() {
-                self.rows[k][4 * r..4 * r + 4].copy_from_slice(&row.to_array());
-            }
-            // The loader's SH rotation: the polar factor of the 3×3 (identity when singular).
-            let linear = DMat3::from_mat4(m.as_dmat4());
-            let r = crate::covariance::polar_rotation(linear).unwrap_or(DMat3::IDENTITY);
-            self.sh_rotation[k] = r.transpose().as_mat3().to_cols_array();
-        }
-        self.count = models.len();
-    }
 }
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
@@ -190,6 +160,10 @@ pub struct SplatRenderer {
     layout: TextureLayout,
     pub(super) models: Models,
     pub(super) state_calls: Cell<StateCalls>,
+    pub(super) path: DrawPath,
+    pub(super) prepass: Option<PrePass>,
+    /// Whether the last draw ran the pre-pass.
+    pub(super) used_prepass: Cell<bool>,
     pub(super) owned: Owned,
 }
 
@@ -254,8 +228,68 @@ impl SplatRenderer {
             layout,
             models: Models::IDENTITY,
             state_calls: Cell::new(StateCalls::default()),
+            path: DrawPath::default(),
+            prepass: None,
+            used_prepass: Cell::new(false),
             owned: objects.keep("SplatRenderer"),
         })
+    }
+
+    /// Whether the pre-pass can run here: a context with transform-feedback objects, the
+    /// correct shaders (erratum variants draw directly, exactly as before the pre-pass).
+    fn prepass_possible(&self) -> bool {
+        self.ctx.tf_objects && self.errata == Errata::default()
+    }
+
+    /// Whether draws of up to `n` splats may want the pre-pass under the current path.
+    fn prepass_wanted(&self, n: usize) -> bool {
+        self.prepass_possible()
+            && match self.path.pipeline {
+                Pipeline::Direct => false,
+                Pipeline::PrePass => true,
+                Pipeline::Auto => n >= PREPASS_MIN_SPLATS,
+            }
+    }
+
+    /// Creates (or grows) the pre-pass for `capacity` splats where it is wanted.
+    fn ensure_prepass(&mut self, gl: &glow::Context, capacity: usize) -> Result<(), GlError> {
+        if !self.prepass_wanted(capacity) {
+            return Ok(());
+        }
+        if let Some(p) = &mut self.prepass {
+            return p.reserve(gl, capacity);
+        }
+        let version = GlslVersion::for_context(self.ctx);
+        let asm = |body: &str| glsl::assemble(version, &self.errata, &self.layout, body);
+        let src = Sources {
+            prep_vert: asm(glsl::SPLAT_PREP_VERT),
+            discard_frag: asm(glsl::DISCARD_FRAG),
+            quad_vert: asm(glsl::SPLAT_QUAD_VERT),
+            splat_frag: asm(glsl::SPLAT_FRAG),
+        };
+        self.prepass = Some(PrePass::new(gl, &src, self.order_buffer, capacity, true)?);
+        Ok(())
+    }
+
+    /// Chooses the draw path (hidden, see [`Pipeline`]); creates the pre-pass's objects
+    /// when the uploaded cloud needs them now.
+    #[doc(hidden)]
+    pub fn set_draw_path(&mut self, gl: &glow::Context, path: DrawPath) -> Result<(), GlError> {
+        self.owned.check()?;
+        self.path = path;
+        self.ensure_prepass(gl, self.order_capacity)
+    }
+
+    /// The draw path (hidden, see [`Pipeline`]).
+    #[doc(hidden)]
+    pub fn draw_path(&self) -> DrawPath {
+        self.path
+    }
+
+    /// Whether the last draw ran the transform-feedback pre-pass (hidden: tests, benchmarks).
+    #[doc(hidden)]
+    pub fn last_draw_used_prepass(&self) -> bool {
+        self.used_prepass.get()
     }
 
     /// Uploads a cloud's data into textures (once per cloud; replaces any previous cloud) and
@@ -292,6 +326,10 @@ impl SplatRenderer {
         if n > self.order_allocated
             && let Err(e) = self.grow_order_buffer(gl, n)
         {
+            textures.destroy(gl);
+            return Err(e);
+        }
+        if let Err(e) = self.ensure_prepass(gl, n) {
             textures.destroy(gl);
             return Err(e);
         }
@@ -421,6 +459,9 @@ impl SplatRenderer {
         if let Some(mut t) = self.textures.take() {
             t.destroy(gl);
         }
+        if let Some(mut p) = self.prepass.take() {
+            p.destroy(gl);
+        }
         self.owned.destroy(gl);
         self.order_capacity = 0;
         self.instances = 0;
@@ -430,6 +471,9 @@ impl SplatRenderer {
     pub(crate) fn abandon(&mut self) {
         if let Some(mut t) = self.textures.take() {
             t.abandon();
+        }
+        if let Some(mut p) = self.prepass.take() {
+            p.abandon();
         }
         self.owned.abandon();
     }

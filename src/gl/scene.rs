@@ -10,6 +10,8 @@ use super::sort::DistanceSorter;
 use super::{GlError, view::ViewParams};
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
+use crate::cull::{CullBounds, radius_scale};
+use glow::HasContext;
 
 /// Several clouds, each placed by a model matrix (its local → world transform, e.g. an
 /// embedded object's pose that changes every frame), drawn in **one** back-to-front order, so
@@ -25,8 +27,9 @@ use crate::cloud::SplatCloud;
 /// leaves the SH unrotated, as the loader does. Changing a model costs nothing on the GPU
 /// (uniforms).
 ///
-/// The order: each draw sorts all splats together by the distance of their **world**
-/// positions to the eye (one [`DistanceSorter`]). World positions are recomputed on the CPU
+/// The order: each draw sorts all splats the view may see ([`crate::cull`], tested on their
+/// world positions and radii) together by the distance of their **world** positions to the
+/// eye (one [`DistanceSorter`]). World positions are recomputed on the CPU
 /// only for clouds whose model changed since the last draw: per-frame work proportional to
 /// the splats of the moving clouds, on top of the sort itself.
 ///
@@ -43,6 +46,9 @@ pub struct SplatScene {
     stale: Vec<bool>,
     local: Vec<[f32; 3]>,
     world: Vec<[f32; 3]>,
+    /// Cull radii in model space, and in world space (scaled by each model's largest stretch).
+    local_bounds: CullBounds,
+    world_bounds: CullBounds,
     sorter: DistanceSorter,
     order: Vec<u32>,
 }
@@ -73,6 +79,8 @@ impl SplatScene {
             stale: Vec::new(),
             local: Vec::new(),
             world: Vec::new(),
+            local_bounds: CullBounds::default(),
+            world_bounds: CullBounds::default(),
             sorter: DistanceSorter::default(),
             order: Vec::new(),
         })
@@ -115,12 +123,17 @@ impl SplatScene {
         self.renderer.set_models(&self.models);
         self.ranges.clear();
         self.local.clear();
+        let mut radii = Vec::new();
         for c in &clouds {
             let start = self.local.len();
             self.local.extend_from_slice(&c.positions);
             self.ranges.push(start..self.local.len());
+            radii.extend_from_slice(CullBounds::new(c).radii());
         }
         self.world.clone_from(&self.local);
+        self.local_bounds = CullBounds::from_radii(radii);
+        self.world_bounds = self.local_bounds.clone();
+        self.world_bounds.set_extent(&self.world);
         self.stale = self.models.iter().map(|m| *m != Mat4::IDENTITY).collect();
         self.order.clear();
         Ok(())
@@ -174,6 +187,16 @@ impl SplatScene {
         self.renderer.settings_mut()
     }
 
+    /// The renderer's draw path (hidden, see [`super::Pipeline`]).
+    #[doc(hidden)]
+    pub fn set_draw_path(
+        &mut self,
+        gl: &glow::Context,
+        path: super::DrawPath,
+    ) -> Result<(), GlError> {
+        self.renderer.set_draw_path(gl, path)
+    }
+
     /// The renderer (read-only: uploads go through [`SplatScene::upload`], so the order always
     /// indexes the clouds drawn).
     pub fn renderer(&self) -> &SplatRenderer {
@@ -185,25 +208,44 @@ impl SplatScene {
         &self.order
     }
 
-    /// Sorts every splat by the distance of its world position to `eye` and uploads the order.
-    fn sort(&mut self, gl: &glow::Context, eye: Vec3) -> Result<(), GlError> {
+    /// Sorts the splats the view may see ([`crate::cull`], on their world positions and
+    /// radii) by the distance of their world positions to the eye and uploads the order.
+    fn sort(&mut self, gl: &glow::Context, view: &ViewParams) -> Result<(), GlError> {
+        let mut moved = false;
         for (k, stale) in self.stale.iter_mut().enumerate() {
             if std::mem::take(stale) {
                 let (r, m) = (self.ranges[k].clone(), self.models[k]);
-                for (w, p) in self.world[r.clone()].iter_mut().zip(&self.local[r]) {
+                for (w, p) in self.world[r.clone()].iter_mut().zip(&self.local[r.clone()]) {
                     *w = m.transform_point3(Vec3::from_array(*p)).to_array();
                 }
+                let grow = radius_scale(m);
+                let local = &self.local_bounds.radii()[r.clone()];
+                for (w, l) in self.world_bounds.radii_mut()[r].iter_mut().zip(local) {
+                    *w = l * grow;
+                }
+                moved = true;
             }
         }
-        self.sorter.sort(&self.world, eye, &mut self.order);
+        if moved {
+            self.world_bounds.set_extent(&self.world);
+        }
+        let frustum = view.frustum();
+        let (world, bounds) = (&self.world, &self.world_bounds);
+        self.sorter
+            .sort_visible(world, bounds, &frustum, view.eye, &mut self.order);
         self.renderer.set_order(gl, &self.order)
     }
 
     /// Sorts for `camera` and draws every cloud into the bound framebuffer and viewport (as
     /// [`SplatRenderer::draw`]).
     pub fn draw(&mut self, gl: &glow::Context, camera: &Camera) -> Result<(), GlError> {
-        self.sort(gl, camera.eye())?;
-        self.renderer.draw_current(gl, camera)
+        let mut viewport = [0i32; 4];
+        // SAFETY: a plain integer query into a 4-element array.
+        unsafe { gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport) };
+        let params = ViewParams::from_camera(camera, viewport);
+        self.sort(gl, &params)?;
+        let settings = *self.renderer.settings();
+        self.renderer.draw_view(gl, &params, &settings)
     }
 
     /// Sorts for the host's camera and draws (as [`SplatRenderer::draw_with_matrices`]).
@@ -215,7 +257,7 @@ impl SplatScene {
         viewport: [i32; 4],
     ) -> Result<(), GlError> {
         let params = ViewParams::from_matrices(view, projection, viewport)?;
-        self.sort(gl, params.eye)?;
+        self.sort(gl, &params)?;
         let settings = *self.renderer.settings();
         self.renderer.draw_view(gl, &params, &settings)
     }

@@ -21,6 +21,30 @@ impl DistanceSorter {
     }
 }
 
+impl DistanceSorter {
+    /// [`DistanceSorter::sort`] of only the splats `frustum` may see
+    /// ([`crate::sort::Sorter::sort_visible`]): `bounds` are the cloud's
+    /// [`CullBounds`](crate::cull::CullBounds), `frustum` from
+    /// [`frustum_for_camera`](super::frustum_for_camera) or
+    /// [`frustum_for_matrices`](super::frustum_for_matrices) of the draw. The image drawn from
+    /// it is the one drawn from the full order; `order.len()` is the visible count.
+    pub fn sort_visible(
+        &mut self,
+        positions: &[[f32; 3]],
+        bounds: &crate::cull::CullBounds,
+        frustum: &crate::cull::Frustum,
+        eye: Vec3,
+        order: &mut Vec<u32>,
+    ) {
+        let request = crate::sort::SortRequest::distance(eye.to_array());
+        let sorted = self
+            .sorter
+            .sort_visible(positions, bounds, frustum, &request);
+        order.clear();
+        order.extend_from_slice(sorted);
+    }
+}
+
 /// [`DistanceSorter::sort`] with fresh scratch (allocates; keep a [`DistanceSorter`] per frame
 /// loop instead).
 pub fn sort_back_to_front(positions: &[[f32; 3]], eye: Vec3, order: &mut Vec<u32>) {

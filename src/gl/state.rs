@@ -29,8 +29,18 @@
 //! | `GL_COLOR_LOGIC_OP` (desktop) | disabled |
 //! | `GL_FRAMEBUFFER_SRGB` (desktop; ES with `GL_EXT_sRGB_write_control`) | enabled iff the colour space drawn is `lin_rec709_display` (blending on linear values, encoded by an sRGB framebuffer) |
 //! | `GL_ALPHA_TEST` (compatibility profile) | disabled |
+//! | `GL_TRANSFORM_FEEDBACK_BINDING` (where transform-feedback objects exist: ES 3.x, desktop ≥ 4.0 or `GL_ARB_transform_feedback2`) | 0 |
 //!
 //! `set_order` binds the order buffer as `GL_ARRAY_BUFFER` to write it.
+//!
+//! **The pre-pass** (large clouds, `docs/gl-backend.md`): between setting that state and the
+//! quad draw, the draw binds its own pre-pass program and vertex array, its own
+//! transform-feedback object (whose buffer binding was made at creation: the generic
+//! `GL_TRANSFORM_FEEDBACK_BUFFER` binding is never touched by a draw), enables
+//! `GL_RASTERIZER_DISCARD` for one `GL_POINTS` draw inside `glBegin/EndTransformFeedback`,
+//! and sets all three back to the values above before the quad draw. So the state left (or
+//! restored) is the same whichever path drew. The host must not have transform feedback
+//! active during a draw (it would capture the splats' quads on any path).
 //!
 //! # Inherited on purpose
 //!
@@ -75,8 +85,10 @@
 //! | `GL_COLOR_LOGIC_OP` | desktop | disabled |
 //! | `GL_FRAMEBUFFER_SRGB` | sRGB switch | enabled iff `lin_rec709_display` |
 //! | `GL_ALPHA_TEST` | compatibility | disabled |
+//! | `GL_TRANSFORM_FEEDBACK_BINDING` | TF objects | 0 |
 //!
-//! ("sRGB switch": desktop GL, or ES with `GL_EXT_sRGB_write_control`.) `tests/gl_embedding.rs`
+//! ("sRGB switch": desktop GL, or ES with `GL_EXT_sRGB_write_control`; "TF objects": ES 3.x,
+//! desktop GL ≥ 4.0 or `GL_ARB_transform_feedback2`.) `tests/gl_embedding.rs`
 //! sets over 60 pieces of host state in ES, core and compatibility contexts and checks, in
 //! both modes, that every one reads back as this module says; a unit test checks that this
 //! table and [`LEFT_WITHOUT_RESTORE`] agree.
@@ -141,6 +153,9 @@ pub enum Contexts {
     /// Where `GL_FRAMEBUFFER_SRGB` can be switched: desktop GL, or ES with
     /// `GL_EXT_sRGB_write_control`.
     SrgbSwitch,
+    /// Where transform-feedback objects exist: ES 3.x, desktop GL ≥ 4.0 or
+    /// `GL_ARB_transform_feedback2`.
+    TransformFeedbackObjects,
 }
 
 /// The value a piece of state is left at by a draw or `set_order` with `restore_state: false`.
@@ -197,7 +212,7 @@ const fn on_unit(mut l: Left, unit: u32) -> Left {
     l
 }
 
-use Contexts::{All, Compatibility, Desktop, SrgbSwitch};
+use Contexts::{All, Compatibility, Desktop, SrgbSwitch, TransformFeedbackObjects};
 use LeftValue::{AllChannels, Bool, DepthFuncSetting, DepthTestSetting, Enabled, Enum, Zero};
 
 const ONE: LeftValue = Enum(glow::ONE, "GL_ONE");
@@ -321,6 +336,12 @@ pub const LEFT_WITHOUT_RESTORE: &[Left] = &[
         LeftValue::LinearColorSpace,
     ),
     left("GL_ALPHA_TEST", ALPHA_TEST, Compatibility, Enabled(false)),
+    left(
+        "GL_TRANSFORM_FEEDBACK_BINDING",
+        glow::TRANSFORM_FEEDBACK_BINDING,
+        TransformFeedbackObjects,
+        Zero,
+    ),
 ];
 
 /// `GL_ALPHA_TEST` (compatibility profile only; not in `glow`'s core enums).
@@ -336,6 +357,7 @@ impl Left {
             Desktop => "desktop",
             Compatibility => "compatibility",
             SrgbSwitch => "sRGB switch",
+            TransformFeedbackObjects => "TF objects",
         };
         let value = match self.value {
             Zero => "0".to_owned(),

@@ -6,6 +6,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::GlError;
 use crate::camera::Camera;
+use crate::cull::Frustum;
 
 /// The per-draw view parameters (the splat program's view uniforms).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,6 +83,31 @@ impl ViewParams {
         })
     }
 
+    /// The cull frustum of this view ([`crate::cull`]): camera space with +z forward (the GL
+    /// eye space with z negated), pixels from the viewport's lower-left corner, the principal
+    /// point where the projection puts the optical axis.
+    pub(crate) fn frustum(&self) -> Frustum {
+        let p = self.projection;
+        let k = -p.z_axis.w;
+        let (vw, vh) = (
+            self.viewport[2].max(1) as f32,
+            self.viewport[3].max(1) as f32,
+        );
+        let principal = Vec2::new(
+            0.5 * vw * (1.0 - p.z_axis.x / k),
+            0.5 * vh * (1.0 - p.z_axis.y / k),
+        );
+        let flip_z = Mat4::from_diagonal(glam::Vec4::new(1.0, 1.0, -1.0, 1.0));
+        Frustum::new(
+            flip_z * self.view,
+            self.focal,
+            principal,
+            Vec2::new(vw, vh),
+            self.tan_half_fov,
+            self.cull_depth,
+        )
+    }
+
     /// From a camera drawn into `viewport`: its GL matrices after fitting it to the viewport
     /// ([`fit_camera`]).
     pub(crate) fn from_camera(camera: &Camera, viewport: [i32; 4]) -> Self {
@@ -89,6 +115,25 @@ impl ViewParams {
         Self::from_matrices(c.gl_view(), c.gl_projection(), viewport)
             .expect("a camera's GL matrices are a perspective projection")
     }
+}
+
+/// The cull frustum ([`crate::cull`]) of `camera` drawn into `viewport` with
+/// [`SplatRenderer::draw`](super::SplatRenderer::draw): what
+/// [`Sorter::sort_visible`](crate::sort::Sorter::sort_visible) needs to sort only the splats
+/// that draw can show. Derived from the same view parameters as the draw itself.
+pub fn frustum_for_camera(camera: &Camera, viewport: [i32; 4]) -> Frustum {
+    ViewParams::from_camera(camera, viewport).frustum()
+}
+
+/// The cull frustum of a host's camera drawn with
+/// [`SplatRenderer::draw_with_matrices`](super::SplatRenderer::draw_with_matrices)
+/// (the same matrices and viewport); refused like that draw refuses them.
+pub fn frustum_for_matrices(
+    view: Mat4,
+    projection: Mat4,
+    viewport: [i32; 4],
+) -> Result<Frustum, GlError> {
+    Ok(ViewParams::from_matrices(view, projection, viewport)?.frustum())
 }
 
 /// The camera as drawn into a viewport of another size: the same size → unchanged; the same
@@ -160,6 +205,28 @@ mod tests {
         let mut skew = cam().gl_projection();
         skew.y_axis.x = 0.3;
         assert!(ViewParams::from_matrices(Mat4::IDENTITY, skew, [0, 0, 8, 8]).is_err());
+    }
+
+    #[test]
+    fn the_gl_frustum_is_the_cameras() {
+        // Off-centre principal point, another viewport aspect: the GL-derived frustum culls
+        // exactly like the camera's own (fitted to the viewport), up to rounding.
+        let mut c = cam();
+        c.cx = 20.0;
+        c.cy = 30.0;
+        for viewport in [[0, 0, 64, 48], [5, 7, 128, 48]] {
+            let gl = frustum_for_camera(&c, viewport);
+            let fitted = fit_camera(&c, viewport);
+            let want = Frustum::from_camera(&fitted, 0.5);
+            let mut differ = 0;
+            for i in 0..20_000 {
+                let t = i as f32 * 0.377;
+                let p = [9.0 * t.sin(), 7.0 * (1.7 * t).cos(), 6.0 * (0.3 * t).sin()];
+                let r = (i % 5) as f32 * 0.05;
+                differ += usize::from(gl.may_see(p, r) != want.may_see(p, r));
+            }
+            assert!(differ <= 2, "{viewport:?}: {differ} of 20000 differ");
+        }
     }
 
     #[test]

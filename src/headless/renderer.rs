@@ -4,9 +4,10 @@
 use super::{HeadlessContext, HeadlessError};
 use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
+use crate::cull::CullBounds;
 use crate::gl::{
-    ColorFormat, DistanceSorter, DrawSettings, Errata, GlError, OffscreenTarget, ReadbackTarget,
-    SplatRenderer,
+    ColorFormat, DistanceSorter, DrawPath, DrawSettings, Errata, GlError, OffscreenTarget,
+    ReadbackTarget, SplatRenderer, frustum_for_camera,
 };
 use crate::image::Image;
 use glow::HasContext;
@@ -51,8 +52,12 @@ pub struct HeadlessRenderer {
     renderer: SplatRenderer,
     target: Option<ReadbackTarget>,
     offscreen: Option<OffscreenTarget>,
-    /// Means of the uploaded cloud, for the sorter.
+    /// Means and cull radii of the uploaded cloud, for the sorter.
     positions: Vec<[f32; 3]>,
+    bounds: CullBounds,
+    /// Sort only the splats the camera may see (off for erratum variants, which must draw
+    /// exactly as before the cull).
+    cull: bool,
     sorter: DistanceSorter,
     order: Vec<u32>,
     // Declared last: dropped after the GL objects above are deleted in `Drop`.
@@ -88,6 +93,8 @@ impl HeadlessRenderer {
             target: None,
             offscreen: None,
             positions: Vec::new(),
+            bounds: CullBounds::default(),
+            cull: errata == Errata::default(),
             sorter: DistanceSorter::default(),
             order: Vec::new(),
             ctx,
@@ -110,17 +117,38 @@ impl HeadlessRenderer {
         self.renderer.upload(self.ctx.gl(), cloud)?;
         self.positions.clear();
         self.positions.extend_from_slice(&cloud.positions);
+        self.bounds = CullBounds::new(cloud);
         Ok(())
     }
 
-    /// Renders the uploaded cloud, sorted back to front for `camera`.
+    /// Chooses the renderer's draw path and whether `render` culls before sorting. **For the
+    /// tests and benchmarks that compare the paths** (every path draws the same image).
+    #[doc(hidden)]
+    pub fn set_path(&mut self, path: DrawPath, cull: bool) -> Result<(), HeadlessError> {
+        self.ctx.make_current()?;
+        self.renderer.set_draw_path(self.ctx.gl(), path)?;
+        self.cull = cull;
+        Ok(())
+    }
+
+    /// Renders the uploaded cloud, sorted back to front for `camera`: only the splats its
+    /// frustum may see ([`crate::cull`]; the same image as from all of them).
     pub fn render(
         &mut self,
         camera: &Camera,
         opts: &HeadlessOptions,
     ) -> Result<Image, HeadlessError> {
         let mut order = std::mem::take(&mut self.order);
-        self.sorter.sort(&self.positions, camera.eye(), &mut order);
+        // (A 0-sized camera renders no pixel: nothing to cull for.)
+        if self.cull && camera.width > 0 && camera.height > 0 {
+            let viewport = [0, 0, camera.width as i32, camera.height as i32];
+            let frustum = frustum_for_camera(camera, viewport);
+            let (p, b) = (&self.positions, &self.bounds);
+            self.sorter
+                .sort_visible(p, b, &frustum, camera.eye(), &mut order);
+        } else {
+            self.sorter.sort(&self.positions, camera.eye(), &mut order);
+        }
         let result = self.render_with_order(camera, opts, &order);
         self.order = order;
         result

@@ -20,6 +20,8 @@ mod project;
 mod raster;
 mod sort;
 
+#[doc(hidden)]
+pub use project::Extent;
 use project::{Projected, ViewContext};
 pub use sort::{SortMode, back_to_front, sort_key};
 
@@ -28,8 +30,10 @@ pub const MAX_BIN_ENTRIES: u64 = 16 << 20;
 
 use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
+use crate::cull::{CullBounds, Frustum};
 use crate::image::Image;
 use crate::profile::{srgb_decode, srgb_encode};
+use crate::sort::{SortRequest, Sorter};
 use rayon::prelude::*;
 
 /// Options of a reference render.
@@ -80,11 +84,50 @@ pub fn render(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Imag
     render_with_stats(cloud, camera, opts).0
 }
 
+/// How the reference gets to its image. Every combination gives the bit-identical image
+/// (tested); the switches exist for the tests and benchmarks that show it.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Path {
+    /// Pixel box per splat.
+    pub extent: Extent,
+    /// Project and sort only the splats the camera's frustum may see ([`crate::cull`]).
+    pub cull: bool,
+}
+
+impl Default for Path {
+    fn default() -> Self {
+        Path {
+            extent: Extent::OpacityAware,
+            cull: true,
+        }
+    }
+}
+
+impl Path {
+    /// The rules before the opacity-aware extent and the cull: 3σ boxes, every splat.
+    pub const FULL: Path = Path {
+        extent: Extent::Full,
+        cull: false,
+    };
+}
+
 /// [`render`], also returning [`RenderStats`].
 pub fn render_with_stats(
     cloud: &SplatCloud,
     camera: &Camera,
     opts: &RenderOptions,
+) -> (Image, RenderStats) {
+    render_with_path(cloud, camera, opts, Path::default())
+}
+
+/// [`render_with_stats`] by a given [`Path`] (the image does not depend on it).
+#[doc(hidden)]
+pub fn render_with_path(
+    cloud: &SplatCloud,
+    camera: &Camera,
+    opts: &RenderOptions,
+    path: Path,
 ) -> (Image, RenderStats) {
     let [r, g, b] = opts.background;
     let mut image = Image::filled(camera.width, camera.height, [r, g, b, 0.0]);
@@ -96,15 +139,29 @@ pub fn render_with_stats(
         return (image, stats);
     }
     let degree = opts.sh_degree.min(cloud.sh_degree);
-    let ctx = ViewContext::new(camera, opts.cull_depth(camera) as f64, degree);
-    let projected: Vec<Option<Projected>> = (0..cloud.len())
-        .into_par_iter()
-        .map(|i| ctx.project(cloud, i))
-        .collect();
-    let splats: Vec<Projected> = back_to_front(&cloud.positions, camera, opts.sort)
-        .into_iter()
-        .filter_map(|i| projected[i as usize])
-        .collect();
+    let cull_depth = opts.cull_depth(camera);
+    let ctx = ViewContext::new(camera, cull_depth as f64, degree, path.extent);
+    let splats: Vec<Projected> = if path.cull {
+        // The same visible set and order the GL backend draws (`docs/rendering-profile.md`).
+        let frustum = Frustum::from_camera(camera, cull_depth);
+        let bounds = CullBounds::new(cloud);
+        let request = SortRequest::for_camera(camera, opts.sort);
+        let mut sorter = Sorter::new();
+        let order = sorter.sort_visible(&cloud.positions, &bounds, &frustum, &request);
+        order
+            .par_iter()
+            .filter_map(|&i| ctx.project(cloud, i as usize))
+            .collect()
+    } else {
+        let projected: Vec<Option<Projected>> = (0..cloud.len())
+            .into_par_iter()
+            .map(|i| ctx.project(cloud, i))
+            .collect();
+        back_to_front(&cloud.positions, camera, opts.sort)
+            .into_iter()
+            .filter_map(|i| projected[i as usize])
+            .collect()
+    };
     // Bin and rasterize in bands of tile rows holding at most MAX_BIN_ENTRIES (splat, tile)
     // pairs, so memory stays bounded however large the splats or the image (a single tile row
     // over the limit is still done alone).
@@ -129,6 +186,24 @@ pub fn render_with_stats(
         tile_entries: tile_entries as usize,
     };
     (image, stats)
+}
+
+/// One projected splat as the rasterizer sees it: centre in pixels (top-left origin), Σ'
+/// after dilation `[xx, xy, yy]` px², opacity. **For the benchmark's fragment-count
+/// prediction** (hidden from the documented API).
+#[doc(hidden)]
+pub fn footprints(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Vec<[f32; 6]> {
+    let degree = opts.sh_degree.min(cloud.sh_degree);
+    let ctx = ViewContext::new(camera, opts.cull_depth(camera) as f64, degree, Extent::Full);
+    (0..cloud.len())
+        .into_par_iter()
+        .filter_map(|i| ctx.project(cloud, i))
+        .map(|p| {
+            [
+                p.mean[0], p.mean[1], p.cov[0], p.cov[1], p.cov[2], p.opacity,
+            ]
+        })
+        .collect()
 }
 
 /// The reference render as a display shows it, in `color_space` (pass

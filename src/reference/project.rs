@@ -4,7 +4,10 @@
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
 use crate::covariance::c_matrix;
-use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2, JACOBIAN_CLAMP};
+use crate::profile::{
+    ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2, JACOBIAN_CLAMP, OPACITY_M2_MARGIN,
+    opacity_cutoff_m2,
+};
 use glam::{DMat3, DMat4, DVec3};
 
 /// One splat ready for rasterization (f32, pixel units).
@@ -21,13 +24,29 @@ pub(crate) struct Projected {
     /// Opacity attribute.
     pub(crate) opacity: f32,
     /// A pure optimisation: beyond this m² no pixel can reach α ≥ 1/255, so the exponential
-    /// is skipped: `min(9, 2·ln(255·opacity) + 1e-3)` (the margin covers f32 rounding).
+    /// is skipped: `min(9, 2·ln(opacity/ALPHA_MIN) + OPACITY_M2_MARGIN)` (the margin covers f32
+    /// rounding of the exponential).
     pub(crate) m2_max: f32,
     /// SH colour (negatives clamped to 0).
     pub(crate) color: [f32; 3],
     /// `[x0, x1, y0, y1]`: the pixels `x0..x1` × `y0..y1` (exclusive ends) whose centres lie in
-    /// the bounding box of the 3σ ellipse, clipped to the image; never empty.
+    /// the bounding box of the ellipse m² ≤ `m2_max` (with [`Extent::Full`]: of the 3σ
+    /// ellipse), clipped to the image; never empty.
     pub(crate) bbox: [u32; 4],
+}
+
+/// Which box of pixels a splat is rasterized over. Both give bit-identical images (every
+/// pixel left out by `OpacityAware` fails the per-pixel test; `docs/rendering-profile.md` §3);
+/// the switch exists for the tests and benchmarks that show it.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Extent {
+    /// The box of the ellipse m² ≤ min(9, 2·ln(opacity/ALPHA_MIN) + margin), widened by a
+    /// proven bound on the f32 rounding of the per-pixel m² (the default).
+    #[default]
+    OpacityAware,
+    /// The box of the 3σ ellipse whatever the opacity (the former rule).
+    Full,
 }
 
 /// Per-view constants shared by all splats.
@@ -44,11 +63,13 @@ pub(crate) struct ViewContext {
     cull_z: f64,
     size: [u32; 2],
     sh_degree: u8,
+    extent: Extent,
 }
 
 impl ViewContext {
-    /// Constants for `camera`; splats with view z ≤ `cull_z` are culled; SH up to `sh_degree`.
-    pub(crate) fn new(camera: &Camera, cull_z: f64, sh_degree: u8) -> Self {
+    /// Constants for `camera`; splats with view z ≤ `cull_z` are culled; SH up to `sh_degree`;
+    /// pixel boxes by `extent`.
+    pub(crate) fn new(camera: &Camera, cull_z: f64, sh_degree: u8, extent: Extent) -> Self {
         let w2c = camera.world_to_camera.as_dmat4();
         let tan = camera.tan_half_fov().as_dvec2();
         ViewContext {
@@ -63,6 +84,7 @@ impl ViewContext {
             cull_z,
             size: [camera.width, camera.height],
             sh_degree,
+            extent,
         }
     }
 
@@ -107,11 +129,14 @@ impl ViewContext {
         }
         let u = self.fx * t.x / t.z + self.cx;
         let v = self.fy * t.y / t.z + self.cy;
-        let bbox = pixel_range(u, 3.0 * a.sqrt(), self.size[0]).zip(pixel_range(
-            v,
-            3.0 * c.sqrt(),
-            self.size[1],
-        ))?;
+        let m2_max = (opacity_cutoff_m2(opacity) + OPACITY_M2_MARGIN).min(f64::from(CUTOFF_M2));
+        let m2_max = m2_max as f32;
+        let conic = [(c / det) as f32, (-b / det) as f32, (a / det) as f32];
+        let (ex, ey) = match self.extent {
+            Extent::Full => (3.0 * a.sqrt(), 3.0 * c.sqrt()),
+            Extent::OpacityAware => box_extents([a, b, c], det, conic, [u, v], m2_max),
+        };
+        let bbox = pixel_range(u, ex, self.size[0]).zip(pixel_range(v, ey, self.size[1]))?;
         let dir = (mean - self.eye).normalize().as_vec3().to_array();
         let color = crate::sh::eval_color(cloud.sh_of(i), self.sh_degree, dir);
         if !color.iter().all(|c| c.is_finite()) {
@@ -121,9 +146,9 @@ impl ViewContext {
             index: i as u32,
             mean: [u as f32, v as f32],
             cov: [a as f32, b as f32, c as f32],
-            conic: [(c / det) as f32, (-b / det) as f32, (a / det) as f32],
+            conic,
             opacity,
-            m2_max: (2.0 * (255.0 * opacity as f64).ln() + 1e-3).min(CUTOFF_M2 as f64) as f32,
+            m2_max,
             color,
             bbox: [bbox.0.0, bbox.0.1, bbox.1.0, bbox.1.1],
         })
@@ -139,4 +164,51 @@ fn pixel_range(centre: f64, extent: f64, size: u32) -> Option<(u32, u32)> {
     let lo = (centre - extent - 0.5).ceil().max(0.0);
     let hi = (centre + extent - 0.5).floor().min(size as f64 - 1.0);
     (lo <= hi).then(|| (lo as u32, hi as u32 + 1))
+}
+
+/// Unit roundoff of f32.
+const U32: f64 = 1.0 / (1u64 << 24) as f64;
+
+/// Half-extents (x, y) in pixels of the box that holds every pixel whose per-pixel test
+/// (`raster::blend`: m² in f32 from the f32 `conic` and f32 offsets, skipped when
+/// m² > `m2_max`) can pass; never larger than the 3σ box `(3√a, 3√c)`, and exactly it when
+/// the proof below cannot do better. `cov = [a, b, c]` is Σ' (f64), `det` its determinant,
+/// `mean` the projected mean (f64).
+///
+/// Proof (`docs/rendering-profile.md` §3 "extent"): a pixel of the 3σ box has
+/// `|dx| ≤ X = 3√a`, `|dy| ≤ Y = 3√c`. Its f32 m² differs from the exact quadratic form of
+/// Σ'⁻¹ at the exact offset by at most `E` (coefficient and product rounding, 8u relative to
+/// the absolute form, plus the offsets' own rounding δ), and the f64 conic is a scalar
+/// multiple `1 ± η` of the exact Σ'⁻¹. The exact form is ≥ dx²/a (its minimum over dy), so a
+/// pixel with `|dx| > e`, `e² = a·(m2_max + E)/(1 − η)`, has f32 m² > m2_max and is skipped
+/// anyway; the same for y.
+fn box_extents(
+    cov: [f64; 3],
+    det: f64,
+    conic: [f32; 3],
+    mean: [f64; 2],
+    m2_max: f32,
+) -> (f64, f64) {
+    let [a, _, c] = cov;
+    let full = (3.0 * a.sqrt(), 3.0 * c.sqrt());
+    let [ca, cb, cc] = conic.map(|v| f64::from(v).abs());
+    let (x, y) = full;
+    let dx = 2.0 * U32 * (mean[0].abs() + x + 1.0);
+    let dy = 2.0 * U32 * (mean[1].abs() + y + 1.0);
+    let q = |x: f64, y: f64| ca * x * x + 2.0 * cb * x * y + cc * y * y;
+    let (outer, inner) = (q(x + dx, y + dy), q(x, y));
+    let e = 8.0 * U32 * outer + (outer - inner);
+    // f64 rounding of Σ' and of its Cauchy–Binet determinant: ≤ 2⁻⁴⁶·(a·c/det + 1).
+    let eta = (a * c / det + 1.0) * (2.0f64).powi(-46);
+    let k2 = (f64::from(m2_max) + e) / (1.0 - eta);
+    if !(k2 < f64::from(CUTOFF_M2) && eta < 1e-3) {
+        return full;
+    }
+    let k = k2.sqrt();
+    // The pixel box's own f64 rounding (`pixel_range`): a relative 1e-9 covers it.
+    let widen = |e: f64, centre: f64| e + 1e-9 * (centre.abs() + e + 1.0);
+    (
+        widen(k * a.sqrt(), mean[0]).min(full.0),
+        widen(k * c.sqrt(), mean[1]).min(full.1),
+    )
 }

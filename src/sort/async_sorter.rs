@@ -11,6 +11,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::{Outcome, SortMode, Sorter};
+use crate::cull::{CullBounds, Frustum};
 
 /// A camera to sort for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,6 +49,7 @@ impl SortRequest {
 pub struct SortedFrame {
     order: Vec<u32>,
     request: Option<SortRequest>,
+    frustum: Option<Frustum>,
     generation: u64,
     outcome: Outcome,
     exact_radius: f64,
@@ -59,6 +61,7 @@ impl SortedFrame {
         SortedFrame {
             order: Vec::new(),
             request: None,
+            frustum: None,
             generation: 0,
             outcome: Outcome::None,
             exact_radius: 0.0,
@@ -90,6 +93,12 @@ impl SortedFrame {
         self.request
     }
 
+    /// The frustum the order was culled for ([`AsyncSorter::request_visible`]); `None`: every
+    /// splat is in the order.
+    pub fn frustum(&self) -> Option<Frustum> {
+        self.frustum
+    }
+
     /// The generation [`AsyncSorter::request`] returned for that request.
     pub fn generation(&self) -> u64 {
         self.generation
@@ -103,7 +112,7 @@ impl SortedFrame {
 
 #[derive(Debug)]
 struct State {
-    pending: Option<(u64, SortRequest)>,
+    pending: Option<(u64, SortRequest, Option<Frustum>)>,
     ready: Option<SortedFrame>,
     spare: Option<SortedFrame>,
     finished: u64,
@@ -151,7 +160,32 @@ impl AsyncSorter {
     ///
     /// # Errors
     /// When the OS cannot start a thread.
-    pub fn new(positions: Arc<[[f32; 3]]>, mut sorter: Sorter) -> std::io::Result<Self> {
+    pub fn new(positions: Arc<[[f32; 3]]>, sorter: Sorter) -> std::io::Result<Self> {
+        Self::start(positions, None, sorter)
+    }
+
+    /// [`AsyncSorter::new`] with the cloud's cull radii, so that
+    /// [`AsyncSorter::request_visible`] sorts only the splats a frustum may see.
+    ///
+    /// # Errors
+    /// When the OS cannot start a thread.
+    ///
+    /// # Panics
+    /// If `bounds` does not have one radius per position.
+    pub fn with_bounds(
+        positions: Arc<[[f32; 3]]>,
+        bounds: Arc<CullBounds>,
+        sorter: Sorter,
+    ) -> std::io::Result<Self> {
+        assert_eq!(bounds.len(), positions.len(), "one cull radius per splat");
+        Self::start(positions, Some(bounds), sorter)
+    }
+
+    fn start(
+        positions: Arc<[[f32; 3]]>,
+        bounds: Option<Arc<CullBounds>>,
+        mut sorter: Sorter,
+    ) -> std::io::Result<Self> {
         let shared = Arc::new(Shared {
             state: Mutex::new(State {
                 pending: None,
@@ -171,7 +205,7 @@ impl AsyncSorter {
                 let _stop = StopOnExit(Arc::clone(&sh));
                 let mut back = SortedFrame::empty();
                 loop {
-                    let (generation, req) = {
+                    let (generation, req, frustum) = {
                         let mut st = sh.lock();
                         loop {
                             if st.stop {
@@ -184,15 +218,18 @@ impl AsyncSorter {
                         }
                     };
                     let started = Instant::now();
-                    let order = match req.mode {
-                        SortMode::Distance => sorter.sort_by_distance(&positions, req.eye),
-                        SortMode::ViewDepth => {
+                    let culled = frustum.zip(bounds.as_deref());
+                    let order = match (culled, req.mode) {
+                        (Some((f, b)), _) => sorter.sort_visible(&positions, b, &f, &req),
+                        (None, SortMode::Distance) => sorter.sort_by_distance(&positions, req.eye),
+                        (None, SortMode::ViewDepth) => {
                             sorter.sort_by_view_depth(&positions, req.eye, req.forward)
                         }
                     };
                     back.order.clear();
                     back.order.extend_from_slice(order);
                     back.request = Some(req);
+                    back.frustum = culled.map(|(f, _)| f);
                     back.generation = generation;
                     back.outcome = sorter.last_outcome();
                     back.exact_radius = match back.outcome {
@@ -220,10 +257,22 @@ impl AsyncSorter {
     /// Posts the newest camera (replacing any request not yet started) and returns its
     /// generation number (1, 2, …). Never waits for a sort.
     pub fn request(&self, request: SortRequest) -> u64 {
+        self.post(request, None)
+    }
+
+    /// [`AsyncSorter::request`] of only the splats `frustum` may see
+    /// ([`Sorter::sort_visible`]): the frame's order is valid for that frustum only (a view
+    /// turned or moved since may show splats it left out). Without bounds
+    /// ([`AsyncSorter::new`]) the frustum is ignored and every splat is sorted.
+    pub fn request_visible(&self, request: SortRequest, frustum: Frustum) -> u64 {
+        self.post(request, Some(frustum))
+    }
+
+    fn post(&self, request: SortRequest, frustum: Option<Frustum>) -> u64 {
         let mut st = self.shared.lock();
         st.issued += 1;
         let generation = st.issued;
-        st.pending = Some((generation, request));
+        st.pending = Some((generation, request, frustum));
         drop(st);
         self.shared.wake.notify_one();
         generation

@@ -34,6 +34,7 @@ mod keys;
 mod quantize;
 mod radix;
 mod reuse;
+mod visible;
 
 pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
@@ -125,6 +126,9 @@ pub struct SortScratch {
     radix: RadixBuffers,
     /// Float keys of a quantized sort.
     fkeys: Vec<f32>,
+    /// A culled sort's visible indices and their positions.
+    visible: Vec<u32>,
+    visible_positions: Vec<[f32; 3]>,
     /// Per-chunk (min, max) of the positive and of all finite keys.
     ranges: Vec<[f32; 4]>,
 }
@@ -141,6 +145,8 @@ struct LastView {
     /// Safe radius ([`Reuse::MotionBound`]), 0 when not computed.
     radius: f64,
     eye_f: [f32; 3],
+    /// For a culled sort ([`Sorter::sort_visible`]): the bounds' address and the frustum.
+    cull: Option<(usize, crate::cull::Frustum)>,
 }
 
 /// A reusable back-to-front sorter. See the [module docs](self) for the exact order.
@@ -309,7 +315,26 @@ impl Sorter {
             },
             radius: 0.0,
             eye_f: eye,
+            cull: None,
         };
+        if self.reuse_last(&view) {
+            return self.order();
+        }
+        self.sort_positions(positions, mode, eye, forward);
+        let radius = if self.reuse == Reuse::MotionBound
+            && self.precision == Precision::Full
+            && mode == SortMode::Distance
+        {
+            reuse::safe_radius(positions, self.order(), eye)
+        } else {
+            0.0
+        };
+        self.last = Some(LastView { radius, ..view });
+        self.order()
+    }
+
+    /// Whether the last order may be reused for `view` (sets the outcome when it is).
+    fn reuse_last(&mut self, view: &LastView) -> bool {
         if self.reuse != Reuse::Never
             && let Some(last) = &self.last
         {
@@ -317,24 +342,35 @@ impl Sorter {
                 eye: last.eye,
                 radius: last.radius,
                 eye_f: last.eye_f,
-                ..view
+                ..*view
             } == *last;
             if same_input && last.eye == view.eye {
                 self.outcome = Outcome::ReusedSameView;
-                return self.order();
+                return true;
             }
             if same_input && last.radius > 0.0 {
-                let moved = reuse::moved(last.eye_f, eye);
+                let moved = reuse::moved(last.eye_f, view.eye_f);
                 if moved < last.radius {
                     self.outcome = Outcome::ReusedWithinBound {
                         moved,
                         radius: last.radius,
                     };
-                    return self.order();
+                    return true;
                 }
             }
         }
+        false
+    }
 
+    /// Keys of `positions` for the view, sorted into the output (`order()`): the sorting core
+    /// shared by the full and the culled sort.
+    fn sort_positions(
+        &mut self,
+        positions: &[[f32; 3]],
+        mode: SortMode,
+        eye: [f32; 3],
+        forward: [f32; 3],
+    ) {
         let n = positions.len();
         let t = chunk_count(n);
         match (self.precision, mode) {
@@ -385,21 +421,23 @@ impl Sorter {
             }
         }
         self.outcome = Outcome::Sorted;
-        let radius = if self.reuse == Reuse::MotionBound
-            && self.precision == Precision::Full
-            && mode == SortMode::Distance
-        {
-            reuse::safe_radius(positions, self.order(), eye)
-        } else {
-            0.0
-        };
-        self.last = Some(LastView { radius, ..view });
-        self.order()
     }
 
     /// Keys (`fill(first, block)` writes those of `first..first + block.len()`) → `out[..n]`
     /// in ascending key order (ties by index).
     fn sort_u32(&mut self, n: usize, t: usize, fill: impl Fn(usize, &mut [u32]) + Sync) {
+        self.sort_u32_ids(n, t, fill, None);
+    }
+
+    /// [`Sorter::sort_u32`] writing `ids[position]` instead of the position (see
+    /// [`RadixBuffers::sort`]).
+    fn sort_u32_ids(
+        &mut self,
+        n: usize,
+        t: usize,
+        fill: impl Fn(usize, &mut [u32]) + Sync,
+        ids: Option<&[u32]>,
+    ) {
         // Counts and indices are u32: more would wrap and make the parallel scatter race.
         assert!(
             n <= u32::MAX as usize,
@@ -409,7 +447,7 @@ impl Sorter {
         rb.prepare(n, t);
         let (keys, minmax) = rb.keys_and_minmax(n, t);
         fill_keys(keys, minmax, t, fill);
-        rb.sort(n, t, self.max_digit_bits);
+        rb.sort(n, t, self.max_digit_bits, ids);
         self.n = n;
     }
 }

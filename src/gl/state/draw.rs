@@ -51,6 +51,7 @@ pub(crate) fn exists(contexts: Contexts, ctx: ContextInfo) -> bool {
         Contexts::Desktop => ctx.desktop(),
         Contexts::Compatibility => ctx.profile == Profile::Compat,
         Contexts::SrgbSwitch => ctx.srgb_switch,
+        Contexts::TransformFeedbackObjects => ctx.tf_objects,
     }
 }
 
@@ -83,6 +84,7 @@ pub(crate) struct Saved {
     depth_mask: Option<bool>,
     color_mask: Option<[bool; 4]>,
     polygon_mode: Option<[u32; 2]>,
+    transform_feedback: Option<glow::TransformFeedback>,
 }
 
 /// The context with a count of the calls made through it.
@@ -160,6 +162,13 @@ fn bind(c: &mut Counted<'_>, want: &DrawState, unbind_sampler: [bool; 2]) {
 
 fn enter_plain(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) {
     bind(c, want, [true; 2]);
+    if ctx.tf_objects {
+        // SAFETY: binds the default transform-feedback object (exists on this context).
+        unsafe {
+            c.s()
+                .bind_transform_feedback(glow::TRANSFORM_FEEDBACK, None)
+        };
+    }
     for (cap, contexts) in CAPS {
         if exists(contexts, ctx) {
             c.set_cap(cap, want.cap(cap));
@@ -201,7 +210,13 @@ fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved 
             depth_mask: None,
             color_mask: None,
             polygon_mode: None,
+            transform_feedback: None,
         };
+        if ctx.tf_objects {
+            s.transform_feedback = c
+                .q()
+                .get_parameter_transform_feedback(glow::TRANSFORM_FEEDBACK_BINDING);
+        }
         for (k, (cap, contexts)) in CAPS.into_iter().enumerate() {
             if exists(contexts, ctx) {
                 s.caps[k] = Some(c.q().is_enabled(cap));
@@ -242,6 +257,13 @@ fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved 
 fn enter_restoring(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) -> Saved {
     let mut s = query_host(c, ctx, want.depth_test);
     bind(c, want, s.units.map(|(_, sampler)| sampler.is_some()));
+    if s.transform_feedback.is_some() {
+        // SAFETY: binds the default transform-feedback object (the host had another bound).
+        unsafe {
+            c.s()
+                .bind_transform_feedback(glow::TRANSFORM_FEEDBACK, None)
+        };
+    }
     for (k, (cap, _)) in CAPS.into_iter().enumerate() {
         match s.caps[k] {
             Some(host) if host != want.cap(cap) => c.set_cap(cap, want.cap(cap)),
@@ -309,6 +331,10 @@ pub(crate) fn leave(gl: &glow::Context, ctx: ContextInfo, saved: Option<Saved>) 
         };
         c.s().bind_vertex_array(s.vao);
         c.s().use_program(s.program);
+        if let Some(tf) = s.transform_feedback {
+            c.s()
+                .bind_transform_feedback(glow::TRANSFORM_FEEDBACK, Some(tf));
+        }
         for unit in (0..2).rev() {
             if unit == 0 {
                 c.s().active_texture(glow::TEXTURE0);

@@ -198,15 +198,19 @@ impl RadixBuffers {
         (&mut self.keys[..n], &mut self.minmax[..t])
     }
 
-    /// Sorts `keys[..n]` (filled by [`fill_keys`] in `t` chunks) into `out[..n]`.
-    pub(crate) fn sort(&mut self, n: usize, t: usize, max_digit: u32) {
+    /// Sorts `keys[..n]` (filled by [`fill_keys`] in `t` chunks) into `out[..n]`: the
+    /// positions `0..n` in ascending key order, or with `ids` (`n` ascending values, e.g. the
+    /// visible splats) `ids[position]` — carried through the passes instead of a remap after.
+    pub(crate) fn sort(&mut self, n: usize, t: usize, max_digit: u32, ids: Option<&[u32]>) {
+        let ids = ids.map(|v| &v[..n]);
+        let id = |j: usize| ids.map_or(j as u32, |v| v[j]);
         let (kmin, kmax) = self.minmax[..t]
             .iter()
             .fold((u32::MAX, 0), |(a, b), &(l, h)| (a.min(l), b.max(h)));
         let out = &mut self.out[..n];
         if n == 0 || kmin == kmax {
             for (i, o) in out.iter_mut().enumerate() {
-                *o = i as u32;
+                *o = id(i);
             }
             return;
         }
@@ -236,11 +240,11 @@ impl RadixBuffers {
                 debug_assert!(pos < n);
                 unsafe {
                     if low == 0 {
-                        o.get().add(pos).write((base + i) as u32);
+                        o.get().add(pos).write(id(base + i));
                     } else {
                         a.get()
                             .add(pos)
-                            .write((u64::from(k - kmin) << 32) | (base + i) as u64);
+                            .write((u64::from(k - kmin) << 32) | u64::from(id(base + i)));
                     }
                 }
             }
