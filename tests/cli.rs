@@ -240,7 +240,15 @@ fn render_takes_the_view_from_a_gltf_camera_node() {
     let scene = tmp("cam.gltf", &serde_json::to_vec(&doc).unwrap());
     let out = tmp("cam.pfm", b"");
     let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
-    let args = ["render", s, "--gltf-camera", "0", "--backend", "reference", "-f"];
+    let args = [
+        "render",
+        s,
+        "--gltf-camera",
+        "0",
+        "--backend",
+        "reference",
+        "-f",
+    ];
     let (code, _, err) = splatgl(&[&args[..], &["--height", "40", "-o", o]].concat());
     assert_eq!(code, 0, "{err}");
     let img = splatgl::image::Image::read(&out).unwrap();

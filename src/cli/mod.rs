@@ -154,7 +154,11 @@ impl LoadCommonArgs {
 impl LoadCommonArgs {
     /// Refuses the format-specific options given for a file of another format (`None`: the
     /// bundled default scene), naming the option and the format.
-    pub fn check_applies(&self, file: &str, format: Option<splatgl::load::Format>) -> Result<(), String> {
+    pub fn check_applies(
+        &self,
+        file: &str,
+        format: Option<splatgl::load::Format>,
+    ) -> Result<(), String> {
         use splatgl::load::Format;
         let what = format.map_or("the bundled default scene (no file given)".into(), |f| {
             format!("a {} file", f.name())

@@ -159,7 +159,10 @@ fn views(a: &Args, scene: SceneView<'_>) -> Result<Vec<(Camera, f32)>, String> {
         Ok((cam, o.focus_distance(&cam, scene.cloud)))
     };
     let count = if a.cam.view == Some(Pick::All) {
-        let n = opts.cameras_json_entries().map_err(|e| e.to_string())?.len();
+        let n = opts
+            .cameras_json_entries()
+            .map_err(|e| e.to_string())?
+            .len();
         Some((n, "views", "cameras.json"))
     } else if a.cam.gltf_camera == Some(Pick::All) {
         Some((scene.cameras.len(), "camera nodes", "scene"))
@@ -168,7 +171,9 @@ fn views(a: &Args, scene: SceneView<'_>) -> Result<Vec<(Camera, f32)>, String> {
     };
     if let Some((n, what, source)) = count {
         if n == 0 {
-            return Err(format!("--view all / --gltf-camera all: the {source} has no {what}"));
+            return Err(format!(
+                "--view all / --gltf-camera all: the {source} has no {what}"
+            ));
         }
         return (0..n)
             .map(|i| {
@@ -229,7 +234,12 @@ fn go(a: &Args) -> Result<(), String> {
     a.check_camera_options()?;
     let bg = background(&a.background)?;
     let _ = a.cam.options()?; // --look-at syntax
-    let inputs: Vec<&Path> = a.scene.iter().chain(&a.cam.camera).map(PathBuf::as_path).collect();
+    let inputs: Vec<&Path> = a
+        .scene
+        .iter()
+        .chain(&a.cam.camera)
+        .map(PathBuf::as_path)
+        .collect();
     out.check_files(1, &inputs, a.force)?;
     let say = |s: String| {
         if !a.quiet {
@@ -247,7 +257,10 @@ fn go(a: &Args) -> Result<(), String> {
         }
         None => (splatgl::scene::default_scene(), None, Vec::new()),
     };
-    let file = a.scene.as_ref().map_or(String::new(), |p| p.display().to_string());
+    let file = a
+        .scene
+        .as_ref()
+        .map_or(String::new(), |p| p.display().to_string());
     a.load.common.check_applies(&file, format)?;
     let scene = SceneView {
         cloud: &cloud,
@@ -291,7 +304,11 @@ fn go(a: &Args) -> Result<(), String> {
         visible = v;
         out.write(&img, i)?;
         progress.clear();
-        let index = if batch { format!("[{i}] ") } else { String::new() };
+        let index = if batch {
+            format!("[{i}] ")
+        } else {
+            String::new()
+        };
         say(format!("camera: {index}{}", look_at_line(cam, *distance)));
         if a.cam.print_camera_json {
             println!("{}", camera_json_line(cam));
@@ -308,7 +325,12 @@ fn go(a: &Args) -> Result<(), String> {
     };
     let (w, h) = (views[0].0.width, views[0].0.height);
     let target = if batch {
-        format!("{} images -> {} .. {}", views.len(), out.describe(0), out.describe(views.len() - 1))
+        format!(
+            "{} images -> {} .. {}",
+            views.len(),
+            out.describe(0),
+            out.describe(views.len() - 1)
+        )
     } else {
         out.describe(0)
     };

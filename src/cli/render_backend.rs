@@ -25,7 +25,10 @@ pub enum Engine {
     Reference,
     /// Headless GL with the cloud uploaded.
     #[cfg(feature = "gl")]
-    Gl(Box<splatgl::headless::HeadlessRenderer>, splatgl::headless::HeadlessOptions),
+    Gl(
+        Box<splatgl::headless::HeadlessRenderer>,
+        splatgl::headless::HeadlessOptions,
+    ),
 }
 
 /// What the flags ask of the backend.
@@ -62,7 +65,10 @@ impl Wanted {
             ));
         }
         if self.target.is_some() && self.backend == Backend::Reference {
-            return Err("--target chooses the GL framebuffer; it does not apply to --backend reference".into());
+            return Err(
+                "--target chooses the GL framebuffer; it does not apply to --backend reference"
+                    .into(),
+            );
         }
         Ok(())
     }
@@ -77,15 +83,25 @@ impl Wanted {
 
     /// Chooses the engine for `cloud` (uploading it for GL); returns it and why it was
     /// chosen.
-    pub fn engine(&self, cloud: &SplatCloud, opts: &RenderOptions) -> Result<(Engine, String), String> {
+    pub fn engine(
+        &self,
+        cloud: &SplatCloud,
+        opts: &RenderOptions,
+    ) -> Result<(Engine, String), String> {
         use super::render::Backend;
         match self.backend {
             Backend::Reference => return Ok((Engine::Reference, "--backend reference".into())),
             Backend::Auto if self.target.is_none() && self.float_output => {
-                return Ok((Engine::Reference, "auto: float output (.pfm / --depth16) needs the reference".into()));
+                return Ok((
+                    Engine::Reference,
+                    "auto: float output (.pfm / --depth16) needs the reference".into(),
+                ));
             }
             Backend::Auto if self.view_depth => {
-                return Ok((Engine::Reference, "auto: --sort view-depth needs the reference".into()));
+                return Ok((
+                    Engine::Reference,
+                    "auto: --sort view-depth needs the reference".into(),
+                ));
             }
             _ => {}
         }
@@ -94,7 +110,9 @@ impl Wanted {
                 if self.backend == Backend::Auto && self.target.is_none() && is_software(&driver) {
                     return Ok((
                         Engine::Reference,
-                        format!("auto: GL is a software rasterizer ({driver}), where the CPU reference is faster"),
+                        format!(
+                            "auto: GL is a software rasterizer ({driver}), where the CPU reference is faster"
+                        ),
                     ));
                 }
                 let why = match self.backend {
@@ -188,6 +206,8 @@ mod tests {
         assert!(!is_software(
             "OpenGL ES 3.2 NVIDIA 550.54 / NVIDIA GeForce RTX 4090/PCIe/SSE2"
         ));
-        assert!(!is_software("OpenGL ES 3.2 Mesa 24.2 / AMD Radeon RX 7900 (radeonsi)"));
+        assert!(!is_software(
+            "OpenGL ES 3.2 Mesa 24.2 / AMD Radeon RX 7900 (radeonsi)"
+        ));
     }
 }

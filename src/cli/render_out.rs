@@ -46,10 +46,14 @@ impl Outputs {
         let name = output.map_or(default.into(), |p| p.to_string_lossy().into_owned());
         if name == "-" {
             if batch {
-                return Err("-o - (stdout) takes one image; a batch needs -o NAME_{index}.png".into());
+                return Err(
+                    "-o - (stdout) takes one image; a batch needs -o NAME_{index}.png".into(),
+                );
             }
             if print_json {
-                return Err("-o - and --print-camera-json both write to stdout; give -o FILE".into());
+                return Err(
+                    "-o - and --print-camera-json both write to stdout; give -o FILE".into(),
+                );
             }
             return Ok(Outputs {
                 pattern: None,
@@ -63,7 +67,11 @@ impl Outputs {
         let kind = match ext.to_ascii_lowercase().as_str() {
             "png" => Kind::Png,
             "pfm" => Kind::Pfm,
-            _ => return Err(format!("{name}: output must end in .png or .pfm (or be - for stdout)")),
+            _ => {
+                return Err(format!(
+                    "{name}: output must end in .png or .pfm (or be - for stdout)"
+                ));
+            }
         };
         if depth16 && kind == Kind::Pfm {
             return Err(format!(

@@ -92,7 +92,9 @@ pub struct Args {
 fn go(a: Args) -> Result<(), String> {
     let bg = background(&a.background)?;
     if a.cam.view == Some(Pick::All) || a.cam.gltf_camera == Some(Pick::All) {
-        return Err("--view all / --gltf-camera all render one image per view: use `splatgl render`".into());
+        return Err(
+            "--view all / --gltf-camera all render one image per view: use `splatgl render`".into(),
+        );
     }
     let default = splatgl::load::Limits::DEFAULT_MAX_SPLATS;
     let load = a
