@@ -5,7 +5,7 @@ use std::process::ExitCode;
 /// Help of `info --json`.
 pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
     kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
-    non_unit_quaternions, memory_bytes, warnings; for quantized containers also container, \
+    non_unit_quaternions, non_finite_opacities, memory_bytes, warnings; for quantized containers also container, \
     container_version, compression, gltf_extension, quantization[{attribute, bits, encoding}], \
     lossy, antialiased — null otherwise; with -v also limits)";
 
@@ -35,6 +35,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "bounds_max": b.map(|b| b.max),
         "scale_space": r.scale_space.map(|s| s.name()),
         "non_unit_quaternions": r.non_unit_quaternions,
+        "non_finite_opacities": r.non_finite_opacities,
         "memory_bytes": c.memory_bytes(),
         "warnings": r.warning_lines(),
     });
@@ -84,8 +85,19 @@ pub fn run(a: super::FileArgs) -> ExitCode {
             println!("  {k:<24}{v}");
         }
     }
-    for w in r.summarized_warnings() {
-        println!("warning: {w}");
+    if r.non_finite_opacities > 0 {
+        println!(
+            "non-finite:     {} opacity logits ±inf (read as opacity 1 or 0)",
+            r.non_finite_opacities
+        );
+    }
+    if !a.quiet {
+        for w in r.summarized_warnings() {
+            println!("warning: {w}");
+        }
+        for n in r.summarized_notes() {
+            println!("note: {n}");
+        }
     }
     ExitCode::SUCCESS
 }

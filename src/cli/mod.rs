@@ -69,6 +69,9 @@ pub struct FileArgs {
     /// Also print the loader's limits (`limits` in JSON).
     #[arg(short, long)]
     pub verbose: bool,
+    /// Less text: `info` without warnings and notes, `validate` only its verdict line.
+    #[arg(short, long, conflicts_with = "verbose")]
+    pub quiet: bool,
     #[command(flatten)]
     pub load: LoadArgs,
 }

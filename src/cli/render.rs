@@ -352,6 +352,11 @@ fn load(p: &Path, a: &Args) -> Result<Scene, String> {
         for w in scene.report.summarized_warnings() {
             eprintln!("warning: {w}");
         }
+        if a.verbose {
+            for n in scene.report.summarized_notes() {
+                eprintln!("note: {n}");
+            }
+        }
     }
     Ok(scene)
 }
