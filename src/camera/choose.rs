@@ -48,7 +48,7 @@ pub struct ViewOptions {
     pub look_at: Option<LookAtSpec>,
     /// Vertical field of view in degrees for look-at and framing (`--fov`).
     pub fov_deg: f32,
-    /// Up axis (`--up`); `None` = auto ([`UpAxis::for_format`]).
+    /// Up axis (`--up`); `None` = auto ([`UpAxis::for_cloud`]).
     pub up: Option<UpAxis>,
     /// Image width (`--width`).
     pub width: Option<u32>,
@@ -82,6 +82,12 @@ impl ViewOptions {
     /// The up axis for a scene of `format`: `up`, or the per-format rule.
     pub fn up_for(&self, format: Option<Format>) -> UpAxis {
         self.up.unwrap_or_else(|| UpAxis::for_format(format))
+    }
+
+    /// The up axis for `scene`: `up`, or the per-cloud rule ([`UpAxis::for_cloud`]).
+    pub fn up_for_scene(&self, scene: SceneView<'_>) -> UpAxis {
+        self.up
+            .unwrap_or_else(|| UpAxis::for_cloud(scene.format, scene.cloud))
     }
 
     /// The image size: `width`/`height`, a missing one derived from `(w, h)`'s aspect ratio.
@@ -163,7 +169,7 @@ impl ViewOptions {
             return Camera::from_gltf(g, w, h);
         }
         let (w, h) = self.size_or(default_size.0, default_size.1);
-        let up = self.up_for(scene.format);
+        let up = self.up_for_scene(scene);
         if let Some(l) = &self.look_at {
             let up = l.up.unwrap_or(up.vector());
             let fwd = l.target - l.eye;

@@ -14,8 +14,9 @@ pub enum UpArg {
     NegY,
     /// +Z up.
     Z,
-    /// From the format: glTF +Y; PLY and the packed formats (COLMAP axes) −Y; the bundled
-    /// default scene +Y.
+    /// From the format: glTF +Y; PLY and the packed formats (COLMAP axes) −Y, but +Z for a
+    /// cloud standing on z = 0 that is clearly taller along +Z than wide; the bundled default
+    /// scene +Y.
     Auto,
 }
 

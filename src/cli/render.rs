@@ -194,7 +194,7 @@ fn views(a: &Args, scene: SceneView<'_>) -> Result<Vec<(Camera, f32)>, String> {
     let up = opts
         .look_at
         .and_then(|l| l.up)
-        .unwrap_or_else(|| opts.up_for(scene.format).vector())
+        .unwrap_or_else(|| opts.up_for_scene(scene).vector())
         .normalize();
     Ok(orbit(&cam, distance, up, n))
 }

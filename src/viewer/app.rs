@@ -220,7 +220,8 @@ impl App {
     /// Shows a loaded scene (or keeps the previous one when it cannot be shown).
     fn install(&mut self, el: &ActiveEventLoop, l: Loaded) {
         let name = l.name();
-        let up = self.opts.view.up_for(l.format);
+        let up = (self.opts.view.up)
+            .unwrap_or_else(|| crate::camera::UpAxis::for_cloud(l.format, &l.cloud));
         let (cam, focus) = match self.first_camera(&l, up) {
             Ok(c) => c,
             Err(e) if self.shown.is_none() => {
