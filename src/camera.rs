@@ -30,7 +30,7 @@ mod choose;
 mod frame;
 mod json;
 pub use choose::{LookAtSpec, SceneView, ViewOptions};
-pub use frame::{Extent, LookAt, UpAxis};
+pub use frame::{Extent, FIT_SIGMAS, FRAME_MARGIN, LookAt, UpAxis, Z_UP_BELOW, Z_UP_TALLER};
 pub use json::{
     CamerasJsonEntry, load_cameras_json, load_cameras_json_limited, parse_cameras_json,
 };

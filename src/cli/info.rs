@@ -21,6 +21,11 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     };
     let c = &loaded.cloud;
     let r = &loaded.report;
+    let file = a.file.display().to_string();
+    if let Err(e) = a.load.common.check_applies(&file, Some(r.format)) {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     let b = c.bounds();
     let mut info = serde_json::json!({
         "file": a.file.display().to_string(),

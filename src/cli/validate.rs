@@ -10,6 +10,15 @@ pub const JSON_HELP: &str = "Print the findings as JSON (keys: file, format, sta
 pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
     let report = splatgl::load::validate::validate_path(&a.file, &opts);
+    if let Some(format) = report.format
+        && let Err(e) = a
+            .load
+            .common
+            .check_applies(&a.file.display().to_string(), Some(format))
+    {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if a.json {
         println!("{:#}", report.to_json(&a.file));
     } else {
