@@ -1,6 +1,8 @@
 //! The converter's library half (`splatgl convert`): a loaded cloud → an RC-conformant glTF
-//! (`.glb`, `.gltf`) or an INRIA PLY, with optional quantization, SH truncation, a rotation
-//! (e.g. a y-down capture to glTF's +Y up) and colour-space relabelling.
+//! (`.glb`, `.gltf`; a `.glb` with `KHR_gaussian_splatting_compression_spz_2` under
+//! `--spz-compress`), an INRIA PLY, Niantic SPZ (v2–v4) or antimatter15 `.splat`, with
+//! optional quantization, SH truncation, a rotation (e.g. a y-down capture to glTF's +Y up)
+//! and colour-space relabelling.
 //!
 //! Output formats are a table keyed by file extension ([`OUTPUTS`]); a new writer is a row.
 //! What the glTF output holds: linear scales, only the component types the RC allows per

@@ -404,3 +404,55 @@ fn external_buffers_count_against_max_bytes() {
     );
     std::fs::remove_dir_all(&root).ok();
 }
+
+#[test]
+fn scenes_can_come_from_standard_input_within_the_byte_limit() {
+    let ply = splatgl::write::to_inria_ply(&random_cloud(20, 1, 5.0, 8));
+    let run = |args: &[&str]| {
+        use std::io::Write;
+        let mut child = Command::new(env!("CARGO_BIN_EXE_splatgl"))
+            .args(args)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The reader may stop early (over the limit): a broken pipe is its answer, not ours.
+        let _ = child.stdin.take().unwrap().write_all(&ply);
+        let out = child.wait_with_output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned()
+            + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code().unwrap_or(-1), text)
+    };
+    let (code, out) = run(&["info", "--json", "-"]);
+    assert_eq!(code, 0, "{out}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (v["splat_count"].as_u64(), v["sh_degree"].as_u64()),
+        (Some(20), Some(1))
+    );
+    let (code, out) = run(&["info", "--max-bytes", "1K", "-"]);
+    assert_eq!(code, 2, "{out}");
+    assert!(out.contains("more than the limit of 1024 bytes"), "{out}");
+}
+
+#[test]
+fn mapped_and_read_scene_files_load_the_same_cloud() {
+    let d = dir("mapped");
+    let p = d.join("m.ply");
+    let cloud = random_cloud(3000, 3, 5.0, 9);
+    std::fs::write(&p, splatgl::write::to_inria_ply(&cloud)).unwrap();
+    let mapped = splatgl::files::map_bounded(&p, 1 << 30, "the scene file").unwrap();
+    assert!(mapped.is_mapped());
+    let from_map = load_bytes(&mapped, Some(&p), &LoadOptions::default()).unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+    let from_read = load_bytes(&bytes, Some(&p), &LoadOptions::default()).unwrap();
+    // The mapped load released its pages as it went; the mapping still reads the file.
+    assert_eq!(&mapped[..], &bytes[..]);
+    assert_eq!(from_map.cloud, from_read.cloud);
+    assert_eq!(
+        load_path(&p, &LoadOptions::default()).unwrap().cloud,
+        from_read.cloud
+    );
+    std::fs::remove_dir_all(&d).ok();
+}

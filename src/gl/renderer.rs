@@ -118,7 +118,7 @@ impl DrawPath {
 
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
 /// [`super::state`] for the GL state each call changes in each mode. All methods must be
-/// called with the same context current. One renderer draws one cloud; a [`SplatScene`]
+/// called with the same context current. One renderer draws one cloud; a [`SplatScene`](super::SplatScene)
 /// draws several in one order.
 ///
 /// Per frame only the order is uploaded (`glBufferSubData`, 4 bytes per splat) and nothing is

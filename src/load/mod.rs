@@ -211,9 +211,13 @@ pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, Lo
     load_bytes(&bytes, Some(path), opts)
 }
 
-/// Reads a scene file: a regular file within `limits.max_bytes`.
-pub(crate) fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<Vec<u8>, LoadError> {
-    crate::files::read_bounded(path, opts.limits.max_bytes, "the scene file").map_err(|source| {
+/// Reads a scene file: a regular file within `limits.max_bytes`, memory-mapped
+/// ([`crate::files::map_bounded`]; `-` reads standard input).
+pub(crate) fn read_scene_file(
+    path: &Path,
+    opts: &LoadOptions,
+) -> Result<crate::files::FileBytes, LoadError> {
+    crate::files::map_bounded(path, opts.limits.max_bytes, "the scene file").map_err(|source| {
         LoadError::Io {
             path: path.to_owned(),
             source,

@@ -105,7 +105,7 @@ impl Report {
 
 /// Validates a file on disk (a regular file within `limits.max_bytes`, like `load_path`).
 pub fn validate_path(path: &Path, opts: &LoadOptions) -> Report {
-    match crate::files::read_bounded(path, opts.limits.max_bytes, "the file") {
+    match crate::files::map_bounded(path, opts.limits.max_bytes, "the file") {
         Ok(bytes) => validate_bytes(&bytes, Some(path), opts),
         Err(e) => Report {
             format: None,

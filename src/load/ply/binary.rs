@@ -87,6 +87,11 @@ pub(super) fn decode_binary(
     cloud.rotations = vec![[0.0; 4]; n];
     cloud.opacities = vec![0.0; n];
     cloud.sh = vec![[0.0; 3]; n * k];
+    crate::files::advise_huge(&mut cloud.positions);
+    crate::files::advise_huge(&mut cloud.scales);
+    crate::files::advise_huge(&mut cloud.rotations);
+    crate::files::advise_huge(&mut cloud.opacities);
+    crate::files::advise_huge(&mut cloud.sh);
     let results: Vec<(RowNotes, Unusable)> = cloud
         .positions
         .par_chunks_mut(BLOCK)
@@ -124,6 +129,9 @@ pub(super) fn decode_binary(
                     Err(e) => bad.add(index, e),
                 }
             }
+            // Each row is read once: a mapped file's pages of this block leave the resident
+            // set now, so peak memory is the cloud plus the blocks in flight.
+            crate::files::release_consumed(raw);
             (notes, bad)
         })
         .collect();

@@ -16,8 +16,12 @@
 //!   canonical path to open with the two above.
 //!
 //! Errors are `io::Error`s whose message names `what` and the rule or limit; callers add the
-//! path. A memory-mapped variant belongs beside [`read_bounded`] with the same contract
-//! ([`open_regular`] first, then the size against the limit before mapping).
+//! path. [`map_bounded`] is the memory-mapped variant with the same contract ([`open_regular`]
+//! first, then the size against the limit before mapping), used for scene files (`map.rs`).
+
+mod map;
+pub use map::{FileBytes, Mapping, NO_MMAP_ENV, map_bounded, read_stdin_bounded};
+pub(crate) use map::{advise_huge, release_consumed};
 
 use std::fs::File;
 use std::io::{self, Read};
