@@ -247,3 +247,52 @@ fn progress_is_absent_without_a_terminal_and_with_quiet() {
     assert_eq!((code, err.as_str()), (0, ""));
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// `--print-camera-json` on a batch prints one cameras.json for all of it: rendered again with
+/// `--camera … --view all`, it gives the same images.
+#[test]
+fn a_batch_prints_one_cameras_json_that_renders_it_again() {
+    let d = dir("json");
+    let s = ply(&d);
+    let base = [
+        "render",
+        &s,
+        "--backend",
+        "reference",
+        "--width",
+        "20",
+        "--height",
+        "16",
+    ];
+    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
+        .args(base)
+        .args(["--orbit", "4", "--print-camera-json", "-o", "a{index}.pfm"])
+        .current_dir(&d)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON value");
+    assert_eq!(json.as_array().map(Vec::len), Some(4), "{json}");
+    assert_eq!(json[2]["img_name"], "a2");
+    std::fs::write(d.join("cams.json"), &out.stdout).unwrap();
+    let again = [
+        "--camera",
+        "cams.json",
+        "--view",
+        "all",
+        "-o",
+        "b{index}.pfm",
+    ];
+    let (code, err) = splatgl_in(&d, &[&base[..], &again].concat());
+    assert_eq!(code, 0, "{err}");
+    for i in 0..4 {
+        let (a, b) = (pfm(&d, &format!("a{i}.pfm")), pfm(&d, &format!("b{i}.pfm")));
+        let c = splatgl::compare::compare(&a, &b, 1.0 / 255.0).unwrap();
+        assert!(c.psnr > 50.0, "frame {i}: {} dB", c.psnr);
+    }
+    std::fs::remove_dir_all(&d).ok();
+}

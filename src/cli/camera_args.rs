@@ -95,7 +95,8 @@ pub struct CameraArgs {
     /// default 50).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true, value_parser = parse_fov)]
     pub fov: Option<f32>,
-    /// Also print the camera as a 3DGS cameras.json (one entry) on stdout.
+    /// Also print the camera as a 3DGS cameras.json (one entry) on stdout; for a render batch,
+    /// one cameras.json with an entry per image (id = index, img_name = the file's stem).
     #[arg(long)]
     pub print_camera_json: bool,
 }

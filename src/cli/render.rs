@@ -294,6 +294,7 @@ fn go(a: &Args) -> Result<(), String> {
         eprintln!("backend: {} ({why})", engine.name());
     }
     let mut visible = None;
+    let mut entries = Vec::new();
     for (i, (cam, distance)) in views.iter().enumerate() {
         if batch {
             progress.step("rendering", i, views.len());
@@ -310,13 +311,22 @@ fn go(a: &Args) -> Result<(), String> {
             String::new()
         };
         say(format!("camera: {index}{}", look_at_line(cam, *distance)));
-        if a.cam.print_camera_json {
+        if a.cam.print_camera_json && !batch {
             println!("{}", camera_json_line(cam));
+        } else if a.cam.print_camera_json {
+            let name = out
+                .path(i)
+                .and_then(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()));
+            entries.push(cam.to_3dgs_json(i as i64, &name.unwrap_or_default()));
         }
     }
     if batch {
         progress.step("rendering", views.len(), views.len());
         progress.clear();
+        if a.cam.print_camera_json {
+            // One cameras.json for the batch: `--camera` on it with `--view all` renders it again.
+            println!("{}", serde_json::Value::Array(entries));
+        }
     }
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;
     let visible = match (visible, batch) {
