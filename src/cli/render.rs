@@ -108,6 +108,15 @@ pub struct Args {
 }
 
 impl Args {
+    /// The files read: the scene and the cameras.json (never written over).
+    fn inputs(&self) -> Vec<&Path> {
+        self.scene
+            .iter()
+            .chain(&self.cam.camera)
+            .map(PathBuf::as_path)
+            .collect()
+    }
+
     fn batch(&self) -> bool {
         self.orbit.is_some()
             || self.cam.view == Some(Pick::All)
@@ -218,13 +227,12 @@ pub fn orbit(cam: &Camera, distance: f32, up: glam::Vec3, n: u32) -> Vec<(Camera
         .collect()
 }
 
-fn go(a: &Args) -> Result<(), String> {
-    let t0 = Instant::now();
-    // Everything that can be checked without the scene, before it is loaded.
-    let batch = a.batch();
+/// Everything that can be checked without the scene, before it is loaded: the outputs, the
+/// backend's options, the view options, the background.
+fn preflight(a: &Args) -> Result<(Outputs, Wanted, [f32; 3]), String> {
     let out = Outputs::plan(
         a.output.as_deref(),
-        batch,
+        a.batch(),
         a.depth16,
         a.alpha,
         a.cam.print_camera_json,
@@ -234,13 +242,15 @@ fn go(a: &Args) -> Result<(), String> {
     a.check_camera_options()?;
     let bg = background(&a.background)?;
     let _ = a.cam.options()?; // --look-at syntax
-    let inputs: Vec<&Path> = a
-        .scene
-        .iter()
-        .chain(&a.cam.camera)
-        .map(PathBuf::as_path)
-        .collect();
-    out.check_files(1, &inputs, a.force)?;
+    out.check_files(1, &a.inputs(), a.force)?;
+    Ok((out, wanted, bg))
+}
+
+fn go(a: &Args) -> Result<(), String> {
+    let t0 = Instant::now();
+    let batch = a.batch();
+    let (out, wanted, bg) = preflight(a)?;
+    let inputs = a.inputs();
     let say = |s: String| {
         if !a.quiet {
             eprintln!("{s}");
