@@ -168,3 +168,50 @@ fn render_quiet_prints_nothing_and_verbose_says_the_backend_and_why() {
     );
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// One broken file, one message: `info`, `validate` and `render` say the same thing, each
+/// naming the file and the element (PLY) or JSON path (glTF).
+#[test]
+fn info_validate_and_render_word_an_error_alike() {
+    let d = dir("alike");
+    let ply = d.join("broken.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nend_header\n",
+    )
+    .unwrap();
+    let gltf = d.join("broken.gltf");
+    std::fs::write(
+        &gltf,
+        r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":5},"extensions":{"KHR_gaussian_splatting":{}}}]}]}"#,
+    )
+    .unwrap();
+    let o = d.join("o.png");
+    for (file, message) in [
+        (&ply, "element 'vertex': missing property 'f_dc_0'"),
+        (
+            &gltf,
+            r#"meshes[0].primitives[0].attributes["POSITION"]: accessor index 5 out of range"#,
+        ),
+    ] {
+        let f = file.to_str().unwrap();
+        let (code, _, info) = splatgl(&["info", f]);
+        assert_eq!(code, 2);
+        let (code, validate, _) = splatgl(&["validate", f]);
+        assert_eq!(code, 1);
+        let (code, _, render) = splatgl(&["render", f, "-o", o.to_str().unwrap()]);
+        assert_eq!(code, 2);
+        for (what, text) in [
+            ("info", &info),
+            ("validate", &validate),
+            ("render", &render),
+        ] {
+            let line = text
+                .lines()
+                .find(|l| l.contains(message))
+                .unwrap_or_else(|| panic!("{what}: no {message:?} in {text}"));
+            assert!(line.contains(f), "{what} does not name the file: {line}");
+        }
+    }
+    std::fs::remove_dir_all(&d).ok();
+}

@@ -23,8 +23,9 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         println!("{:#}", report.to_json(&a.file));
     } else {
         if !a.quiet {
+            // Each line names the file, as `info` and `render` do in their errors.
             for line in report.summarized() {
-                println!("{line}");
+                println!("{}: {line}", a.file.display());
             }
         }
         let status = report.status();
