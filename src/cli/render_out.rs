@@ -2,7 +2,7 @@
 //! checked before anything is loaded (extension, folder, existing files), and the writing.
 
 use splatgl::image::{Image, PngDepth};
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
 /// What the output is.
@@ -53,6 +53,11 @@ impl Outputs {
             if print_json {
                 return Err(
                     "-o - and --print-camera-json both write to stdout; give -o FILE".into(),
+                );
+            }
+            if std::io::stdout().is_terminal() {
+                return Err(
+                    "-o -: stdout is a terminal; redirect it (> out.png) or pipe it".into(),
                 );
             }
             return Ok(Outputs {
