@@ -39,6 +39,7 @@ mod visible;
 pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
 pub use quantize::quantized_bucket_width;
+pub use reuse::Outcome;
 
 use quantize::{given_keys_range, quantized_key, visible_range};
 use radix::{RadixBuffers, chunk_count, fill_keys};
@@ -98,25 +99,6 @@ pub enum Reuse {
     /// each sort; on large real clouds it is usually 0 (some pair of different splats has
     /// bit-equal keys), so this mostly pays off for small clouds.
     MotionBound,
-}
-
-/// What the last call did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Outcome {
-    /// Nothing sorted yet.
-    None,
-    /// The order was computed for this call.
-    Sorted,
-    /// The previous order was returned because the view was bit-identical.
-    ReusedSameView,
-    /// The previous order was returned because the eye moved by `moved`, less than the proven
-    /// safe radius `radius`.
-    ReusedWithinBound {
-        /// Distance the eye moved since the sorted view.
-        moved: f64,
-        /// Safe radius of that sorted order.
-        radius: f64,
-    },
 }
 
 /// Every buffer a sort needs, kept across frames: after the first sort of N splats, sorting
