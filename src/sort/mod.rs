@@ -131,6 +131,34 @@ struct LastView {
     cull: Option<(usize, crate::cull::Frustum)>,
 }
 
+impl LastView {
+    fn new(
+        positions: &[[f32; 3]],
+        mode: SortMode,
+        precision: Precision,
+        eye: [f32; 3],
+        forward: [f32; 3],
+        cull: Option<(usize, crate::cull::Frustum)>,
+    ) -> LastView {
+        LastView {
+            ptr: positions.as_ptr() as usize,
+            len: positions.len(),
+            mode,
+            precision,
+            eye: bits_of(eye),
+            // The forward vector only matters to view-depth keys.
+            forward: if mode == SortMode::ViewDepth {
+                bits_of(forward)
+            } else {
+                [0; 3]
+            },
+            radius: 0.0,
+            eye_f: eye,
+            cull,
+        }
+    }
+}
+
 /// A reusable back-to-front sorter. See the [module docs](self) for the exact order.
 #[derive(Debug)]
 pub struct Sorter {
@@ -284,21 +312,7 @@ impl Sorter {
         eye: [f32; 3],
         forward: [f32; 3],
     ) -> &[u32] {
-        let view = LastView {
-            ptr: positions.as_ptr() as usize,
-            len: positions.len(),
-            mode,
-            precision: self.precision,
-            eye: bits_of(eye),
-            forward: if mode == SortMode::ViewDepth {
-                bits_of(forward)
-            } else {
-                [0; 3]
-            },
-            radius: 0.0,
-            eye_f: eye,
-            cull: None,
-        };
+        let view = LastView::new(positions, mode, self.precision, eye, forward, None);
         if self.reuse_last(&view) {
             return self.order();
         }
