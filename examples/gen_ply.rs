@@ -17,7 +17,7 @@ fn main() {
     let cloud = splatgl::scene::random_cloud(n, 3, 10.0, 7);
     let path = std::path::Path::new(&out);
     let result = if normals {
-        let bytes = with_normals(&splatgl::write::to_inria_ply(&cloud), n);
+        let bytes = splatgl::write::to_inria_ply_with_normals(&cloud);
         splatgl::write::write_bytes_atomic(path, &[], &bytes)
     } else {
         splatgl::write::save(&cloud, path, &[])
@@ -26,24 +26,4 @@ fn main() {
         eprintln!("{out}: {e}");
         std::process::exit(2);
     }
-}
-
-/// The same file with zero `nx ny nz` after `z` in the header and in every row.
-fn with_normals(ply: &[u8], n: usize) -> Vec<u8> {
-    let end = b"end_header\n";
-    let h = ply.windows(end.len()).position(|w| w == end).unwrap() + end.len();
-    let header = std::str::from_utf8(&ply[..h]).unwrap().replace(
-        "property float z\n",
-        "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n",
-    );
-    let body = &ply[h..];
-    let stride = body.len() / n;
-    let mut out = Vec::with_capacity(header.len() + n * (stride + 12));
-    out.extend_from_slice(header.as_bytes());
-    for row in body.chunks_exact(stride) {
-        out.extend_from_slice(&row[..12]);
-        out.extend_from_slice(&[0; 12]);
-        out.extend_from_slice(&row[12..]);
-    }
-    out
 }

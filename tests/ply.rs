@@ -223,3 +223,15 @@ fn compressed_ply_fields() {
         (colour[0] - 1.0).abs() < 1e-5 && colour[1].abs() < 1e-5 && (colour[2] - 1.0).abs() < 1e-5
     );
 }
+
+#[test]
+fn trainer_normals_are_skipped_like_any_extra_property() {
+    let cloud = random_cloud(500, 3, 5.0, 12);
+    let plain = splatgl::write::to_inria_ply(&cloud);
+    let with = splatgl::write::to_inria_ply_with_normals(&cloud);
+    assert_eq!(
+        with.len() - plain.len(),
+        500 * 12 + 3 * "property float nx\n".len()
+    );
+    assert_eq!(load(&with), load(&plain));
+}

@@ -159,10 +159,7 @@ pub(crate) fn release_consumed(bytes: &[u8]) {
     if !inside {
         return;
     }
-    let page = page_size();
-    let first = start.div_ceil(page) * page;
-    let last = end / page * page;
-    if last > first {
+    if let Some((first, last)) = whole_pages(start, end) {
         // SAFETY: [first, last) lies within a live read-only private file mapping (checked
         // above under the registry's lock ordering: a mapping is unregistered before it is
         // unmapped, and the caller's borrow of `bytes` keeps it alive); DONTNEED on such a
@@ -175,6 +172,13 @@ pub(crate) fn release_consumed(bytes: &[u8]) {
             );
         }
     }
+}
+
+/// The whole pages inside the address range `[start, end)`, if any.
+fn whole_pages(start: usize, end: usize) -> Option<(usize, usize)> {
+    let page = page_size();
+    let (first, last) = (start.div_ceil(page) * page, end / page * page);
+    (last > first).then_some((first, last))
 }
 
 fn page_size() -> usize {
@@ -191,11 +195,8 @@ pub(crate) fn advise_huge<T>(v: &mut [T]) {
     if bytes < (4 << 20) {
         return;
     }
-    let page = page_size();
     let start = v.as_mut_ptr() as usize;
-    let first = start.div_ceil(page) * page;
-    let last = (start + bytes) / page * page;
-    if last > first {
+    if let Some((first, last)) = whole_pages(start, start + bytes) {
         // SAFETY: the range lies inside `v`'s allocation; MADV_HUGEPAGE changes no contents.
         unsafe {
             libc::madvise(

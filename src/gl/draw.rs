@@ -7,7 +7,8 @@ use glow::HasContext;
 
 use super::GlError;
 use super::prepass::PREPASS_MIN_SPLATS;
-use super::renderer::{DrawSettings, Pipeline, SplatRenderer};
+use super::renderer::SplatRenderer;
+use super::settings::{DrawSettings, Pipeline};
 use super::state::{self, DrawState};
 use super::view::ViewParams;
 use crate::camera::Camera;

@@ -58,6 +58,7 @@ mod program;
 mod readback;
 mod renderer;
 mod scene;
+mod settings;
 mod sort;
 pub mod state;
 mod target;
@@ -72,10 +73,11 @@ pub use prepass::PREPASS_MIN_SPLATS;
 #[doc(hidden)]
 pub use program::build_program;
 pub use readback::{ColorFormat, DepthFormat, ReadbackTarget};
-pub use renderer::{DepthFunc, DrawSettings, SplatRenderer};
-#[doc(hidden)]
-pub use renderer::{DrawPath, Pipeline};
+pub use renderer::SplatRenderer;
 pub use scene::SplatScene;
+pub use settings::{DepthFunc, DrawSettings};
+#[doc(hidden)]
+pub use settings::{DrawPath, Pipeline};
 pub use sort::{DistanceSorter, sort_back_to_front};
 #[doc(hidden)]
 pub use state::StateCalls;

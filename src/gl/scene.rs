@@ -5,7 +5,8 @@ use std::ops::Range;
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::renderer::{DrawSettings, SplatRenderer};
+use super::renderer::SplatRenderer;
+use super::settings::DrawSettings;
 use super::sort::DistanceSorter;
 use super::{GlError, view::ViewParams};
 use crate::camera::Camera;

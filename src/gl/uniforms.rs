@@ -6,7 +6,8 @@ use glow::HasContext;
 
 use super::SplatScene;
 use super::program;
-use super::renderer::{DrawSettings, SplatRenderer};
+use super::renderer::SplatRenderer;
+use super::settings::DrawSettings;
 use super::view::ViewParams;
 
 /// Declares `Uniforms`, one location per uniform the renderer sets, each field named exactly

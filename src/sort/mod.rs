@@ -39,6 +39,7 @@ mod visible;
 pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
 pub use quantize::quantized_bucket_width;
+pub use reuse::Outcome;
 
 use quantize::{given_keys_range, quantized_key, visible_range};
 use radix::{RadixBuffers, chunk_count, fill_keys};
@@ -100,25 +101,6 @@ pub enum Reuse {
     MotionBound,
 }
 
-/// What the last call did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Outcome {
-    /// Nothing sorted yet.
-    None,
-    /// The order was computed for this call.
-    Sorted,
-    /// The previous order was returned because the view was bit-identical.
-    ReusedSameView,
-    /// The previous order was returned because the eye moved by `moved`, less than the proven
-    /// safe radius `radius`.
-    ReusedWithinBound {
-        /// Distance the eye moved since the sorted view.
-        moved: f64,
-        /// Safe radius of that sorted order.
-        radius: f64,
-    },
-}
-
 /// Every buffer a sort needs, kept across frames: after the first sort of N splats, sorting
 /// at most N splats again allocates nothing.
 #[derive(Debug, Default)]
@@ -147,6 +129,34 @@ struct LastView {
     eye_f: [f32; 3],
     /// For a culled sort ([`Sorter::sort_visible`]): the bounds' address and the frustum.
     cull: Option<(usize, crate::cull::Frustum)>,
+}
+
+impl LastView {
+    fn new(
+        positions: &[[f32; 3]],
+        mode: SortMode,
+        precision: Precision,
+        eye: [f32; 3],
+        forward: [f32; 3],
+        cull: Option<(usize, crate::cull::Frustum)>,
+    ) -> LastView {
+        LastView {
+            ptr: positions.as_ptr() as usize,
+            len: positions.len(),
+            mode,
+            precision,
+            eye: bits_of(eye),
+            // The forward vector only matters to view-depth keys.
+            forward: if mode == SortMode::ViewDepth {
+                bits_of(forward)
+            } else {
+                [0; 3]
+            },
+            radius: 0.0,
+            eye_f: eye,
+            cull,
+        }
+    }
 }
 
 /// A reusable back-to-front sorter. See the [module docs](self) for the exact order.
@@ -302,21 +312,7 @@ impl Sorter {
         eye: [f32; 3],
         forward: [f32; 3],
     ) -> &[u32] {
-        let view = LastView {
-            ptr: positions.as_ptr() as usize,
-            len: positions.len(),
-            mode,
-            precision: self.precision,
-            eye: bits_of(eye),
-            forward: if mode == SortMode::ViewDepth {
-                bits_of(forward)
-            } else {
-                [0; 3]
-            },
-            radius: 0.0,
-            eye_f: eye,
-            cull: None,
-        };
+        let view = LastView::new(positions, mode, self.precision, eye, forward, None);
         if self.reuse_last(&view) {
             return self.order();
         }

@@ -19,6 +19,25 @@
 //! `R = min(0.4 √K, min over adjacent pairs with p_i ≠ p_j of (gap − M) / (2 |p_i − p_j|))`,
 //! and 0 if any gap is `≤ M` or any key is not finite.
 
+/// What the last call did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outcome {
+    /// Nothing sorted yet.
+    None,
+    /// The order was computed for this call.
+    Sorted,
+    /// The previous order was returned because the view was bit-identical.
+    ReusedSameView,
+    /// The previous order was returned because the eye moved by `moved`, less than the proven
+    /// safe radius `radius`.
+    ReusedWithinBound {
+        /// Distance the eye moved since the sorted view.
+        moved: f64,
+        /// Safe radius of that sorted order.
+        radius: f64,
+    },
+}
+
 use super::keys::squared_distance;
 
 /// Distance between two eyes, in `f64`.

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 
 use super::radix::chunk_count;
 use super::{
-    LastView, Outcome, Precision, SortMode, SortRequest, Sorter, bits_of, far_first_key, radix,
+    LastView, Outcome, Precision, SortMode, SortRequest, Sorter, far_first_key, radix,
     squared_distance, view_depth,
 };
 use crate::cull::{CullBounds, Frustum, visible_into};
@@ -31,21 +31,8 @@ impl Sorter {
         request: &SortRequest,
     ) -> &[u32] {
         let SortRequest { mode, eye, forward } = *request;
-        let view = LastView {
-            ptr: positions.as_ptr() as usize,
-            len: positions.len(),
-            mode,
-            precision: self.precision,
-            eye: bits_of(eye),
-            forward: if mode == SortMode::ViewDepth {
-                bits_of(forward)
-            } else {
-                [0; 3]
-            },
-            radius: 0.0,
-            eye_f: eye,
-            cull: Some((bounds.radii().as_ptr() as usize, *frustum)),
-        };
+        let cull = Some((bounds.radii().as_ptr() as usize, *frustum));
+        let view = LastView::new(positions, mode, self.precision, eye, forward, cull);
         if self.reuse_last(&view) {
             return self.order();
         }

@@ -21,7 +21,7 @@ pub mod quantize;
 pub mod scene;
 pub use atomic::{refuse_overwriting_inputs, write_atomic, write_bytes_atomic};
 pub use comp::Comp;
-pub use ply::to_inria_ply;
+pub use ply::{to_inria_ply, to_inria_ply_with_normals};
 mod glb_spz;
 mod splat;
 mod spz;

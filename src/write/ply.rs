@@ -13,11 +13,27 @@ use crate::cloud::SplatCloud;
 /// that decode to exactly 1, 0 and 0 (±110: `sigmoid(±110)` and `exp(−110)` round to them),
 /// so no ±inf reaches other tools.
 pub fn to_inria_ply(cloud: &SplatCloud) -> Vec<u8> {
+    write(cloud, false)
+}
+
+/// [`to_inria_ply`] with zero `nx ny nz` after `x y z`, as the INRIA trainer writes them (62
+/// floats a splat at SH 3: the 248 MB file of 1M splats the load benchmarks read).
+pub fn to_inria_ply_with_normals(cloud: &SplatCloud) -> Vec<u8> {
+    write(cloud, true)
+}
+
+fn write(cloud: &SplatCloud, normals: bool) -> Vec<u8> {
     let k = cloud.coeffs_per_splat();
+    let extra = if normals { 3 } else { 0 };
     let mut out = Vec::new();
     let mut h = String::from("ply\nformat binary_little_endian 1.0\n");
     h += &format!("element vertex {}\n", cloud.len());
-    for p in ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2"] {
+    let normal_names: &[&str] = if normals { &["nx", "ny", "nz"] } else { &[] };
+    for p in ["x", "y", "z"]
+        .iter()
+        .chain(normal_names)
+        .chain(&["f_dc_0", "f_dc_1", "f_dc_2"])
+    {
         h += &format!("property float {p}\n");
     }
     for i in 0..3 * (k - 1) {
@@ -30,11 +46,13 @@ pub fn to_inria_ply(cloud: &SplatCloud) -> Vec<u8> {
     }
     h += "end_header\n";
     out.extend_from_slice(h.as_bytes());
-    out.reserve(cloud.len() * (14 + 3 * k) * 4);
+    out.reserve(cloud.len() * (14 + extra + 3 * k) * 4);
+    let mut row: Vec<f32> = Vec::with_capacity(14 + extra + 3 * k);
     for i in 0..cloud.len() {
         let sh = cloud.sh_of(i);
-        let mut row: Vec<f32> = Vec::with_capacity(14 + 3 * k);
+        row.clear();
         row.extend_from_slice(&cloud.positions[i]);
+        row.extend(std::iter::repeat_n(0.0, extra));
         row.extend_from_slice(&sh[0]);
         for ch in 0..3 {
             for c in &sh[1..] {

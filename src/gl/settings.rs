@@ -1,0 +1,102 @@
+//! What a draw is asked to do: [`DrawSettings`] (SH degree, depth test and function, restore
+//! mode, colour space) and the hidden draw-path switch ([`DrawPath`], [`Pipeline`]) the tests
+//! and benches use to compare paths.
+
+use crate::cloud::ColorSpace;
+
+/// The depth comparison of [`DrawSettings::depth_func`] (the host's convention: `Less` /
+/// `LessEqual` for a standard depth buffer cleared to 1, `Greater` / `GreaterEqual` for a
+/// reversed-Z one cleared to 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DepthFunc {
+    /// `GL_LESS` (the default).
+    #[default]
+    Less,
+    /// `GL_LEQUAL`.
+    LessEqual,
+    /// `GL_GREATER`.
+    Greater,
+    /// `GL_GEQUAL`.
+    GreaterEqual,
+}
+
+impl DepthFunc {
+    /// The GL enum.
+    pub fn gl_enum(self) -> u32 {
+        match self {
+            DepthFunc::Less => glow::LESS,
+            DepthFunc::LessEqual => glow::LEQUAL,
+            DepthFunc::Greater => glow::GREATER,
+            DepthFunc::GreaterEqual => glow::GEQUAL,
+        }
+    }
+}
+
+/// Per-draw settings: the renderer's own ([`SplatRenderer::settings_mut`], used by
+/// [`SplatRenderer::draw`] and [`SplatRenderer::set_order`]) or given for one draw
+/// ([`SplatRenderer::draw_current_with`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DrawSettings {
+    /// SH degree to evaluate (clamped to the cloud's degree); `None` = the cloud's degree.
+    pub sh_degree: Option<u8>,
+    /// Test against the bound depth buffer with [`DrawSettings::depth_func`], never writing
+    /// depth, so splats hide behind the host's opaque geometry. On by default (embedding);
+    /// without a depth attachment the test always passes. The headless renderer turns it off.
+    pub depth_test: bool,
+    /// The depth comparison (the host's convention; `Less` by default).
+    pub depth_func: DepthFunc,
+    /// Put back every piece of GL state the call changes (`true`, recommended for legacy
+    /// hosts), or leave the documented values (`false`, the default: no state queries). See
+    /// [`super::state`].
+    pub restore_state: bool,
+    /// The colour space to draw as (`None` = the uploaded cloud's): decides
+    /// `GL_FRAMEBUFFER_SRGB` where it can be switched (see [`SplatRenderer`]).
+    pub color_space: Option<ColorSpace>,
+}
+
+impl Default for DrawSettings {
+    fn default() -> Self {
+        DrawSettings {
+            sh_degree: None,
+            depth_test: true,
+            depth_func: DepthFunc::Less,
+            restore_state: false,
+            color_space: None,
+        }
+    }
+}
+
+/// Which way the renderer computes the per-splat maths. **For the benchmarks and the tests
+/// that compare the paths** (hidden from the documented API): every path draws the same image.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Pipeline {
+    /// The pre-pass from [`PREPASS_MIN_SPLATS`] splats drawn on, else direct (the default).
+    #[default]
+    Auto,
+    /// Every quad corner runs the per-splat maths (the path before the pre-pass).
+    Direct,
+    /// Always the transform-feedback pre-pass (where the context has transform-feedback
+    /// objects and no erratum is switched in; else direct).
+    PrePass,
+}
+
+/// The renderer's draw path (hidden, see [`Pipeline`]).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DrawPath {
+    /// Direct, pre-pass, or chosen by the splat count.
+    pub pipeline: Pipeline,
+    /// The former quads: the 3σ ellipse's rectangle whatever the opacity, with the former
+    /// 0.5 px margin ([`crate::profile::FORMER_QUAD_MARGIN_PX`]), instead of the
+    /// opacity-aware extent and [`crate::profile::QUAD_MARGIN_PX`].
+    pub former_quads: bool,
+}
+
+impl DrawPath {
+    /// The path before the opacity-aware extent and the pre-pass.
+    pub const FORMER: DrawPath = DrawPath {
+        pipeline: Pipeline::Direct,
+        former_quads: true,
+    };
+}
