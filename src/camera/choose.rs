@@ -111,12 +111,14 @@ impl ViewOptions {
 
     /// The distance from `cam`'s eye to its focus (the viewer's orbit pivot, and the target of
     /// a printed `--look-at`): the --look-at target's distance, else the depth of the content's
-    /// centre ([`Extent`](super::Extent), [`Camera::focus_distance_to`]), else 1.
+    /// centre (of its [`FIT_SIGMAS`](super::FIT_SIGMAS) [`Extent`](super::Extent), which default
+    /// views look at; [`Camera::focus_distance_to`]), else 1.
     pub fn focus_distance(&self, cam: &Camera, cloud: &SplatCloud) -> f32 {
         if let Some(l) = &self.look_at {
             return (l.target - l.eye).length();
         }
-        super::Extent::of_cloud(cloud).map_or(1.0, |e| cam.focus_distance_to(e.centre()))
+        super::Extent::of_cloud_at(cloud, super::FIT_SIGMAS)
+            .map_or(1.0, |e| cam.focus_distance_to(e.centre()))
     }
 
     /// The view for `scene`. `default_size` is the image size when neither the options nor
