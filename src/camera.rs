@@ -30,7 +30,7 @@ mod choose;
 mod frame;
 mod json;
 pub use choose::{LookAtSpec, SceneView, ViewOptions};
-pub use frame::{Extent, LookAt, UpAxis};
+pub use frame::{Extent, FIT_SIGMAS, FRAME_MARGIN, LookAt, UpAxis, Z_UP_BELOW, Z_UP_TALLER};
 pub use json::{
     CamerasJsonEntry, load_cameras_json, load_cameras_json_limited, parse_cameras_json,
 };
@@ -57,6 +57,15 @@ pub enum CameraError {
         /// What was expected.
         message: String,
     },
+    /// A `cameras.json` file that is not JSON or has the wrong shape ([`CameraError::Json`],
+    /// [`CameraError::Invalid`]), with the file's name.
+    #[error("{}: {}", path.display(), source.detail())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong in it.
+        source: Box<CameraError>,
+    },
     /// Parameters that give no usable camera (zero size, non-finite or non-positive focal
     /// length, degenerate pose).
     #[error("invalid camera: {0}")]
@@ -66,6 +75,21 @@ pub enum CameraError {
     /// frame).
     #[error("{0}")]
     Unavailable(String),
+}
+
+impl CameraError {
+    /// The message without the `cameras.json: ` prefix: a JSON error, or `LOCATION: MESSAGE`
+    /// (`$` for the top level, else a path such as `$[3].rotation[1]`).
+    fn detail(&self) -> String {
+        match self {
+            CameraError::Json(e) => format!("not JSON: {e}"),
+            CameraError::Invalid { location, message } if location.is_empty() => {
+                format!("$: {message}")
+            }
+            CameraError::Invalid { location, message } => format!("${location}: {message}"),
+            other => other.to_string(),
+        }
+    }
 }
 
 /// A glTF 2.0 perspective camera as instanced by a node, in the glTF convention: the camera

@@ -243,3 +243,32 @@ fn auto_up_axis_follows_the_format() {
     assert_eq!(UpAxis::for_format(Some(Format::Ply)), UpAxis::NegY);
     assert_eq!(UpAxis::for_format(None), UpAxis::Y);
 }
+
+/// `--up auto` with the cloud: PLY is −Y up unless the content stands on z = 0 and is clearly
+/// taller along +Z than wide (the MuJoCo fox); glTF stays +Y whatever its shape.
+#[test]
+fn auto_up_axis_takes_z_for_content_standing_on_z_zero() {
+    use splatgl::camera::UpAxis;
+    use splatgl::load::Format;
+    let column = |z0: f32| {
+        let mut c = splatgl::SplatCloud::new(0);
+        for i in 0..200 {
+            let t = i as f32 / 199.0;
+            let p = [0.3 * (t * 17.0).sin(), 0.3 * (t * 23.0).cos(), z0 + 2.0 * t];
+            c.push(p, [0.02; 3], [0.0, 0.0, 0.0, 1.0], 0.8, &[[0.2; 3]]);
+        }
+        c
+    };
+    let standing = column(0.0);
+    assert_eq!(UpAxis::for_cloud(Some(Format::Ply), &standing), UpAxis::Z);
+    assert_eq!(UpAxis::for_cloud(Some(Format::Spz), &standing), UpAxis::Z);
+    assert_eq!(UpAxis::for_cloud(Some(Format::Glb), &standing), UpAxis::Y);
+    // Spanning both sides of z = 0 (COLMAP scenes around the origin): −Y.
+    assert_eq!(
+        UpAxis::for_cloud(Some(Format::Ply), &column(-1.0)),
+        UpAxis::NegY
+    );
+    // Not taller along z than wide: −Y.
+    let wide = splatgl::scene::random_cloud(200, 0, 1.0, 5);
+    assert_eq!(UpAxis::for_cloud(Some(Format::Ply), &wide), UpAxis::NegY);
+}

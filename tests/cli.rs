@@ -171,11 +171,13 @@ fn backends_agree_on_linear_colour_space() {
         "--background",
         "0.2,0.3,0.4",
     ];
+    // (The outputs exist, made by `tmp`: -f.)
     let mut args = vec![
         "render",
         scene.to_str().unwrap(),
         "--backend",
         "reference",
+        "-f",
         "-o",
     ];
     let r = out("reference");
@@ -189,6 +191,7 @@ fn backends_agree_on_linear_colour_space() {
         scene.to_str().unwrap(),
         "--backend",
         "gl",
+        "-f",
         "-o",
         g.to_str().unwrap(),
     ];
@@ -237,7 +240,15 @@ fn render_takes_the_view_from_a_gltf_camera_node() {
     let scene = tmp("cam.gltf", &serde_json::to_vec(&doc).unwrap());
     let out = tmp("cam.pfm", b"");
     let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
-    let args = ["render", s, "--gltf-camera", "0", "--backend", "reference"];
+    let args = [
+        "render",
+        s,
+        "--gltf-camera",
+        "0",
+        "--backend",
+        "reference",
+        "-f",
+    ];
     let (code, _, err) = splatgl(&[&args[..], &["--height", "40", "-o", o]].concat());
     assert_eq!(code, 0, "{err}");
     let img = splatgl::image::Image::read(&out).unwrap();
@@ -261,7 +272,7 @@ fn render_takes_the_view_from_a_gltf_camera_node() {
         "same image as the reference from that camera"
     );
 
-    let (code, _, err) = splatgl(&[&args[..2], &["--gltf-camera", "1", "-o", o]].concat());
+    let (code, _, err) = splatgl(&[&args[..2], &["-f", "--gltf-camera", "1", "-o", o]].concat());
     assert_eq!(code, 2);
     assert!(err.contains("1 perspective camera node"), "{err}");
 }

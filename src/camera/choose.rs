@@ -48,7 +48,7 @@ pub struct ViewOptions {
     pub look_at: Option<LookAtSpec>,
     /// Vertical field of view in degrees for look-at and framing (`--fov`).
     pub fov_deg: f32,
-    /// Up axis (`--up`); `None` = auto ([`UpAxis::for_format`]).
+    /// Up axis (`--up`); `None` = auto ([`UpAxis::for_cloud`]).
     pub up: Option<UpAxis>,
     /// Image width (`--width`).
     pub width: Option<u32>,
@@ -84,6 +84,12 @@ impl ViewOptions {
         self.up.unwrap_or_else(|| UpAxis::for_format(format))
     }
 
+    /// The up axis for `scene`: `up`, or the per-cloud rule ([`UpAxis::for_cloud`]).
+    pub fn up_for_scene(&self, scene: SceneView<'_>) -> UpAxis {
+        self.up
+            .unwrap_or_else(|| UpAxis::for_cloud(scene.format, scene.cloud))
+    }
+
     /// The image size: `width`/`height`, a missing one derived from `(w, h)`'s aspect ratio.
     pub fn size_or(&self, w: u32, h: u32) -> (u32, u32) {
         let derive = |a: u32, b: u32, c: u32| (a as u64 * b as u64 + c as u64 / 2) / c as u64;
@@ -105,12 +111,14 @@ impl ViewOptions {
 
     /// The distance from `cam`'s eye to its focus (the viewer's orbit pivot, and the target of
     /// a printed `--look-at`): the --look-at target's distance, else the depth of the content's
-    /// centre ([`Extent`](super::Extent), [`Camera::focus_distance_to`]), else 1.
+    /// centre (of its [`FIT_SIGMAS`](super::FIT_SIGMAS) [`Extent`](super::Extent), which default
+    /// views look at; [`Camera::focus_distance_to`]), else 1.
     pub fn focus_distance(&self, cam: &Camera, cloud: &SplatCloud) -> f32 {
         if let Some(l) = &self.look_at {
             return (l.target - l.eye).length();
         }
-        super::Extent::of_cloud(cloud).map_or(1.0, |e| cam.focus_distance_to(e.centre()))
+        super::Extent::of_cloud_at(cloud, super::FIT_SIGMAS)
+            .map_or(1.0, |e| cam.focus_distance_to(e.centre()))
     }
 
     /// The view for `scene`. `default_size` is the image size when neither the options nor
@@ -163,7 +171,7 @@ impl ViewOptions {
             return Camera::from_gltf(g, w, h);
         }
         let (w, h) = self.size_or(default_size.0, default_size.1);
-        let up = self.up_for(scene.format);
+        let up = self.up_for_scene(scene);
         if let Some(l) = &self.look_at {
             let up = l.up.unwrap_or(up.vector());
             let fwd = l.target - l.eye;

@@ -32,6 +32,32 @@ impl UpAxis {
         }
     }
 
+    /// The rule for `--up auto` with the cloud at hand: [`UpAxis::for_format`], except that
+    /// a cloud of a non-glTF format that stands on the z = 0 plane and is clearly taller along
+    /// +Z than wide is +Z up (robotics / photogrammetry exports such as the MuJoCo fox): over
+    /// the drawable splats' centres (1st..99th percentile per axis), the z extent is at least
+    /// [`Z_UP_TALLER`] × the x and the y extent, and at most [`Z_UP_BELOW`] of it lies below
+    /// z = 0. COLMAP-axis training output (−Y up) is wide in x and z and spans both sides of
+    /// z = 0, so it keeps −Y.
+    pub fn for_cloud(format: Option<Format>, cloud: &SplatCloud) -> Self {
+        let by_format = Self::for_format(format);
+        if by_format != UpAxis::NegY {
+            return by_format;
+        }
+        match centre_box(cloud) {
+            Some((lo, hi)) => {
+                let e = hi - lo;
+                let tall = e.z > 0.0 && e.z >= Z_UP_TALLER * e.x.max(e.y);
+                if tall && -lo.z <= Z_UP_BELOW * e.z {
+                    UpAxis::Z
+                } else {
+                    by_format
+                }
+            }
+            None => by_format,
+        }
+    }
+
     /// The unit vector.
     pub fn vector(self) -> Vec3 {
         match self {
@@ -71,6 +97,44 @@ impl UpAxis {
     }
 }
 
+/// [`Camera::frame_extent_along`]: the fraction of the image's width and height left free on
+/// each side of the framed box.
+pub const FRAME_MARGIN: f32 = 0.04;
+
+/// [`Camera::frame_cloud`]: the width, in standard deviations, of the splat boxes a default
+/// view fits to the image (the eye stays outside the 3σ ones).
+pub const FIT_SIGMAS: f32 = 2.0;
+
+/// [`UpAxis::for_cloud`]: how much taller along z than along x and y a cloud must be to be
+/// taken as +Z up.
+pub const Z_UP_TALLER: f32 = 1.1;
+/// [`UpAxis::for_cloud`]: the most of a +Z-up cloud's z extent that may lie below z = 0.
+pub const Z_UP_BELOW: f32 = 0.05;
+
+/// Per axis, the 1st and 99th percentile of the drawable splats' centres.
+fn centre_box(cloud: &SplatCloud) -> Option<(Vec3, Vec3)> {
+    let mut axes: [Vec<f32>; 3] = Default::default();
+    for (p, &o) in cloud.positions.iter().zip(&cloud.opacities) {
+        if o >= crate::profile::ALPHA_MIN && p.iter().all(|v| v.is_finite()) {
+            for (a, v) in axes.iter_mut().zip(p) {
+                a.push(*v);
+            }
+        }
+    }
+    let n = axes[0].len();
+    if n == 0 {
+        return None;
+    }
+    let (i0, i1) = ((n - 1) / 100, n - 1 - (n - 1) / 100);
+    let mut lo = Vec3::ZERO;
+    let mut hi = Vec3::ZERO;
+    for (k, a) in axes.iter_mut().enumerate() {
+        lo[k] = *a.select_nth_unstable_by(i0, f32::total_cmp).1;
+        hi[k] = *a.select_nth_unstable_by(i1, f32::total_cmp).1;
+    }
+    Some((lo, hi))
+}
+
 /// The box a default view frames: per axis, the 1st percentile of the splats' 3σ box minima
 /// and the 99th percentile of their maxima, over the splats that can be drawn (finite position
 /// and scale, opacity ≥ [`ALPHA_MIN`](crate::profile::ALPHA_MIN)). The 3σ box of a splat is
@@ -88,7 +152,12 @@ pub struct Extent {
 impl Extent {
     /// The extent of `cloud`'s content; `None` when no splat can be drawn.
     pub fn of_cloud(cloud: &SplatCloud) -> Option<Self> {
-        let k = crate::profile::CUTOFF_M2.sqrt(); // 3σ
+        Self::of_cloud_at(cloud, crate::profile::CUTOFF_M2.sqrt()) // 3σ
+    }
+
+    /// [`Extent::of_cloud`] with boxes `k` standard deviations wide instead of 3
+    /// ([`FIT_SIGMAS`] for the part of the content a default view fits to the image).
+    pub fn of_cloud_at(cloud: &SplatCloud, k: f32) -> Option<Self> {
         let mut lo: [Vec<f32>; 3] = Default::default();
         let mut hi: [Vec<f32>; 3] = Default::default();
         for i in 0..cloud.len() {
@@ -138,8 +207,11 @@ impl Extent {
 
 impl Camera {
     /// The default view of a cloud: looking along [`UpAxis::default_forward`] with `up` up,
-    /// at the centre of its [`Extent`], from [`Camera::frame_extent_along`]'s distance.
-    /// `None` when no splat can be drawn.
+    /// at the centre of its [`FIT_SIGMAS`] extent, as close as keeps that box in the image
+    /// and the eye outside the 3σ [`Extent`] ([`Camera::frame_boxes_along`]). A splat's
+    /// 2σ ellipsoid is where an opaque one is still at alpha e⁻² ≈ 0.14: fitting the 3σ box
+    /// instead would leave a lone splat a small blob in a wide dark frame. `None` when no
+    /// splat can be drawn.
     pub fn frame_cloud(
         cloud: &SplatCloud,
         up: UpAxis,
@@ -147,25 +219,34 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Option<Self> {
-        let extent = Extent::of_cloud(cloud)?;
-        Self::frame_extent_along(
-            &extent,
-            up.default_forward(),
-            up.vector(),
-            fov_y,
-            width,
-            height,
-        )
+        let outside = Extent::of_cloud(cloud)?;
+        let fit = Extent::of_cloud_at(cloud, FIT_SIGMAS)?;
+        let (fwd, up) = (up.default_forward(), up.vector());
+        Self::frame_boxes_along(&fit, &outside, fwd, up, fov_y, width, height)
     }
 
-    /// A camera looking along `forward` (`up` roughly up) at the centre of `extent`, far
-    /// enough that the box's bounding sphere fits the smaller field of view with a 10 % margin,
-    /// so the eye is outside the box; and at least 1.5 × the near cull
-    /// ([`NEAR_CULL`](crate::profile::NEAR_CULL)) in front of the sphere, so tiny content is
-    /// not culled. An extent without size (coincident points of zero scale) is framed as a unit
-    /// sphere. `None` when `forward ∥ up`.
+    /// A camera looking along `forward` (`up` roughly up) at the centre of `extent`, as close
+    /// as keeps every corner of the box inside the image with a [`FRAME_MARGIN`] margin on each
+    /// side and every corner in front of the eye (so the eye is outside the box), at least
+    /// 1.5 × the near cull ([`NEAR_CULL`](crate::profile::NEAR_CULL)) ahead of the nearest
+    /// one, so tiny content is not culled. An extent without size (coincident points of zero
+    /// scale) is framed as a unit sphere. `None` when `forward ∥ up`.
     pub fn frame_extent_along(
         extent: &Extent,
+        forward: Vec3,
+        up: Vec3,
+        fov_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        Self::frame_boxes_along(extent, extent, forward, up, fov_y, width, height)
+    }
+
+    /// [`Camera::frame_extent_along`] fitting `fit` to the image while keeping the eye outside
+    /// `outside` (every corner of both in front of the eye).
+    pub fn frame_boxes_along(
+        fit: &Extent,
+        outside: &Extent,
         forward: Vec3,
         up: Vec3,
         fov_y: f32,
@@ -175,16 +256,45 @@ impl Camera {
         if forward.cross(up).length_squared() <= 1e-12 {
             return None;
         }
-        let centre = extent.centre();
-        let half = extent.radius();
-        let radius = if half > 1e-6 { half } else { 1.0 };
-        let tan_y = (0.5 * fov_y).tan();
-        let tan_min = tan_y.min(tan_y * width as f32 / height.max(1) as f32);
-        let fit = 1.1 * radius / tan_min.atan().sin();
-        let dist = fit.max(radius + 1.5 * crate::profile::NEAR_CULL as f32);
-        let eye = centre - forward.normalize() * dist;
+        let centre = fit.centre();
+        let f = forward.normalize();
+        let right = f.cross(up).normalize();
+        let image_up = right.cross(f);
+        let sized = |e: &Extent| e.radius() > 1e-6;
+        let half = if sized(fit) {
+            0.5 * (fit.hi - fit.lo)
+        } else {
+            Vec3::splat(1.0 / 3f32.sqrt()) // a unit sphere's box, as far as framing goes
+        };
+        let tan_y = (0.5 * fov_y).tan() * (1.0 - 2.0 * FRAME_MARGIN);
+        let tan_x = tan_y * width as f32 / height.max(1) as f32;
+        let near = 1.5 * crate::profile::NEAR_CULL as f32;
+        // A corner at (x, y, z) in the camera's axes, seen from `d` behind the centre, is in
+        // the image when |x| ≤ tan_x (d + z) and |y| ≤ tan_y (d + z); in front when d + z > near.
+        let mut dist = 0.0f32;
+        for i in 0..8 {
+            let s = Vec3::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            );
+            let c = s * half;
+            let (x, y, z) = (c.dot(right), c.dot(image_up), c.dot(f));
+            dist = dist
+                .max(x.abs() / tan_x - z)
+                .max(y.abs() / tan_y - z)
+                .max(near - z);
+            if sized(outside) {
+                let o = outside.centre() - centre + s * 0.5 * (outside.hi - outside.lo);
+                dist = dist.max(near - o.dot(f));
+            }
+        }
+        let eye = centre - f * dist;
         let mut cam = Self::look_at(eye, centre, up, fov_y, width, height);
-        cam.far = (dist + 2.0 * radius).max(cam.far);
+        let reach = half
+            .length()
+            .max((outside.centre() - centre).length() + outside.radius());
+        cam.far = (dist + 2.0 * reach).max(cam.far);
         Some(cam)
     }
 

@@ -142,7 +142,13 @@ pub fn load_cameras_json_limited(
             format!("cameras.json is not UTF-8 ({e})"),
         ))
     })?;
-    parse_limited(&text, limits)
+    parse_limited(&text, limits).map_err(|e| match e {
+        CameraError::Json(_) | CameraError::Invalid { .. } => CameraError::File {
+            path: path.to_owned(),
+            source: Box::new(e),
+        },
+        other => other,
+    })
 }
 
 impl super::Camera {

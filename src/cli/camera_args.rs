@@ -14,9 +14,47 @@ pub enum UpArg {
     NegY,
     /// +Z up.
     Z,
-    /// From the format: glTF +Y; PLY and the packed formats (COLMAP axes) −Y; the bundled
-    /// default scene +Y.
+    /// From the format: glTF +Y; PLY and the packed formats (COLMAP axes) −Y, but +Z for a
+    /// cloud standing on z = 0 that is clearly taller along +Z than wide; the bundled default
+    /// scene +Y.
     Auto,
+}
+
+/// `--view` / `--gltf-camera`: one index, or `all` (render only: one image each).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pick {
+    /// The N-th (0-based).
+    Index(usize),
+    /// Every one, in list order.
+    All,
+}
+
+impl Pick {
+    /// The index, `0` for `all` (the first view).
+    pub fn first(self) -> usize {
+        match self {
+            Pick::Index(i) => i,
+            Pick::All => 0,
+        }
+    }
+}
+
+fn parse_pick(s: &str) -> Result<Pick, String> {
+    if s == "all" {
+        return Ok(Pick::All);
+    }
+    s.parse()
+        .map(Pick::Index)
+        .map_err(|_| format!("expected a 0-based index or `all`, found {s:?}"))
+}
+
+/// `--fov`: degrees in (0, 180).
+fn parse_fov(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        Ok(v) => Err(format!("{v} is outside (0, 180) degrees")),
+        Err(_) => Err(format!("expected degrees in (0, 180), found {s:?}")),
+    }
 }
 
 /// Camera options.
@@ -25,9 +63,10 @@ pub struct CameraArgs {
     /// 3DGS cameras.json to take the view from (see --view).
     #[arg(long, value_name = "cameras.json", conflicts_with_all = ["look_at", "gltf_camera"])]
     pub camera: Option<std::path::PathBuf>,
-    /// Index (0-based, list order) of the view in --camera.
-    #[arg(long, default_value_t = 0, value_name = "N")]
-    pub view: usize,
+    /// Index (0-based, list order) of the view in --camera (default 0); `all` (render):
+    /// one image per view.
+    #[arg(long, value_name = "N|all", requires = "camera", value_parser = parse_pick)]
+    pub view: Option<Pick>,
     /// Look-at camera: eye, target and optionally up (default: the --up axis).
     #[arg(
         long,
@@ -36,13 +75,13 @@ pub struct CameraArgs {
     )]
     #[arg(conflicts_with = "gltf_camera")]
     pub look_at: Option<String>,
-    /// Use the N-th glTF camera node of the scene.
+    /// Use the N-th glTF camera node of the scene; `all` (render): one image per camera node.
     ///
     /// Without any camera option the view frames the scene's content (the splats' 3σ boxes)
     /// from the front, slightly from above, with the --up axis up; the default scene has its
     /// own camera.
-    #[arg(long, value_name = "N")]
-    pub gltf_camera: Option<usize>,
+    #[arg(long, value_name = "N|all", value_parser = parse_pick)]
+    pub gltf_camera: Option<Pick>,
     /// Which world axis is up, for framing and --look-at's default up.
     #[arg(long, value_enum, default_value_t = UpArg::Auto, allow_hyphen_values = true)]
     pub up: UpArg,
@@ -52,12 +91,25 @@ pub struct CameraArgs {
     /// Image height (default 480 for render, 720 for view; or the cameras.json view's, scaled).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: Option<u32>,
-    /// Vertical field of view in degrees (look-at and automatic framing).
-    #[arg(long, default_value_t = 50.0, value_name = "DEG")]
-    pub fov: f32,
-    /// Also print the camera as a 3DGS cameras.json (one entry) on stdout.
+    /// Vertical field of view in degrees, in (0, 180) (look-at and automatic framing;
+    /// default 50).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true, value_parser = parse_fov)]
+    pub fov: Option<f32>,
+    /// Also print the camera as a 3DGS cameras.json (one entry) on stdout; for a render batch,
+    /// one cameras.json with an entry per image (id = index, img_name = the file's stem).
     #[arg(long)]
     pub print_camera_json: bool,
+}
+
+/// `--background r,g,b`: three display values in [0, 1].
+pub fn background(s: &str) -> Result<[f32; 3], String> {
+    let v = floats(s, "--background", &[3])?;
+    if let Some(x) = v.iter().find(|x| !(0.0..=1.0).contains(*x)) {
+        return Err(format!(
+            "--background {s}: {x} is outside [0, 1] (display values)"
+        ));
+    }
+    Ok([v[0], v[1], v[2]])
 }
 
 /// Comma-separated finite floats, `counts` of them.
@@ -92,10 +144,10 @@ impl CameraArgs {
         };
         Ok(ViewOptions {
             cameras_json: self.camera.clone(),
-            view: self.view,
-            gltf_camera: self.gltf_camera,
+            view: self.view.map_or(0, Pick::first),
+            gltf_camera: self.gltf_camera.map(Pick::first),
             look_at,
-            fov_deg: self.fov,
+            fov_deg: self.fov.unwrap_or(50.0),
             up: match self.up {
                 UpArg::Y => Some(UpAxis::Y),
                 UpArg::NegY => Some(UpAxis::NegY),

@@ -207,6 +207,9 @@ fn go(a: &Args) -> Result<(), String> {
     }
     check_output(&a.output, &a.input, a.force)?;
     let scene = splatgl::load::load_path(&a.input, &a.load.options()).map_err(|e| e.to_string())?;
+    a.load
+        .common
+        .check_applies(&a.input.display().to_string(), Some(scene.report.format))?;
     for w in scene.report.summarized_warnings() {
         eprintln!("warning: {w}");
     }

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 /// Help of `info --json`.
 pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
     kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
-    non_unit_quaternions, memory_bytes, warnings; for quantized containers also container, \
+    non_unit_quaternions, non_finite_opacities, memory_bytes, warnings; for quantized containers also container, \
     container_version, compression, gltf_extension, quantization[{attribute, bits, encoding}], \
     lossy, antialiased — null otherwise; with -v also limits)";
 
@@ -21,6 +21,11 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     };
     let c = &loaded.cloud;
     let r = &loaded.report;
+    let file = a.file.display().to_string();
+    if let Err(e) = a.load.common.check_applies(&file, Some(r.format)) {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     let b = c.bounds();
     let mut info = serde_json::json!({
         "file": a.file.display().to_string(),
@@ -35,6 +40,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "bounds_max": b.map(|b| b.max),
         "scale_space": r.scale_space.map(|s| s.name()),
         "non_unit_quaternions": r.non_unit_quaternions,
+        "non_finite_opacities": r.non_finite_opacities,
         "memory_bytes": c.memory_bytes(),
         "warnings": r.warning_lines(),
     });
@@ -84,8 +90,19 @@ pub fn run(a: super::FileArgs) -> ExitCode {
             println!("  {k:<24}{v}");
         }
     }
-    for w in r.summarized_warnings() {
-        println!("warning: {w}");
+    if r.non_finite_opacities > 0 {
+        println!(
+            "non-finite:     {} opacity logits ±inf (read as opacity 1 or 0)",
+            r.non_finite_opacities
+        );
+    }
+    if !a.quiet {
+        for w in r.summarized_warnings() {
+            println!("warning: {w}");
+        }
+        for n in r.summarized_notes() {
+            println!("note: {n}");
+        }
     }
     ExitCode::SUCCESS
 }

@@ -9,7 +9,10 @@ mod compare;
 mod conformance;
 mod convert;
 mod info;
+mod progress;
 mod render;
+mod render_backend;
+mod render_out;
 mod validate;
 #[cfg(feature = "viewer")]
 mod view;
@@ -66,6 +69,9 @@ pub struct FileArgs {
     /// Also print the loader's limits (`limits` in JSON).
     #[arg(short, long)]
     pub verbose: bool,
+    /// Less text: `info` without warnings and notes, `validate` only its verdict line.
+    #[arg(short, long, conflicts_with = "verbose")]
+    pub quiet: bool,
     #[command(flatten)]
     pub load: LoadArgs,
 }
@@ -86,14 +92,16 @@ pub struct LoadArgs {
 pub struct LoadCommonArgs {
     /// How glTF SCALE values are read: auto (signed types or negatives mean the review
     /// draft's log space), linear (RC) or log.
-    #[arg(long, default_value = "auto", value_name = "auto|linear|log")]
-    pub scale_space: splatgl::load::ScaleSpace,
+    /// glTF only (an error for other inputs).
+    #[arg(long, value_name = "auto|linear|log")]
+    pub scale_space: Option<splatgl::load::ScaleSpace>,
     /// Axes of SPZ data: rub (Niantic's RUB, converted to splatgl's frame: RDF for .spz files,
     /// glTF's LUF inside glTF), raw (no conversion: what splat-transform 3.x writes into .spz,
     /// and CesiumJS expects inside glTF) or auto (.spz: rub; glTF: what POSITION min/max show,
     /// else rub for KHR_gaussian_splatting_compression_spz_2 and raw for the legacy extension).
-    #[arg(long, default_value = "auto", value_name = "auto|rub|raw")]
-    pub spz_axes: splatgl::load::spz::SpzAxes,
+    /// .spz and glTF only (an error for other inputs).
+    #[arg(long, value_name = "auto|rub|raw")]
+    pub spz_axes: Option<splatgl::load::spz::SpzAxes>,
     /// Fail on a splat with a non-finite or overflowing value instead of dropping it.
     #[arg(long)]
     pub strict: bool,
@@ -132,8 +140,8 @@ impl LoadCommonArgs {
     /// The library's options, with `max_splats` as the splat limit.
     pub fn options(&self, max_splats: u64) -> splatgl::load::LoadOptions {
         splatgl::load::LoadOptions {
-            scale_space: self.scale_space,
-            spz_axes: self.spz_axes,
+            scale_space: self.scale_space.unwrap_or_default(),
+            spz_axes: self.spz_axes.unwrap_or_default(),
             strict: self.strict,
             allow_outside_paths: self.allow_outside_paths,
             resolver: None,
@@ -143,6 +151,33 @@ impl LoadCommonArgs {
                 ..Limits::default()
             },
         }
+    }
+}
+
+impl LoadCommonArgs {
+    /// Refuses the format-specific options given for a file of another format (`None`: the
+    /// bundled default scene), naming the option and the format.
+    pub fn check_applies(
+        &self,
+        file: &str,
+        format: Option<splatgl::load::Format>,
+    ) -> Result<(), String> {
+        use splatgl::load::Format;
+        let what = format.map_or("the bundled default scene (no file given)".into(), |f| {
+            format!("a {} file", f.name())
+        });
+        let gltf = matches!(format, Some(Format::Gltf | Format::Glb));
+        if self.scale_space.is_some() && !gltf {
+            return Err(format!(
+                "--scale-space applies to glTF scenes only; {file} is {what}"
+            ));
+        }
+        if self.spz_axes.is_some() && !(gltf || format == Some(Format::Spz)) {
+            return Err(format!(
+                "--spz-axes applies to .spz and glTF scenes only; {file} is {what}"
+            ));
+        }
+        Ok(())
     }
 }
 

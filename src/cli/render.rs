@@ -1,8 +1,10 @@
 //! `splatgl render`: one image of a scene (or of the bundled default scene).
 
-use super::camera_args::{camera_json_line, floats, look_at_line};
+use super::camera_args::{Pick, background, camera_json_line, look_at_line};
+use super::progress::Progress;
+use super::render_backend::Wanted;
+use super::render_out::{Kind, Outputs};
 use splatgl::camera::{Camera, SceneView};
-use splatgl::image::{Image, PngDepth};
 use splatgl::load::Scene;
 use splatgl::reference::{RenderOptions, SortMode};
 use std::path::{Path, PathBuf};
@@ -12,11 +14,13 @@ use std::time::Instant;
 /// Rendering backends.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Backend {
-    /// GL for 8-bit PNG output when a headless EGL context can be made here (else the
-    /// reference, with a note); the reference for `.pfm`, `--depth16` and `--sort view-depth`,
-    /// which need more than an 8-bit framebuffer or a distance sort.
+    /// GL when the headless EGL context is a hardware driver; the reference when it is a
+    /// software rasterizer (llvmpipe, softpipe, SwiftShader), when no context can be made, and
+    /// for `.pfm`, `--depth16` and `--sort view-depth` (more than 8 bits, a view-depth sort).
+    /// `-v` says which and why.
     Auto,
-    /// OpenGL ES 3 through headless EGL (Mesa surfaceless or a GPU driver).
+    /// OpenGL ES 3 through headless EGL (Mesa surfaceless or a GPU driver); 8-bit output
+    /// only (.pfm and --depth16 are refused rather than quantized).
     Gl,
     /// The CPU reference rasterizer (normative math, slow but exact).
     Reference,
@@ -48,12 +52,17 @@ pub struct Args {
     pub scene: Option<PathBuf>,
     #[command(flatten)]
     pub cam: super::camera_args::CameraArgs,
-    /// Highest SH degree to evaluate (the file's degree caps it).
+    /// Highest SH degree to evaluate, 0..=3 (the file's degree caps it).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=3))]
     pub sh_degree: u8,
-    /// Background colour as it appears in the output image (display values, 0..1; for
+    /// Background colour as it appears in the output image (display values in [0, 1]; for
     /// lin_rec709_display clouds it is decoded before blending so it comes out unchanged).
-    #[arg(long, default_value = "0,0,0", value_name = "r,g,b")]
+    #[arg(
+        long,
+        default_value = "0,0,0",
+        value_name = "r,g,b",
+        allow_hyphen_values = true
+    )]
     pub background: String,
     /// Blending order.
     #[arg(long, value_enum, default_value_t = SortArg::Distance)]
@@ -61,110 +70,228 @@ pub struct Args {
     /// Renderer.
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     pub backend: Backend,
-    /// Framebuffer the GL backend blends in.
-    #[arg(long, value_enum, default_value_t = TargetArg::Rgba8)]
-    pub target: TargetArg,
-    /// Output: .png (8-bit, or 16-bit with --depth16) or .pfm (32-bit float RGB).
-    #[arg(short, long, default_value = "out.png")]
-    pub output: PathBuf,
-    /// Write a 16-bit PNG.
+    /// Framebuffer the GL backend blends in (default rgba8; asks auto for GL; an error with
+    /// --backend reference).
+    #[arg(long, value_enum)]
+    pub target: Option<TargetArg>,
+    /// Output: .png (8-bit, or 16-bit with --depth16), .pfm (32-bit float RGB) or - (PNG on
+    /// stdout). Default out.png; for a batch (--view all, --gltf-camera all, --orbit) the
+    /// name must hold {index}, default out_{index}.png.
+    #[arg(short, long, value_name = "FILE", allow_hyphen_values = true)]
+    pub output: Option<PathBuf>,
+    /// Overwrite output files that exist.
+    #[arg(short, long)]
+    pub force: bool,
+    /// Write a 16-bit PNG (reference backend).
     #[arg(long)]
     pub depth16: bool,
     /// Keep alpha (1 − T): RGBA PNG; for .pfm also writes NAME.alpha.pfm.
     #[arg(long)]
     pub alpha: bool,
+    /// Render N frames on a circle around the framing pivot (the focus of the view: the
+    /// content's centre, or the --look-at target), about the --up axis, frame 0 the view
+    /// itself; writes -o's {index} pattern.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=3600))]
+    #[arg(conflicts_with_all = ["camera", "gltf_camera"])]
+    pub orbit: Option<u32>,
+    /// Print only errors (no camera line, summary, warnings or progress).
+    #[arg(short, long, conflicts_with_all = ["verbose", "progress"])]
+    pub quiet: bool,
+    /// Also say which backend was chosen and why.
+    #[arg(short, long)]
+    pub verbose: bool,
+    /// Show progress even when stderr is not a terminal (one line per step).
+    #[arg(long)]
+    pub progress: bool,
     #[command(flatten)]
     pub load: super::LoadArgs,
 }
 
-/// The view (see [`splatgl::camera::ViewOptions::camera`]) and the distance to print its
-/// target at.
-fn camera(a: &Args, scene: SceneView<'_>) -> Result<(Camera, f32), String> {
+impl Args {
+    /// The files read: the scene and the cameras.json (never written over).
+    fn inputs(&self) -> Vec<&Path> {
+        self.scene
+            .iter()
+            .chain(&self.cam.camera)
+            .map(PathBuf::as_path)
+            .collect()
+    }
+
+    fn batch(&self) -> bool {
+        self.orbit.is_some()
+            || self.cam.view == Some(Pick::All)
+            || self.cam.gltf_camera == Some(Pick::All)
+    }
+
+    fn wanted(&self, kind: Kind) -> Wanted {
+        Wanted {
+            backend: self.backend,
+            target: self.target,
+            float_output: kind == Kind::Pfm || self.depth16,
+            view_depth: self.sort == SortArg::ViewDepth,
+        }
+    }
+
+    /// The options that do not apply to the chosen view source, found before loading.
+    fn check_camera_options(&self) -> Result<(), String> {
+        let given = if self.cam.camera.is_some() {
+            Some("--camera")
+        } else if self.cam.gltf_camera.is_some() {
+            Some("--gltf-camera")
+        } else {
+            None
+        };
+        if let Some(src) = given {
+            if self.cam.up != super::camera_args::UpArg::Auto {
+                return Err(format!(
+                    "--up applies to automatic framing and --look-at; {src} gives the whole view"
+                ));
+            }
+            if self.cam.fov.is_some() {
+                return Err(format!(
+                    "--fov applies to automatic framing and --look-at; {src} gives the field of view"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The views to render, each with the distance to print its target at.
+fn views(a: &Args, scene: SceneView<'_>) -> Result<Vec<(Camera, f32)>, String> {
     let opts = splatgl::camera::ViewOptions {
         limits: a.load.options().limits,
         ..a.cam.options()?
     };
-    let cam = opts.camera(scene, (640, 480)).map_err(|e| e.to_string())?;
-    Ok((cam, opts.focus_distance(&cam, scene.cloud)))
-}
-
-fn write(img: &Image, a: &Args) -> Result<(), String> {
-    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("");
-    let r = match ext.to_ascii_lowercase().as_str() {
-        "png" => {
-            let depth = if a.depth16 {
-                PngDepth::Sixteen
-            } else {
-                PngDepth::Eight
-            };
-            img.write_png(&a.output, depth, a.alpha)
-        }
-        "pfm" => img.write_pfm(&a.output).and_then(|()| {
-            if a.alpha {
-                img.write_pfm_alpha(a.output.with_extension("alpha.pfm"))
-            } else {
-                Ok(())
-            }
-        }),
-        _ => {
+    let one = |o: &splatgl::camera::ViewOptions| -> Result<(Camera, f32), String> {
+        let cam = o.camera(scene, (640, 480)).map_err(|e| e.to_string())?;
+        Ok((cam, o.focus_distance(&cam, scene.cloud)))
+    };
+    let count = if a.cam.view == Some(Pick::All) {
+        let n = opts
+            .cameras_json_entries()
+            .map_err(|e| e.to_string())?
+            .len();
+        Some((n, "views", "cameras.json"))
+    } else if a.cam.gltf_camera == Some(Pick::All) {
+        Some((scene.cameras.len(), "camera nodes", "scene"))
+    } else {
+        None
+    };
+    if let Some((n, what, source)) = count {
+        if n == 0 {
             return Err(format!(
-                "{}: output must end in .png or .pfm",
-                a.output.display()
+                "--view all / --gltf-camera all: the {source} has no {what}"
             ));
         }
+        return (0..n)
+            .map(|i| {
+                let mut o = opts.clone();
+                if a.cam.view.is_some() {
+                    o.view = i;
+                } else {
+                    o.gltf_camera = Some(i);
+                }
+                one(&o)
+            })
+            .collect();
+    }
+    let (cam, distance) = one(&opts)?;
+    let Some(n) = a.orbit else {
+        return Ok(vec![(cam, distance)]);
     };
-    r.map_err(|e| e.to_string())
+    let up = opts
+        .look_at
+        .and_then(|l| l.up)
+        .unwrap_or_else(|| opts.up_for_scene(scene).vector())
+        .normalize();
+    Ok(orbit(&cam, distance, up, n))
 }
 
-/// Refuses outputs that would replace an input (the scene or the cameras.json), before any
-/// work is done.
-fn check_outputs(a: &Args) -> Result<(), String> {
-    let inputs: Vec<&Path> = a
-        .scene
-        .iter()
-        .chain(&a.cam.camera)
-        .map(PathBuf::as_path)
-        .collect();
-    let alpha = a.output.with_extension("alpha.pfm");
-    let mut outputs = vec![a.output.as_path()];
-    if a.alpha {
-        outputs.push(&alpha);
-    }
-    for out in outputs {
-        splatgl::write::refuse_overwriting_inputs(out, &inputs)
-            .map_err(|e| format!("{}: {e}", out.display()))?;
-    }
-    Ok(())
+/// `n` cameras on a circle around `cam`'s focus (`distance` ahead of its eye), about `up`,
+/// the first `cam` itself; intrinsics unchanged.
+pub fn orbit(cam: &Camera, distance: f32, up: glam::Vec3, n: u32) -> Vec<(Camera, f32)> {
+    let c2w = cam.world_to_camera.inverse();
+    let pivot = cam.eye() + c2w.transform_vector3(glam::Vec3::Z) * distance;
+    (0..n)
+        .map(|k| {
+            let angle = std::f32::consts::TAU * k as f32 / n as f32;
+            // Moving the world by the inverse rotation about the pivot turns the camera.
+            let turn = glam::Mat4::from_translation(pivot)
+                * glam::Mat4::from_axis_angle(up, angle)
+                * glam::Mat4::from_translation(-pivot);
+            let mut c = *cam;
+            c.world_to_camera = cam.world_to_camera * turn.inverse();
+            (c, distance)
+        })
+        .collect()
+}
+
+/// Everything that can be checked without the scene, before it is loaded: the outputs, the
+/// backend's options, the view options, the background.
+fn preflight(a: &Args) -> Result<(Outputs, Wanted, [f32; 3]), String> {
+    let out = Outputs::plan(
+        a.output.as_deref(),
+        a.batch(),
+        a.depth16,
+        a.alpha,
+        a.cam.print_camera_json,
+    )?;
+    let wanted = a.wanted(out.kind);
+    wanted.check()?;
+    a.check_camera_options()?;
+    let bg = background(&a.background)?;
+    let _ = a.cam.options()?; // --look-at syntax
+    out.check_files(1, &a.inputs(), a.force)?;
+    Ok((out, wanted, bg))
 }
 
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
-    check_outputs(a)?;
+    let batch = a.batch();
+    let (out, wanted, bg) = preflight(a)?;
+    let inputs = a.inputs();
+    let say = |s: String| {
+        if !a.quiet {
+            eprintln!("{s}");
+        }
+    };
+    let progress = Progress::new(a.quiet, a.progress);
+
     let (cloud, format, cameras) = match &a.scene {
         Some(p) => {
-            let s = load(p, a.load.options())?;
+            progress.stage(&format!("loading {}", p.display()));
+            let s = load(p, a)?;
+            progress.clear();
             (s.cloud, Some(s.report.format), s.cameras)
         }
         None => (splatgl::scene::default_scene(), None, Vec::new()),
     };
+    let file = a
+        .scene
+        .as_ref()
+        .map_or(String::new(), |p| p.display().to_string());
+    a.load.common.check_applies(&file, format)?;
     let scene = SceneView {
         cloud: &cloud,
         format,
         cameras: &cameras,
     };
-    let (cam, distance) = camera(a, scene)?;
-    // cameras.json sizes and derived sizes are bounded like the flags (an image is 16 bytes
-    // per pixel in f32).
-    if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
-        return Err(format!(
-            "image size {}x{} is outside 1..=16384 per side; give --width/--height",
-            cam.width, cam.height
-        ));
+    let views = views(a, scene)?;
+    for (cam, _) in &views {
+        // cameras.json sizes and derived sizes are bounded like the flags (an image is 16
+        // bytes per pixel in f32).
+        if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
+            return Err(format!(
+                "image size {}x{} is outside 1..=16384 per side; give --width/--height",
+                cam.width, cam.height
+            ));
+        }
     }
-    let bg = floats(&a.background, "--background", &[3])?;
+    out.check_files(views.len(), &inputs, a.force)?;
     let opts = RenderOptions {
         sh_degree: a.sh_degree,
-        background: [bg[0], bg[1], bg[2]],
+        background: bg,
         sort: match a.sort {
             SortArg::Distance => SortMode::Distance,
             SortArg::ViewDepth => SortMode::ViewDepth,
@@ -172,97 +299,84 @@ fn go(a: &Args) -> Result<(), String> {
         ..Default::default()
     };
     let t1 = Instant::now();
-    // Auto: GL unless the reference is the only backend that can honour the options (view-
-    // depth sorting) or no GL context can be made here.
-    let use_gl = match a.backend {
-        Backend::Gl => true,
-        Backend::Reference => false,
-        Backend::Auto => {
-            let exact_output = a.depth16
-                || a.output
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("pfm"));
-            a.sort == SortArg::Distance && !exact_output
-        }
-    };
-    let gl = if use_gl {
-        match render_gl(a, &cloud, &cam, &opts) {
-            Ok(img) => Some(img),
-            Err(e) if a.backend == Backend::Gl => return Err(format!("--backend gl: {e}")),
-            Err(e) => {
-                eprintln!("note: GL backend unavailable ({e}); using the reference rasterizer");
-                None
-            }
-        }
-    } else {
-        None
-    };
-    let (img, backend, visible) = match gl {
-        Some(img) => (img, "gl", None),
-        None => {
-            // As displayed (sRGB-encoded for lin_rec709_display): what the GL backend gives.
-            let space = cloud.meta.color_space.effective();
-            let (img, stats) = splatgl::reference::render_display(&cloud, &cam, &opts, space);
-            (img, "reference", Some(stats.visible))
-        }
-    };
-    let render_ms = t1.elapsed().as_secs_f64() * 1e3;
-    write(&img, a)?;
-    let visible = visible.map_or(String::new(), |v| format!(" ({v} visible)"));
-    eprintln!("camera: {}", look_at_line(&cam, distance));
-    if a.cam.print_camera_json {
-        println!("{}", camera_json_line(&cam));
+    let (mut engine, why) = wanted.engine(&cloud, &opts)?;
+    if a.verbose {
+        eprintln!("backend: {} ({why})", engine.name());
     }
-    eprintln!(
-        "splatgl render: {} splats{visible}, {}x{}, backend {backend}: render {render_ms:.1} ms, \
-         total {:.1} ms -> {}",
+    let mut visible = None;
+    let mut entries = Vec::new();
+    for (i, (cam, distance)) in views.iter().enumerate() {
+        if batch {
+            progress.step("rendering", i, views.len());
+        } else {
+            progress.stage("rendering");
+        }
+        let (img, v) = engine.render(&cloud, cam, &opts)?;
+        visible = v;
+        out.write(&img, i)?;
+        progress.clear();
+        let index = if batch {
+            format!("[{i}] ")
+        } else {
+            String::new()
+        };
+        say(format!("camera: {index}{}", look_at_line(cam, *distance)));
+        if a.cam.print_camera_json && !batch {
+            println!("{}", camera_json_line(cam));
+        } else if a.cam.print_camera_json {
+            let name = out
+                .path(i)
+                .and_then(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()));
+            entries.push(cam.to_3dgs_json(i as i64, &name.unwrap_or_default()));
+        }
+    }
+    if batch {
+        progress.step("rendering", views.len(), views.len());
+        progress.clear();
+        if a.cam.print_camera_json {
+            // One cameras.json for the batch: `--camera` on it with `--view all` renders it again.
+            println!("{}", serde_json::Value::Array(entries));
+        }
+    }
+    let render_ms = t1.elapsed().as_secs_f64() * 1e3;
+    let visible = match (visible, batch) {
+        (Some(v), false) => format!(" ({v} visible)"),
+        _ => String::new(),
+    };
+    let (w, h) = (views[0].0.width, views[0].0.height);
+    let target = if batch {
+        format!(
+            "{} images -> {} .. {}",
+            views.len(),
+            out.describe(0),
+            out.describe(views.len() - 1)
+        )
+    } else {
+        out.describe(0)
+    };
+    say(format!(
+        "splatgl render: {} splats{visible}, {w}x{h}, backend {}: render {render_ms:.1} ms, \
+         total {:.1} ms -> {target}",
         cloud.len(),
-        cam.width,
-        cam.height,
+        engine.name(),
         t0.elapsed().as_secs_f64() * 1e3,
-        a.output.display()
-    );
+    ));
     Ok(())
 }
 
-#[cfg(feature = "gl")]
-fn render_gl(
-    a: &Args,
-    cloud: &splatgl::SplatCloud,
-    cam: &Camera,
-    opts: &RenderOptions,
-) -> Result<Image, String> {
-    use splatgl::headless::{HeadlessOptions, TargetKind};
-    if a.sort != SortArg::Distance {
-        return Err("--sort view-depth is only implemented by --backend reference".into());
-    }
-    let o = HeadlessOptions {
-        target: match a.target {
-            TargetArg::Rgba8 => TargetKind::Rgba8,
-            TargetArg::Rgba16f => TargetKind::Rgba16fResolve,
-        },
-        background: opts.background,
-        sh_degree: Some(opts.sh_degree),
-        color_space: None,
-    };
-    splatgl::headless::render(cloud, cam, &o).map_err(|e| e.to_string())
-}
-
-#[cfg(not(feature = "gl"))]
-fn render_gl(
-    _a: &Args,
-    _cloud: &splatgl::SplatCloud,
-    _cam: &Camera,
-    _opts: &RenderOptions,
-) -> Result<Image, String> {
-    Err("this splatgl was built without the `gl` feature".into())
-}
-
-/// The scene file, parsed once (cloud and cameras); its findings go to stderr as warnings.
-fn load(p: &Path, opts: splatgl::load::LoadOptions) -> Result<Scene, String> {
-    let scene = splatgl::load::load_path(p, &opts).map_err(|e| e.to_string())?;
-    for w in scene.report.summarized_warnings() {
-        eprintln!("warning: {w}");
+/// The scene file, parsed once (cloud and cameras); its findings go to stderr as warnings
+/// (notes with `-v`).
+fn load(p: &Path, a: &Args) -> Result<Scene, String> {
+    let scene = splatgl::load::load_path(p, &a.load.options()).map_err(|e| e.to_string())?;
+    if !a.quiet {
+        for w in scene.report.summarized_warnings() {
+            eprintln!("warning: {w}");
+        }
+        if a.verbose {
+            for n in scene.report.summarized_notes() {
+                eprintln!("note: {n}");
+            }
+        }
     }
     Ok(scene)
 }

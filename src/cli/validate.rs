@@ -3,29 +3,54 @@ use std::process::ExitCode;
 
 /// Help of `validate --json`.
 pub const JSON_HELP: &str = "Print the findings as JSON (keys: file, format, status, valid, \
-    errors, warnings, splat_count, findings[{severity, path, message, index}])";
+    errors, warnings, unsupported, notes, splat_count, findings[{severity (error, unsupported, \
+    warning or info), path, message, index}])";
 
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
 pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
     let report = splatgl::load::validate::validate_path(&a.file, &opts);
+    if let Some(format) = report.format
+        && let Err(e) = a
+            .load
+            .common
+            .check_applies(&a.file.display().to_string(), Some(format))
+    {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if a.json {
         println!("{:#}", report.to_json(&a.file));
     } else {
-        for f in &report.findings {
-            println!("{f}");
+        if !a.quiet {
+            // Each line names the file, as `info` and `render` do in their errors.
+            for line in report.summarized() {
+                println!("{}: {line}", a.file.display());
+            }
         }
-        let verdict = match report.status() {
+        let status = report.status();
+        let verdict = match status {
             splatgl::load::validate::Status::Valid => "valid",
             splatgl::load::validate::Status::Invalid => "INVALID",
             splatgl::load::validate::Status::Unreadable => "UNREADABLE",
         };
-        println!(
-            "{}: {verdict} ({} errors, {} warnings)",
-            a.file.display(),
-            report.errors(),
-            report.warnings()
-        );
+        let mut counts = format!("{} errors, {} warnings", report.errors(), report.warnings());
+        for (n, what) in [
+            (report.unsupported(), "unsupported"),
+            (report.notes(), "notes"),
+        ] {
+            if n > 0 {
+                counts += &format!(", {n} {what}");
+            }
+        }
+        println!("{}: {verdict} ({counts})", a.file.display());
+        if report.unsupported() > 0 && status == splatgl::load::validate::Status::Valid && !a.quiet
+        {
+            println!(
+                "note: valid, but splatgl cannot decode it (the `unsupported` findings above); \
+                 exit status 0"
+            );
+        }
     }
     ExitCode::from(report.status() as u8)
 }

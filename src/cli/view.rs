@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use super::camera_args::{CameraArgs, floats};
+use super::camera_args::{CameraArgs, Pick, background};
 use super::render::TargetArg;
 use splatgl::camera::ViewOptions;
 
@@ -68,7 +68,12 @@ pub struct Args {
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=3))]
     pub sh_degree: u8,
     /// Background colour (display values, 0..1).
-    #[arg(long, default_value = "0,0,0", value_name = "r,g,b")]
+    #[arg(
+        long,
+        default_value = "0,0,0",
+        value_name = "r,g,b",
+        allow_hyphen_values = true
+    )]
     pub background: String,
     /// Render N frames (along one orbit with --orbit, else from the initial camera), print
     /// frame time min/median/p99, sort ms and the GL driver, and exit.
@@ -85,7 +90,12 @@ pub struct Args {
 }
 
 fn go(a: Args) -> Result<(), String> {
-    let bg = floats(&a.background, "--background", &[3])?;
+    let bg = background(&a.background)?;
+    if a.cam.view == Some(Pick::All) || a.cam.gltf_camera == Some(Pick::All) {
+        return Err(
+            "--view all / --gltf-camera all render one image per view: use `splatgl render`".into(),
+        );
+    }
     let default = splatgl::load::Limits::DEFAULT_MAX_SPLATS;
     let load = a
         .load
@@ -108,7 +118,7 @@ fn go(a: Args) -> Result<(), String> {
             TargetArg::Rgba16f => splatgl::viewer::TargetChoice::Float,
         },
         sh_degree: a.sh_degree,
-        background: [bg[0], bg[1], bg[2]],
+        background: bg,
         bench: a.bench_frames.map(|n| splatgl::viewer::Bench {
             frames: n as usize,
             orbit: a.orbit,

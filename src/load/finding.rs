@@ -10,16 +10,23 @@ use std::fmt;
 pub enum Severity {
     /// The file breaks a MUST of glTF 2.0 or of `KHR_gaussian_splatting` (RC).
     Error,
+    /// Valid as far as splatgl can tell, but splatgl cannot decode it (a required or
+    /// compression extension it does not implement, a superseded draft extension).
+    Unsupported,
     /// Allowed, but worth knowing (legacy draft data, unknown enum values, SHOULDs).
     Warning,
+    /// Normal, for the record (e.g. the unnormalised quaternions 3DGS trainers write).
+    Info,
 }
 
 impl Severity {
-    /// `"error"` or `"warning"`.
+    /// `"error"`, `"unsupported"`, `"warning"` or `"info"`.
     pub fn name(self) -> &'static str {
         match self {
             Severity::Error => "error",
+            Severity::Unsupported => "unsupported",
             Severity::Warning => "warning",
+            Severity::Info => "info",
         }
     }
 }
@@ -67,6 +74,20 @@ impl Finding {
             ..Finding::error(path, message)
         }
     }
+    /// Something splatgl cannot decode in an otherwise valid file; stops loading.
+    pub(crate) fn unsupported(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Finding {
+            severity: Severity::Unsupported,
+            ..Finding::fatal(path, message)
+        }
+    }
+    /// A note about something normal.
+    pub(crate) fn info(path: impl Into<String>, message: impl Into<String>) -> Self {
+        Finding {
+            severity: Severity::Info,
+            ..Finding::error(path, message)
+        }
+    }
     /// Sets the offending index.
     pub(crate) fn at(mut self, index: u64) -> Self {
         self.index = Some(index);
@@ -80,7 +101,8 @@ impl Finding {
                 "invalid per KHR_gaussian_splatting RC / glTF 2.0: {}",
                 self.message
             ),
-            Severity::Warning => self.message.clone(),
+            Severity::Unsupported => format!("not decodable by splatgl: {}", self.message),
+            Severity::Warning | Severity::Info => self.message.clone(),
         };
         let location = match self.index {
             Some(i) => format!("{} [index {i}]", self.path),

@@ -40,6 +40,9 @@ pub struct LoadReport {
     pub scale_space: Option<ScaleSeen>,
     /// Quaternions that were not unit length (within 1e-3) and were normalised.
     pub non_unit_quaternions: usize,
+    /// PLY opacity logits that were ±inf (read as opacity 1 or 0; NaN ones are dropped with
+    /// the splat, as a finding).
+    pub non_finite_opacities: usize,
     /// What the reader noticed, in file order. None of them stopped the load (a finding that
     /// does is the [`super::LoadError`]); `splatgl validate` lists the same findings.
     pub findings: Vec<Finding>,
@@ -54,6 +57,7 @@ impl LoadReport {
             format,
             scale_space: None,
             non_unit_quaternions: 0,
+            non_finite_opacities: 0,
             findings: Vec::new(),
             details: None,
         }
@@ -66,10 +70,22 @@ impl LoadReport {
     }
 
     /// The warnings for people: identical messages merged into one line naming the first
-    /// location and how many more there are, in first-seen order.
+    /// location and how many more there are, in first-seen order; without the
+    /// [`Severity::Info`](super::Severity::Info) notes ([`LoadReport::summarized_notes`]).
     pub fn summarized_warnings(&self) -> Vec<String> {
+        self.summarized(|s| s != super::Severity::Info)
+    }
+
+    /// The [`Severity::Info`](super::Severity::Info) notes, merged like
+    /// [`LoadReport::summarized_warnings`].
+    pub fn summarized_notes(&self) -> Vec<String> {
+        self.summarized(|s| s == super::Severity::Info)
+    }
+
+    fn summarized(&self, keep: impl Fn(super::Severity) -> bool) -> Vec<String> {
         finding::collapse(&self.findings)
             .into_iter()
+            .filter(|(f, _)| keep(f.severity))
             .map(|(f, n)| match n {
                 1 => f.warning_line(),
                 n => format!("{} (and {} more like it)", f.warning_line(), n - 1),

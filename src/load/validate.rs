@@ -11,7 +11,8 @@ use std::path::Path;
 /// Overall verdict; the process exit status of `splatgl validate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Status {
-    /// No errors (warnings allowed): exit 0.
+    /// No errors (warnings allowed; also when splatgl cannot decode the file:
+    /// [`Report::unsupported`] > 0): exit 0.
     Valid = 0,
     /// At least one error: exit 1.
     Invalid = 1,
@@ -52,7 +53,29 @@ impl Report {
     }
     /// Number of warnings.
     pub fn warnings(&self) -> usize {
-        self.findings.len() - self.errors()
+        self.count(Severity::Warning)
+    }
+    /// Number of [`Severity::Unsupported`] findings: valid, but splatgl cannot decode it.
+    pub fn unsupported(&self) -> usize {
+        self.count(Severity::Unsupported)
+    }
+    /// Number of [`Severity::Info`] notes.
+    pub fn notes(&self) -> usize {
+        self.count(Severity::Info)
+    }
+    fn count(&self, s: Severity) -> usize {
+        self.findings.iter().filter(|f| f.severity == s).count()
+    }
+    /// The findings for people: repeats of one message collapsed into its first finding
+    /// (`(and N more like it)`), in first-seen order.
+    pub fn summarized(&self) -> Vec<String> {
+        super::finding::collapse(&self.findings)
+            .into_iter()
+            .map(|(f, n)| match n {
+                1 => f.to_string(),
+                n => format!("{f} (and {} more like it)", n - 1),
+            })
+            .collect()
     }
     /// Machine-readable form (the `--json` output).
     pub fn to_json(&self, file: &Path) -> serde_json::Value {
@@ -67,6 +90,8 @@ impl Report {
             "valid": self.status() == Status::Valid,
             "errors": self.errors(),
             "warnings": self.warnings(),
+            "unsupported": self.unsupported(),
+            "notes": self.notes(),
             "splat_count": self.splat_count,
             "findings": self.findings.iter().map(|f| serde_json::json!({
                 "severity": f.severity.name(),
@@ -117,7 +142,11 @@ pub fn validate_bytes(bytes: &[u8], path: Option<&Path>, opts: &LoadOptions) -> 
                 load.findings.push(Finding::fatal("", e.to_string()));
             }
             Ok(w) => {
-                if w.splat_primitives == 0 {
+                let unsupported = load
+                    .findings
+                    .iter()
+                    .any(|f| f.severity == Severity::Unsupported);
+                if w.splat_primitives == 0 && !unsupported {
                     load.findings.push(Finding::fatal(
                         "meshes",
                         "no primitive uses KHR_gaussian_splatting",

@@ -45,6 +45,9 @@ pub(super) struct Shown {
     pub sh_degree: u8,
     pub cameras: Vec<GltfPerspective>,
     pub extent: Option<Extent>,
+    /// The part of the content default views fit to the image ([`crate::camera::FIT_SIGMAS`]
+    /// boxes); its centre is the pivot.
+    pub fit: Option<Extent>,
     pub orders: Orders,
     /// Generation of the order in the renderer's buffer.
     pub uploaded: Option<u64>,
@@ -213,14 +216,16 @@ impl App {
             .map_or(self.opts.view.fov_deg.to_radians(), |r| r.fov_y());
         let cam = Camera::frame_cloud(&l.cloud, up, fov, w, h)
             .ok_or("no splat that can be drawn, nothing to frame")?;
-        let focus = Extent::of_cloud(&l.cloud).map_or(1.0, |e| cam.focus_distance_to(e.centre()));
+        let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
+        let focus = fit.map_or(1.0, |e| cam.focus_distance_to(e.centre()));
         Ok((cam, focus))
     }
 
     /// Shows a loaded scene (or keeps the previous one when it cannot be shown).
     fn install(&mut self, el: &ActiveEventLoop, l: Loaded) {
         let name = l.name();
-        let up = self.opts.view.up_for(l.format);
+        let up = (self.opts.view.up)
+            .unwrap_or_else(|| crate::camera::UpAxis::for_cloud(l.format, &l.cloud));
         let (cam, focus) = match self.first_camera(&l, up) {
             Ok(c) => c,
             Err(e) if self.shown.is_none() => {
@@ -244,6 +249,7 @@ impl App {
             eprintln!("warning: {w}");
         }
         let extent = Extent::of_cloud(&l.cloud);
+        let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
         let rig = Rig::from_camera(&cam, focus, up.vector());
         self.controls.fly_speed = extent.map_or(1.0, |e| (0.5 * e.radius()).max(0.05));
         self.controls.stop();
@@ -267,6 +273,7 @@ impl App {
             sh_degree: l.cloud.sh_degree,
             cameras: l.cameras,
             extent,
+            fit,
             orders,
             uploaded: None,
             up,

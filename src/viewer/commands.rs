@@ -89,7 +89,7 @@ impl App {
         let (Some(s), Some(r)) = (&mut self.shown, &mut self.rig) else {
             return;
         };
-        let Some(extent) = s.extent else {
+        let (Some(extent), Some(fit)) = (s.extent, s.fit) else {
             return;
         };
         if next_up {
@@ -102,8 +102,8 @@ impl App {
         } else {
             r.forward()
         };
-        if let Some(cam) = Camera::frame_extent_along(&extent, fwd, up, r.fov_y(), w, h) {
-            *r = Rig::from_camera(&cam, (extent.centre() - cam.eye()).length(), up);
+        if let Some(cam) = Camera::frame_boxes_along(&fit, &extent, fwd, up, r.fov_y(), w, h) {
+            *r = Rig::from_camera(&cam, (fit.centre() - cam.eye()).length(), up);
             self.controls.stop();
         }
     }
@@ -133,7 +133,7 @@ impl App {
         };
         match cam {
             Ok(cam) => {
-                let focus = s.extent.map_or(1.0, |e| cam.focus_distance_to(e.centre()));
+                let focus = s.fit.map_or(1.0, |e| cam.focus_distance_to(e.centre()));
                 *r = Rig::from_camera(&cam, focus, s.up.vector());
                 self.controls.stop();
                 println!("camera: {what} of {}", ng + nj);

@@ -153,7 +153,7 @@ fn check_required_extensions(json: &Value, findings: &mut Vec<Finding>) {
                         "required extension {n:?} concerns materials, which splat rendering ignores"
                     ),
                 )),
-            Some(n) => findings.push(Finding::fatal(
+            Some(n) => findings.push(Finding::unsupported(
                 path,
                 format!("required extension {n:?} is not supported by splatgl"),
             )),

@@ -82,7 +82,7 @@ pub fn read(
             if name == super::spz::SPZ_2 {
                 // Read by the primitive reader (`spz.rs`).
             } else if name.to_ascii_lowercase().contains("compression") {
-                f.push(Finding::fatal(
+                f.push(Finding::unsupported(
                     ep,
                     format!("compression extension {name:?} is not supported (yet)"),
                 ));

@@ -149,7 +149,7 @@ fn decode_primitives(
                     k.as_str() != EXT && k.as_str() != spz::LEGACY && k.contains("gaussian_splats")
                 })
             }) {
-                findings.push(Finding::fatal(
+                findings.push(Finding::unsupported(
                     format!("{ppath}.extensions.{legacy}"),
                     format!("legacy draft extension {legacy:?} is not supported (re-export with KHR_gaussian_splatting)"),
                 ));

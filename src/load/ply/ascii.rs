@@ -1,7 +1,7 @@
 //! ASCII PLY bodies: one row per line, values parsed at their declared precision.
 
 use super::header::{Header, Scalar};
-use super::{Layout, PlyError, Unusable, convert_row};
+use super::{Layout, PlyError, RowNotes, Unusable, convert_row};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 
 /// Decodes the `vertex` rows (element `vi`) of an ASCII body; returns the cloud, the number of
@@ -11,7 +11,7 @@ pub(super) fn decode(
     vi: usize,
     l: &Layout,
     body: &[u8],
-) -> Result<(SplatCloud, usize, Unusable), PlyError> {
+) -> Result<(SplatCloud, RowNotes, Unusable), PlyError> {
     let vertex = &header.elements[vi];
     let text = std::str::from_utf8(body).map_err(|e| PlyError::Ascii {
         line: header.lines + 1,
@@ -45,7 +45,7 @@ pub(super) fn decode(
     let mut cloud = SplatCloud::with_capacity(l.sh_degree, n);
     let mut vals = vec![0.0f64; ncols];
     let mut sh = vec![[0.0f32; 3]; k];
-    let (mut non_unit, mut bad) = (0, Unusable::default());
+    let (mut notes, mut bad) = (RowNotes::default(), Unusable::default());
     for i in 0..n {
         let (ln, line) = lines.next().ok_or_else(|| PlyError::EndsEarly {
             element: "vertex".into(),
@@ -85,10 +85,10 @@ pub(super) fn decode(
             &mut sh,
         );
         match off {
-            Ok(off) => non_unit += off as usize,
+            Ok(flags) => notes.add(i, flags),
             Err(e) => bad.add(i, e),
         }
         cloud.push(p, s, r, o, &sh);
     }
-    Ok((cloud, non_unit, bad))
+    Ok((cloud, notes, bad))
 }

@@ -2,7 +2,7 @@
 //! `vertex` rows decoded in parallel blocks.
 
 use super::header::{Element, Property, Scalar};
-use super::{Layout, PlyError, Unusable, convert_row, fixed_rows_len};
+use super::{Layout, PlyError, RowNotes, Unusable, convert_row, fixed_rows_len};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 use rayon::prelude::*;
 
@@ -70,14 +70,14 @@ pub(super) fn skip_binary(before: &[Element], body: &[u8], be: bool) -> Result<u
 
 const BLOCK: usize = 4096;
 
-/// Decodes the `vertex` rows; returns the cloud, the number of non-unit quaternions and the
+/// Decodes the `vertex` rows; returns the cloud, what the rows showed ([`RowNotes`]) and the
 /// rows whose values cannot be used (left in the cloud for the caller to drop or fail on).
 pub(super) fn decode_binary(
     l: &Layout,
     props: &[Property],
     rows: &[u8],
     be: bool,
-) -> Result<(SplatCloud, usize, Unusable), PlyError> {
+) -> Result<(SplatCloud, RowNotes, Unusable), PlyError> {
     let n = rows.len().checked_div(l.stride).unwrap_or(0);
     let k = sh_coeff_count(l.sh_degree);
     let all_f32_le = !be && l.cols.iter().all(|&(_, t)| t == Scalar::F32);
@@ -92,7 +92,7 @@ pub(super) fn decode_binary(
     crate::files::advise_huge(&mut cloud.rotations);
     crate::files::advise_huge(&mut cloud.opacities);
     crate::files::advise_huge(&mut cloud.sh);
-    let results: Vec<(usize, Unusable)> = cloud
+    let results: Vec<(RowNotes, Unusable)> = cloud
         .positions
         .par_chunks_mut(BLOCK)
         .zip(cloud.scales.par_chunks_mut(BLOCK))
@@ -102,7 +102,7 @@ pub(super) fn decode_binary(
         .zip(rows.par_chunks(BLOCK * l.stride))
         .enumerate()
         .map(|(b, (((((p, s), r), o), sh), raw))| {
-            let (mut non_unit, mut bad) = (0, Unusable::default());
+            let (mut notes, mut bad) = (RowNotes::default(), Unusable::default());
             for i in 0..p.len() {
                 let row = &raw[i * l.stride..(i + 1) * l.stride];
                 let out = (&mut p[i], &mut s[i], &mut r[i], &mut o[i]);
@@ -125,20 +125,20 @@ pub(super) fn decode_binary(
                     convert_row(l, props, index, get, out.0, out.1, out.2, out.3, sh)
                 };
                 match off {
-                    Ok(off) => non_unit += off as usize,
+                    Ok(flags) => notes.add(index, flags),
                     Err(e) => bad.add(index, e),
                 }
             }
             // Each row is read once: a mapped file's pages of this block leave the resident
             // set now, so peak memory is the cloud plus the blocks in flight.
             crate::files::release_consumed(raw);
-            (non_unit, bad)
+            (notes, bad)
         })
         .collect();
-    let (mut non_unit, mut bad) = (0, Unusable::default());
+    let (mut notes, mut bad) = (RowNotes::default(), Unusable::default());
     for (n, b) in results {
-        non_unit += n;
+        notes.merge(n);
         bad.extend(b);
     }
-    Ok((cloud, non_unit, bad))
+    Ok((cloud, notes, bad))
 }

@@ -203,8 +203,42 @@ fn sigmoid(x: f64) -> f64 {
     }
 }
 
+/// [`convert_row`]'s result flag: the quaternion was not unit length.
+pub(super) const NON_UNIT: u8 = 1;
+/// [`convert_row`]'s result flag: the opacity logit was ±inf (read as opacity 1 or 0).
+pub(super) const INF_OPACITY: u8 = 2;
+
+/// What [`convert_row`] noticed over many rows: counts of its flags, and the first row with
+/// an infinite opacity logit.
+#[derive(Debug, Default, Clone, Copy)]
+pub(super) struct RowNotes {
+    /// Quaternions that were not unit length.
+    pub non_unit: usize,
+    /// Opacity logits that were ±inf.
+    pub inf_opacity: usize,
+    /// The first row with one.
+    pub first_inf: Option<usize>,
+}
+
+impl RowNotes {
+    /// Counts row `index`'s flags (rows in ascending order).
+    pub fn add(&mut self, index: usize, flags: u8) {
+        self.non_unit += (flags & NON_UNIT != 0) as usize;
+        if flags & INF_OPACITY != 0 {
+            self.inf_opacity += 1;
+            self.first_inf.get_or_insert(index);
+        }
+    }
+    /// Adds the notes of later rows.
+    pub fn merge(&mut self, later: RowNotes) {
+        self.non_unit += later.non_unit;
+        self.inf_opacity += later.inf_opacity;
+        self.first_inf = self.first_inf.or(later.first_inf);
+    }
+}
+
 /// Converts one row (read through `get(column)`) into the outputs of splat `index`.
-/// Returns whether the quaternion was not unit length.
+/// Returns [`NON_UNIT`] and [`INF_OPACITY`] flags.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn convert_row(
@@ -217,7 +251,7 @@ fn convert_row(
     rot: &mut [f32; 4],
     opacity: &mut f32,
     sh: &mut [[f32; 3]],
-) -> Result<bool, PlyError> {
+) -> Result<u8, PlyError> {
     let bad = |col: usize, message: &str| PlyError::Value {
         index,
         property: names[col].name.clone(),
@@ -276,11 +310,12 @@ fn convert_row(
         return Err(bad(l.opacity, "opacity logit is NaN"));
     }
     *opacity = sigmoid(o) as f32;
+    let inf = if o.is_infinite() { INF_OPACITY } else { 0 };
     let q = [get(l.rot[1]), get(l.rot[2]), get(l.rot[3]), get(l.rot[0])].map(|v| v as f32);
     match super::normalize_quat(q) {
         Some((q, off)) => {
             *rot = q;
-            Ok(off)
+            Ok(inf | if off { NON_UNIT } else { 0 })
         }
         None => Err(bad(l.rot[0], "quaternion is zero or not finite")),
     }
@@ -371,7 +406,7 @@ pub(crate) fn read(
     }
     let l = layout(vertex)?;
 
-    let (mut cloud, non_unit, bad) = match header.encoding {
+    let (mut cloud, notes, bad) = match header.encoding {
         Encoding::Ascii => ascii::decode(&header, vi, &l, body)?,
         enc => {
             let start = skip_binary(&header.elements[..vi], body, enc == Encoding::Be)?;
@@ -395,13 +430,26 @@ pub(crate) fn read(
         }
     };
     bad.settle(&mut cloud, opts.strict, &mut report.findings)?;
+    let non_unit = notes.non_unit;
+    if let Some(first) = notes.first_inf {
+        let n = notes.inf_opacity;
+        report.findings.push(
+            Finding::warning(
+                "vertex.opacity",
+                format!("{n} opacity logits are ±inf (non-finite; read as opacity 1 or 0)"),
+            )
+            .at(first as u64),
+        );
+    }
     if non_unit > 0 {
-        report.findings.push(Finding::warning(
+        // Normal for trained output (3DGS trainers store raw, unnormalised quaternions).
+        report.findings.push(Finding::info(
             "vertex.rot_0..3",
             format!("{non_unit} quaternions were not unit length and were normalised"),
         ));
     }
     report.non_unit_quaternions = non_unit;
+    report.non_finite_opacities = notes.inf_opacity;
     Ok(cloud)
 }
 
