@@ -53,7 +53,7 @@ impl FileBytes {
     }
 }
 
-/// A live mapping, registered so that [`release_consumed`] knows which byte ranges it may
+/// A live mapping, registered so that `release_consumed` knows which byte ranges it may
 /// advise; unregistered when dropped.
 #[derive(Debug)]
 pub struct Mapping {

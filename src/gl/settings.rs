@@ -32,9 +32,9 @@ impl DepthFunc {
     }
 }
 
-/// Per-draw settings: the renderer's own ([`SplatRenderer::settings_mut`], used by
-/// [`SplatRenderer::draw`] and [`SplatRenderer::set_order`]) or given for one draw
-/// ([`SplatRenderer::draw_current_with`]).
+/// Per-draw settings: the renderer's own ([`SplatRenderer::settings_mut`](super::SplatRenderer::settings_mut), used by
+/// [`SplatRenderer::draw`](super::SplatRenderer::draw) and [`SplatRenderer::set_order`](super::SplatRenderer::set_order)) or given for one draw
+/// ([`SplatRenderer::draw_current_with`](super::SplatRenderer::draw_current_with)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DrawSettings {
     /// SH degree to evaluate (clamped to the cloud's degree); `None` = the cloud's degree.
@@ -50,7 +50,7 @@ pub struct DrawSettings {
     /// [`super::state`].
     pub restore_state: bool,
     /// The colour space to draw as (`None` = the uploaded cloud's): decides
-    /// `GL_FRAMEBUFFER_SRGB` where it can be switched (see [`SplatRenderer`]).
+    /// `GL_FRAMEBUFFER_SRGB` where it can be switched (see [`SplatRenderer`](super::SplatRenderer)).
     pub color_space: Option<ColorSpace>,
 }
 
