@@ -46,7 +46,8 @@ enum Command {
     /// Compare two images (PNG/PFM): PSNR, max error, pixels over a threshold, heat-map.
     /// Exit status: 0 within --max-abs/--min-psnr, 1 outside, 2 on errors.
     Compare(compare::Args),
-    /// Convert a splat file to glTF (.glb/.gltf, KHR_gaussian_splatting RC) or INRIA PLY.
+    /// Convert a splat file to glTF (.glb/.gltf, KHR_gaussian_splatting RC; SPZ-compressed .glb
+    /// with --spz-compress), INRIA PLY, Niantic SPZ (.spz) or antimatter15 .splat.
     /// Exit status: 0, or 2 on any error.
     Convert(convert::Args),
     /// Open a window and fly through a scene (without a scene: the bundled default scene).
