@@ -125,6 +125,17 @@ fn trainer_quaternions_are_notes_not_warnings() {
     assert_eq!(v["notes"], 1, "{v}");
     let (_, quiet, _) = splatgl(&["info", "-q", &f]);
     assert!(!quiet.contains("not unit length"), "{quiet}");
+    // info --json keeps them apart from the warnings too.
+    let (_, json, _) = splatgl(&["info", "--json", &f]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let has = |key: &str| {
+        v[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|l| l.as_str().unwrap().contains("not unit length"))
+    };
+    assert!(has("notes") && !has("warnings"), "{v}");
     // render keeps it to -v.
     let d = dir("notes");
     let o = d.join("o.png");

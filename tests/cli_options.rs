@@ -303,3 +303,42 @@ fn a_bad_cameras_json_is_named_with_a_json_path() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn camera_options_that_would_be_ignored_or_overflow_are_errors() {
+    let d = dir("camera-ignored");
+    let s = ply(&d);
+    let out = d.join("o.png");
+    let o = out.to_str().unwrap();
+    let small = ["--width", "8", "--height", "8", "-o", o];
+    // Finite points whose difference overflows f32: no NaN camera reaches a renderer.
+    let far = ["render", &s, "--look-at", "-3e38,0,0,3e38,0,0"];
+    refused(
+        &[&far[..], &small[..]].concat(),
+        &["--look-at", "too far apart"],
+        &out,
+    );
+    // --up beside a look-at that gives its own up vector.
+    let up = ["render", &s, "--look-at", "0,0,5,0,0,0,0,1,0", "--up", "z"];
+    refused(
+        &[&up[..], &small[..]].concat(),
+        &["--up has no effect"],
+        &out,
+    );
+    // --fov for the default scene, whose camera is fixed.
+    refused(
+        &[&["render", "--fov", "30"][..], &small[..]].concat(),
+        &["--fov 30", "fixed camera"],
+        &out,
+    );
+    // …but with --up the default scene is framed with it.
+    let (code, _, err) =
+        splatgl(&[&["render", "--fov", "30", "--up", "y"][..], &small[..]].concat());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("--fov 30"), "{err}");
+    // -q has nothing to leave out of JSON.
+    let (code, _, err) = splatgl(&["info", "-q", "--json", &s]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--json"), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}

@@ -456,3 +456,24 @@ fn mapped_and_read_scene_files_load_the_same_cloud() {
     );
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn compare_reads_images_within_its_byte_limit() {
+    let d = dir("compare-limit");
+    let img = splatgl::image::Image {
+        width: 64,
+        height: 64,
+        pixels: (0..64 * 64)
+            .map(|i| [(i % 251) as f32 / 250.0, 0.5, 0.25, 1.0])
+            .collect(),
+    };
+    let p = d.join("a.pfm");
+    img.write_pfm(&p).unwrap();
+    let s = p.to_str().unwrap();
+    let (code, out) = splatgl(&["compare", s, s]);
+    assert_eq!(code, 0, "{out}");
+    let (code, out) = splatgl(&["compare", "--max-bytes", "1K", s, s]);
+    assert_eq!(code, 2, "{out}");
+    assert!(out.contains("more than the limit of 1024 bytes"), "{out}");
+    std::fs::remove_dir_all(&d).ok();
+}

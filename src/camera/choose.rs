@@ -114,11 +114,33 @@ impl ViewOptions {
     /// centre (of its [`FIT_SIGMAS`](super::FIT_SIGMAS) [`Extent`](super::Extent), which default
     /// views look at; [`Camera::focus_distance_to`]), else 1.
     pub fn focus_distance(&self, cam: &Camera, cloud: &SplatCloud) -> f32 {
+        self.focus_distance_in(cam, self.focus_extent(cloud).as_ref())
+    }
+
+    /// The content's extent [`ViewOptions::focus_distance_in`] measures against (`None` with
+    /// a --look-at, which gives its own target, or without drawable splats): computed once
+    /// for a batch of views.
+    pub fn focus_extent(&self, cloud: &SplatCloud) -> Option<super::Extent> {
+        match self.look_at {
+            Some(_) => None,
+            None => super::Extent::of_cloud_at(cloud, super::FIT_SIGMAS),
+        }
+    }
+
+    /// [`ViewOptions::focus_distance`] with the extent given (from
+    /// [`ViewOptions::focus_extent`]).
+    pub fn focus_distance_in(&self, cam: &Camera, extent: Option<&super::Extent>) -> f32 {
         if let Some(l) = &self.look_at {
             return (l.target - l.eye).length();
         }
-        super::Extent::of_cloud_at(cloud, super::FIT_SIGMAS)
-            .map_or(1.0, |e| cam.focus_distance_to(e.centre()))
+        extent.map_or(1.0, |e| cam.focus_distance_to(e.centre()))
+    }
+
+    /// The camera of one cameras.json entry, resized by the options' --width / --height.
+    pub fn camera_for_entry(&self, e: &CamerasJsonEntry) -> Result<Camera, CameraError> {
+        let cam = Camera::from_3dgs(e)?;
+        let (w, h) = self.size_or(cam.width, cam.height);
+        cam.resized(w, h).validated()
     }
 
     /// The view for `scene`. `default_size` is the image size when neither the options nor
@@ -145,9 +167,7 @@ impl ViewOptions {
                     list.len()
                 ))
             })?;
-            let cam = Camera::from_3dgs(e)?;
-            let (w, h) = self.size_or(cam.width, cam.height);
-            return Ok(cam.resized(w, h));
+            return self.camera_for_entry(e);
         }
         if let Some(n) = self.gltf_camera {
             if !matches!(scene.format, Some(Format::Gltf | Format::Glb)) {
@@ -175,18 +195,30 @@ impl ViewOptions {
         if let Some(l) = &self.look_at {
             let up = l.up.unwrap_or(up.vector());
             let fwd = l.target - l.eye;
-            if fwd.length() == 0.0 || fwd.cross(up).length() <= 1e-6 * fwd.length() * up.length() {
+            // `!(… > …)` also refuses NaN: finite points far apart overflow `fwd` to inf.
+            let side = fwd.cross(up).length();
+            if !(fwd.is_finite() && fwd.length() > 0.0 && side > 1e-6 * fwd.length() * up.length())
+            {
                 return Err(unavailable(
-                    "--look-at: eye = target, or up parallel to the view direction".into(),
+                    "--look-at: eye = target, up parallel to the view direction, or points too far apart for f32".into(),
                 ));
             }
-            return Ok(Camera::look_at(l.eye, l.target, up, fov, w, h));
+            return Camera::look_at(l.eye, l.target, up, fov, w, h).validated();
         }
         if scene.format.is_none() && self.up.is_none() {
             return Ok(crate::scene::default_camera(w, h));
         }
-        Camera::frame_cloud(scene.cloud, up, fov, w, h).ok_or_else(|| {
-            unavailable("the scene has no splat that can be drawn to frame; give --look-at".into())
-        })
+        Camera::frame_cloud(scene.cloud, up, fov, w, h)
+            .ok_or_else(|| {
+                unavailable(
+                    "the scene has no splat that can be drawn to frame; give --look-at".into(),
+                )
+            })?
+            .validated()
+            .map_err(|_| {
+                unavailable(
+                    "the scene's extent is too large to frame in f32 (positions near ±3.4e38); give --look-at".into(),
+                )
+            })
     }
 }

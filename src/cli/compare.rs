@@ -36,6 +36,10 @@ pub struct Args {
     /// Print nothing; the exit status says it.
     #[arg(short, long, conflicts_with = "json")]
     pub quiet: bool,
+    /// Most bytes read from each image file. Plain bytes or with a K, M or G suffix (powers
+    /// of 1024).
+    #[arg(long, value_name = "BYTES", default_value = "4G", value_parser = super::parse_bytes)]
+    pub max_bytes: u64,
 }
 
 /// Refuses a --diff file that cannot or should not be written, before the images are read.
@@ -73,8 +77,8 @@ fn go(a: &Args) -> Result<bool, String> {
     if let Some(path) = &a.diff {
         check_diff(a, path)?;
     }
-    let ia = Image::read(&a.a).map_err(|e| e.to_string())?;
-    let ib = Image::read(&a.b).map_err(|e| e.to_string())?;
+    let ia = Image::read_limited(&a.a, a.max_bytes).map_err(|e| e.to_string())?;
+    let ib = Image::read_limited(&a.b, a.max_bytes).map_err(|e| e.to_string())?;
     let c = compare(&ia, &ib, a.threshold).map_err(|e| e.to_string())?;
     if let Some(path) = &a.diff {
         let d = diff_image(&ia, &ib, a.diff_scale).map_err(|e| e.to_string())?;

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 /// Help of `info --json`.
 pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
     kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
-    non_unit_quaternions, non_finite_opacities, memory_bytes, warnings; for quantized containers also container, \
+    non_unit_quaternions, non_finite_opacities, memory_bytes, warnings, notes; for quantized containers also container, \
     container_version, compression, gltf_extension, quantization[{attribute, bits, encoding}], \
     lossy, antialiased — null otherwise; with -v also limits)";
 
@@ -43,6 +43,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "non_finite_opacities": r.non_finite_opacities,
         "memory_bytes": c.memory_bytes(),
         "warnings": r.warning_lines(),
+        "notes": r.note_lines(),
     });
     let details = r.details.as_ref();
     if let Some(obj) = info.as_object_mut() {

@@ -70,8 +70,9 @@ pub struct FileArgs {
     /// Also print the loader's limits (`limits` in JSON).
     #[arg(short, long)]
     pub verbose: bool,
-    /// Less text: `info` without warnings and notes, `validate` only its verdict line.
-    #[arg(short, long, conflicts_with = "verbose")]
+    /// Less text: `info` without warnings and notes, `validate` only its verdict line
+    /// (text output only: JSON is always whole).
+    #[arg(short, long, conflicts_with_all = ["verbose", "json"])]
     pub quiet: bool,
     #[command(flatten)]
     pub load: LoadArgs,
@@ -117,7 +118,7 @@ pub struct LoadCommonArgs {
 }
 
 /// `123`, `64K`, `512M`, `4G` (binary multiples).
-fn parse_bytes(s: &str) -> Result<u64, String> {
+pub(crate) fn parse_bytes(s: &str) -> Result<u64, String> {
     let (num, shift) = match s.char_indices().last() {
         Some((i, 'k' | 'K')) => (&s[..i], 10),
         Some((i, 'm' | 'M')) => (&s[..i], 20),
@@ -151,6 +152,8 @@ impl LoadCommonArgs {
                 max_bytes: self.max_bytes,
                 ..Limits::default()
             },
+            // The command maps scene files (SPLATGL_NO_MMAP=1: read them).
+            memory_map: true,
         }
     }
 }
@@ -164,18 +167,17 @@ impl LoadCommonArgs {
         format: Option<splatgl::load::Format>,
     ) -> Result<(), String> {
         use splatgl::load::Format;
-        let what = format.map_or("the bundled default scene (no file given)".into(), |f| {
-            format!("a {} file", f.name())
-        });
+        let what = format.map_or(
+            "no file was given (the bundled default scene)".into(),
+            |f| format!("{file} is a {} file", f.name()),
+        );
         let gltf = matches!(format, Some(Format::Gltf | Format::Glb));
         if self.scale_space.is_some() && !gltf {
-            return Err(format!(
-                "--scale-space applies to glTF scenes only; {file} is {what}"
-            ));
+            return Err(format!("--scale-space applies to glTF scenes only; {what}"));
         }
         if self.spz_axes.is_some() && !(gltf || format == Some(Format::Spz)) {
             return Err(format!(
-                "--spz-axes applies to .spz and glTF scenes only; {file} is {what}"
+                "--spz-axes applies to .spz and glTF scenes only; {what}"
             ));
         }
         Ok(())

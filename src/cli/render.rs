@@ -153,6 +153,24 @@ impl Args {
                 ));
             }
         }
+        let auto_up = self.cam.up == super::camera_args::UpArg::Auto;
+        let look_at_up = (self.cam.look_at.as_deref()).is_some_and(|l| l.split(',').count() == 9);
+        if !auto_up && look_at_up {
+            return Err(
+                "--up has no effect: --look-at gives its own up vector (its last three values)"
+                    .into(),
+            );
+        }
+        if self.scene.is_none()
+            && given.is_none()
+            && self.cam.look_at.is_none()
+            && auto_up
+            && let Some(fov) = self.cam.fov
+        {
+            return Err(format!(
+                "--fov {fov}: the bundled default scene has a fixed camera (40°); give --look-at, or --up to frame it automatically"
+            ));
+        }
         Ok(())
     }
 }
@@ -163,36 +181,42 @@ fn views(a: &Args, scene: SceneView<'_>) -> Result<Vec<(Camera, f32)>, String> {
         limits: a.load.options().limits,
         ..a.cam.options()?
     };
+    // One extent for every view of a batch (it walks the whole cloud).
+    let extent = opts.focus_extent(scene.cloud);
+    let focus = |cam: Camera| (cam, opts.focus_distance_in(&cam, extent.as_ref()));
     let one = |o: &splatgl::camera::ViewOptions| -> Result<(Camera, f32), String> {
-        let cam = o.camera(scene, (640, 480)).map_err(|e| e.to_string())?;
-        Ok((cam, o.focus_distance(&cam, scene.cloud)))
+        o.camera(scene, (640, 480))
+            .map(focus)
+            .map_err(|e| e.to_string())
     };
-    let count = if a.cam.view == Some(Pick::All) {
-        let n = opts
-            .cameras_json_entries()
-            .map_err(|e| e.to_string())?
-            .len();
-        Some((n, "views", "cameras.json"))
-    } else if a.cam.gltf_camera == Some(Pick::All) {
-        Some((scene.cameras.len(), "camera nodes", "scene"))
-    } else {
-        None
-    };
-    if let Some((n, what, source)) = count {
-        if n == 0 {
-            return Err(format!(
-                "--view all / --gltf-camera all: the {source} has no {what}"
-            ));
+    if a.cam.view == Some(Pick::All) {
+        // The cameras.json is read and parsed once, however many views it holds.
+        let entries = opts.cameras_json_entries().map_err(|e| e.to_string())?;
+        let file = a.cam.camera.as_deref().unwrap_or(Path::new("cameras.json"));
+        if entries.is_empty() {
+            return Err(format!("--view all: {} has no views", file.display()));
         }
-        return (0..n)
+        return entries
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                opts.camera_for_entry(e)
+                    .map(focus)
+                    .map_err(|err| format!("--view all: {} view {i}: {err}", file.display()))
+            })
+            .collect();
+    }
+    if a.cam.gltf_camera == Some(Pick::All) {
+        if scene.cameras.is_empty() {
+            return Err("--gltf-camera all: the scene has no perspective camera nodes".into());
+        }
+        return (0..scene.cameras.len())
             .map(|i| {
-                let mut o = opts.clone();
-                if a.cam.view.is_some() {
-                    o.view = i;
-                } else {
-                    o.gltf_camera = Some(i);
-                }
-                one(&o)
+                let o = splatgl::camera::ViewOptions {
+                    gltf_camera: Some(i),
+                    ..opts.clone()
+                };
+                one(&o).map_err(|err| format!("--gltf-camera all: camera {i}: {err}"))
             })
             .collect();
     }
@@ -240,6 +264,10 @@ fn preflight(a: &Args) -> Result<(Outputs, Wanted, [f32; 3]), String> {
     let wanted = a.wanted(out.kind);
     wanted.check()?;
     a.check_camera_options()?;
+    if a.scene.is_none() {
+        // The default scene's format is known before anything is loaded.
+        a.load.common.check_applies("", None)?;
+    }
     let bg = background(&a.background)?;
     let _ = a.cam.options()?; // --look-at syntax
     out.check_files(1, &a.inputs(), a.force)?;
@@ -261,8 +289,7 @@ fn go(a: &Args) -> Result<(), String> {
     let (cloud, format, cameras) = match &a.scene {
         Some(p) => {
             progress.stage(&format!("loading {}", p.display()));
-            let s = load(p, a)?;
-            progress.clear();
+            let s = load(p, a, progress)?;
             (s.cloud, Some(s.report.format), s.cameras)
         }
         None => (splatgl::scene::default_scene(), None, Vec::new()),
@@ -366,8 +393,12 @@ fn go(a: &Args) -> Result<(), String> {
 
 /// The scene file, parsed once (cloud and cameras); its findings go to stderr as warnings
 /// (notes with `-v`).
-fn load(p: &Path, a: &Args) -> Result<Scene, String> {
-    let scene = splatgl::load::load_path(p, &a.load.options()).map_err(|e| e.to_string())?;
+/// Loads the scene and prints its warnings (notes with `-v`), the progress line cleared
+/// first, also on an error.
+fn load(p: &Path, a: &Args, progress: Progress) -> Result<Scene, String> {
+    let scene = splatgl::load::load_path(p, &a.load.options());
+    progress.clear();
+    let scene = scene.map_err(|e| e.to_string())?;
     if !a.quiet {
         for w in scene.report.summarized_warnings() {
             eprintln!("warning: {w}");

@@ -4,7 +4,7 @@ use std::process::ExitCode;
 /// Help of `validate --json`.
 pub const JSON_HELP: &str = "Print the findings as JSON (keys: file, format, status, valid, \
     errors, warnings, unsupported, notes, splat_count, findings[{severity (error, unsupported, \
-    warning or info), path, message, index}])";
+    warning or info), path, message, index}]; with -v also limits)";
 
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
 pub fn run(a: super::FileArgs) -> ExitCode {
@@ -20,7 +20,14 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     if a.json {
-        println!("{:#}", report.to_json(&a.file));
+        let mut json = report.to_json(&a.file);
+        if a.verbose {
+            let map: serde_json::Map<_, _> = (opts.limits.entries().iter())
+                .map(|&(k, v)| (k.to_owned(), serde_json::json!(v)))
+                .collect();
+            json["limits"] = serde_json::Value::Object(map);
+        }
+        println!("{json:#}");
     } else {
         if !a.quiet {
             // Each line names the file, as `info` and `render` do in their errors.
@@ -44,6 +51,12 @@ pub fn run(a: super::FileArgs) -> ExitCode {
             }
         }
         println!("{}: {verdict} ({counts})", a.file.display());
+        if a.verbose {
+            println!("limits:");
+            for (k, v) in opts.limits.entries() {
+                println!("  {k:<24}{v}");
+            }
+        }
         if report.unsupported() > 0 && status == splatgl::load::validate::Status::Valid && !a.quiet
         {
             println!(

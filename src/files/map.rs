@@ -16,8 +16,9 @@
 //! mapping (an owned buffer would be zeroed by `MADV_DONTNEED`, so it is never advised).
 //!
 //! A file truncated by another process while it is mapped makes the reading thread fault
-//! (`SIGBUS`): the usual trade of every mapping reader (ripgrep, plyfile's `mmap=True`).
-//! Set `SPLATGL_NO_MMAP=1` to read into memory instead.
+//! (`SIGBUS`): the usual trade of every mapping reader (ripgrep, plyfile's `mmap=True`). So
+//! the library maps only when asked (`LoadOptions::memory_map`; the `splatgl` command asks),
+//! and `SPLATGL_NO_MMAP=1` reads into memory even then.
 
 use std::io::{self, Read};
 use std::ops::Deref;
@@ -120,8 +121,21 @@ pub fn map_bounded(path: &Path, limit: u64, what: &str) -> io::Result<FileBytes>
         ));
     }
     // Sequential read-ahead: the decoders walk the file front to back (in parallel blocks).
+    #[cfg(unix)]
     let _ = map.advise(memmap2::Advice::Sequential);
     Ok(FileBytes::Mapped(Mapping::new(map)))
+}
+
+/// [`map_bounded`] when `map` is set, else the same checks and [`super::read_bounded`]'s
+/// read into memory (`-`: standard input either way).
+pub fn read_file_bytes(path: &Path, limit: u64, what: &str, map: bool) -> io::Result<FileBytes> {
+    if map {
+        map_bounded(path, limit, what)
+    } else if path.as_os_str() == "-" {
+        read_stdin_bounded(limit, what).map(FileBytes::Read)
+    } else {
+        super::read_bounded(path, limit, what).map(FileBytes::Read)
+    }
 }
 
 /// Reads standard input up to `limit` bytes; more is an error naming `what`.
@@ -159,19 +173,48 @@ pub(crate) fn release_consumed(bytes: &[u8]) {
     if !inside {
         return;
     }
-    if let Some((first, last)) = whole_pages(start, end) {
-        // SAFETY: [first, last) lies within a live read-only private file mapping (checked
-        // above under the registry's lock ordering: a mapping is unregistered before it is
-        // unmapped, and the caller's borrow of `bytes` keeps it alive); DONTNEED on such a
-        // mapping only drops pages that a later access re-reads from the file.
+    // SAFETY: [start, end) lies within a live read-only private file mapping (checked above
+    // under the registry's lock; a mapping is unregistered before it is unmapped, and the
+    // caller's borrow of `bytes` keeps it alive); DONTNEED on such a mapping only drops pages
+    // that a later access re-reads from the file.
+    unsafe { advise_pages(start, end, PageAdvice::DontNeed) }
+}
+
+/// What [`advise_pages`] tells the kernel.
+#[derive(Debug, Clone, Copy)]
+enum PageAdvice {
+    /// `MADV_DONTNEED` (unix).
+    DontNeed,
+    /// `MADV_HUGEPAGE` (Linux).
+    HugePage,
+}
+
+/// `madvise` on the whole pages of `[start, end)`; a no-op where the advice does not exist
+/// (no `madvise` off unix, no huge pages off Linux).
+///
+/// # Safety
+/// The range must lie in memory the caller owns or a live mapping, and the advice must not
+/// lose data the caller will read (`DontNeed` only on read-only file mappings).
+unsafe fn advise_pages(start: usize, end: usize, advice: PageAdvice) {
+    let Some((first, last)) = whole_pages(start, end) else {
+        return;
+    };
+    #[cfg(unix)]
+    {
+        let flag = match advice {
+            PageAdvice::DontNeed => libc::MADV_DONTNEED,
+            #[cfg(target_os = "linux")]
+            PageAdvice::HugePage => libc::MADV_HUGEPAGE,
+            #[cfg(not(target_os = "linux"))]
+            PageAdvice::HugePage => return,
+        };
+        // SAFETY: per this function's contract.
         unsafe {
-            libc::madvise(
-                first as *mut libc::c_void,
-                last - first,
-                libc::MADV_DONTNEED,
-            );
+            libc::madvise(first as *mut libc::c_void, last - first, flag);
         }
     }
+    #[cfg(not(unix))]
+    let _ = (first, last, advice);
 }
 
 /// The whole pages inside the address range `[start, end)`, if any.
@@ -182,30 +225,28 @@ fn whole_pages(start: usize, end: usize) -> Option<(usize, usize)> {
 }
 
 fn page_size() -> usize {
-    // SAFETY: sysconf has no preconditions.
-    let p = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
-    if p > 0 { p as usize } else { 4096 }
+    #[cfg(unix)]
+    {
+        // SAFETY: sysconf has no preconditions.
+        let p = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+        if p > 0 {
+            return p as usize;
+        }
+    }
+    4096
 }
 
 /// Asks for transparent huge pages on a large, freshly allocated output array before it is
 /// filled (`MADV_HUGEPAGE`): 512× fewer page faults where the kernel's THP mode is `madvise`
-/// (the default on Debian and Ubuntu); no effect where THP is off or `always`.
+/// (the default on Debian and Ubuntu); no effect where THP is off or `always`, nor off Linux.
 pub(crate) fn advise_huge<T>(v: &mut [T]) {
     let bytes = std::mem::size_of_val(v);
     if bytes < (4 << 20) {
         return;
     }
     let start = v.as_mut_ptr() as usize;
-    if let Some((first, last)) = whole_pages(start, start + bytes) {
-        // SAFETY: the range lies inside `v`'s allocation; MADV_HUGEPAGE changes no contents.
-        unsafe {
-            libc::madvise(
-                first as *mut libc::c_void,
-                last - first,
-                libc::MADV_HUGEPAGE,
-            );
-        }
-    }
+    // SAFETY: the range lies inside `v`'s allocation; MADV_HUGEPAGE changes no contents.
+    unsafe { advise_pages(start, start + bytes, PageAdvice::HugePage) }
 }
 
 #[cfg(test)]
@@ -229,6 +270,40 @@ mod tests {
         assert_eq!(&m[..], &data[..]);
         release_consumed(&m[100..900_000]);
         assert_eq!(&m[..], &data[..], "a released page reads the file again");
+    }
+
+    /// The process's resident file-backed memory in bytes (Linux).
+    #[cfg(target_os = "linux")]
+    fn rss_file_bytes() -> u64 {
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let line = status.lines().find(|l| l.starts_with("RssFile:")).unwrap();
+        let kb: u64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+        kb * 1024
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn released_pages_leave_the_resident_set() {
+        const MB: usize = 1 << 20;
+        let data: Vec<u8> = (0..48 * MB).map(|i| (i % 253) as u8).collect();
+        let p = temp_file("resident.bin", &data);
+        drop(data);
+        let m = map_bounded(&p, 1 << 30, "the scene file").unwrap();
+        let before = rss_file_bytes();
+        let sum: u64 = m.iter().step_by(4096).map(|&b| b as u64).sum();
+        assert!(sum > 0);
+        let touched = rss_file_bytes();
+        assert!(
+            touched >= before + 40 * MB as u64,
+            "touching 48 MB of the mapping: {before} → {touched} bytes resident"
+        );
+        release_consumed(&m);
+        let released = rss_file_bytes();
+        assert!(
+            released + 40 * MB as u64 <= touched,
+            "after release_consumed: {touched} → {released} bytes resident"
+        );
+        std::fs::remove_file(&p).ok();
     }
 
     #[test]

@@ -20,7 +20,7 @@
 //! first, then the size against the limit before mapping), used for scene files (`map.rs`).
 
 mod map;
-pub use map::{FileBytes, Mapping, NO_MMAP_ENV, map_bounded, read_stdin_bounded};
+pub use map::{FileBytes, Mapping, NO_MMAP_ENV, map_bounded, read_file_bytes, read_stdin_bounded};
 pub(crate) use map::{advise_huge, release_consumed};
 
 use std::fs::File;

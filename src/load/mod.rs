@@ -93,6 +93,13 @@ pub struct LoadOptions {
     pub resolver: Option<Resolver>,
     /// Resource limits.
     pub limits: Limits,
+    /// [`load_path`] and [`validate::validate_path`] memory-map the file instead of reading
+    /// it ([`crate::files::map_bounded`]: no copy of the file, peak memory the cloud plus a
+    /// few blocks for binary PLY). Off by default in the library: a file that another process
+    /// truncates while it is mapped kills the reading process with `SIGBUS`, which an
+    /// embedding application may not accept. The `splatgl` command turns it on
+    /// (`SPLATGL_NO_MMAP=1` turns it off again).
+    pub memory_map: bool,
 }
 
 impl std::fmt::Debug for LoadOptions {
@@ -104,6 +111,7 @@ impl std::fmt::Debug for LoadOptions {
             .field("allow_outside_paths", &self.allow_outside_paths)
             .field("resolver", &self.resolver.as_ref().map(|_| "Fn(&str)"))
             .field("limits", &self.limits)
+            .field("memory_map", &self.memory_map)
             .finish()
     }
 }
@@ -211,17 +219,21 @@ pub fn load_path(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, Lo
     load_bytes(&bytes, Some(path), opts)
 }
 
-/// Reads a scene file: a regular file within `limits.max_bytes`, memory-mapped
-/// ([`crate::files::map_bounded`]; `-` reads standard input).
+/// Reads a scene file: a regular file within `limits.max_bytes`, memory-mapped with
+/// [`LoadOptions::memory_map`]; `-` reads standard input.
 pub(crate) fn read_scene_file(
     path: &Path,
     opts: &LoadOptions,
 ) -> Result<crate::files::FileBytes, LoadError> {
-    crate::files::map_bounded(path, opts.limits.max_bytes, "the scene file").map_err(|source| {
-        LoadError::Io {
-            path: path.to_owned(),
-            source,
-        }
+    crate::files::read_file_bytes(
+        path,
+        opts.limits.max_bytes,
+        "the scene file",
+        opts.memory_map,
+    )
+    .map_err(|source| LoadError::Io {
+        path: path.to_owned(),
+        source,
     })
 }
 

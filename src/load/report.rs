@@ -66,7 +66,22 @@ impl LoadReport {
     /// Every finding as one line ([`Finding::warning_line`]): the `warnings` of
     /// `splatgl info --json`.
     pub fn warning_lines(&self) -> Vec<String> {
-        self.findings.iter().map(Finding::warning_line).collect()
+        self.findings
+            .iter()
+            .filter(|f| f.severity != super::Severity::Info)
+            .map(Finding::warning_line)
+            .collect()
+    }
+
+    /// The [`Severity::Info`](super::Severity::Info) notes (normal trainer artefacts such as
+    /// non-unit quaternions), one line each in the form of [`LoadReport::warning_lines`]
+    /// (`info --json` key `notes`).
+    pub fn note_lines(&self) -> Vec<String> {
+        self.findings
+            .iter()
+            .filter(|f| f.severity == super::Severity::Info)
+            .map(Finding::warning_line)
+            .collect()
     }
 
     /// The warnings for people: identical messages merged into one line naming the first

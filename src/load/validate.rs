@@ -103,9 +103,10 @@ impl Report {
     }
 }
 
-/// Validates a file on disk (a regular file within `limits.max_bytes`, like `load_path`).
+/// Validates a file on disk (a regular file within `limits.max_bytes`, memory-mapped with
+/// [`LoadOptions::memory_map`], like `load_path`).
 pub fn validate_path(path: &Path, opts: &LoadOptions) -> Report {
-    match crate::files::map_bounded(path, opts.limits.max_bytes, "the file") {
+    match crate::files::read_file_bytes(path, opts.limits.max_bytes, "the file", opts.memory_map) {
         Ok(bytes) => validate_bytes(&bytes, Some(path), opts),
         Err(e) => Report {
             format: None,
