@@ -31,6 +31,11 @@ fn has_warning(l: &splatgl::load::Scene, needle: &str) -> bool {
     l.report.warning_lines().iter().any(|w| w.contains(needle))
 }
 
+/// Whether an `info`-level note (a normal trainer artefact) mentions `needle`.
+fn has_note(l: &splatgl::load::Scene, needle: &str) -> bool {
+    l.report.note_lines().iter().any(|w| w.contains(needle))
+}
+
 #[test]
 fn inria_ply_files() {
     if let Some(l) = load_ok("supersplat_fruit_drops_minimal_sh3.ply", 4721, 3) {
@@ -38,7 +43,8 @@ fn inria_ply_files() {
             l.report.non_unit_quaternions > 4000,
             "|q| ranges 0.60..1.93"
         );
-        assert!(has_warning(&l, "not unit length"));
+        assert!(has_note(&l, "not unit length"));
+        assert!(!has_warning(&l, "not unit length"), "a note, not a warning");
     }
     if let Some(l) = load_ok("mujoco_warp_fox_sh0.ply", 50_000, 0) {
         // +inf logits become opacity 1.

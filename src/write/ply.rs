@@ -1,6 +1,8 @@
 //! INRIA 3DGS PLY writer.
 
 use crate::cloud::SplatCloud;
+// The loader's own function: "decodes back exactly" is checked against what it computes.
+use crate::load::ply::sigmoid;
 
 /// Writes a cloud as INRIA binary little-endian PLY (log scale, logit opacity, w-first
 /// quaternion, channel-major `f_rest`) — the inverse of the
@@ -73,16 +75,6 @@ const SATURATED: f32 = 110.0;
 
 fn logit(o: f64) -> f64 {
     (o / (1.0 - o)).ln()
-}
-
-/// The PLY loader's sigmoid (f64).
-fn sigmoid(x: f64) -> f64 {
-    if x >= 0.0 {
-        1.0 / (1.0 + (-x).exp())
-    } else {
-        let e = x.exp();
-        e / (1.0 + e)
-    }
 }
 
 /// The f32 `x` near `inverse(v)` with `decode(x) as f32 == v`, searching ±64 ulps (nearest

@@ -194,7 +194,8 @@ fn layout(vertex: &Element) -> Result<Layout, PlyError> {
     })
 }
 
-fn sigmoid(x: f64) -> f64 {
+/// Logit → opacity, in f64 (the PLY writer inverts exactly this function).
+pub(crate) fn sigmoid(x: f64) -> f64 {
     if x >= 0.0 {
         1.0 / (1.0 + (-x).exp())
     } else {
