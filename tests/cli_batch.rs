@@ -2,20 +2,15 @@
 //! camera node), `--orbit N` (N frames around the framing pivot), the `{index}` output
 //! pattern, and progress output (absent when stderr is not a terminal or with `--quiet`).
 
+mod common;
+
 use splatgl::image::Image;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn splatgl_in(cwd: &Path, args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::cli::run_in(cwd, args);
+    (r.code, r.stderr)
 }
 
 fn dir(name: &str) -> PathBuf {

@@ -2,19 +2,13 @@
 //! splatgl* (`unsupported`) and collapses repeats; `info` and `validate` count non-finite
 //! values; trainer artefacts are notes, not warnings; `-q` and `-v`.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn splatgl(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::cli::run(args);
+    (r.code, r.out(), r.stderr)
 }
 
 fn real(name: &str) -> String {

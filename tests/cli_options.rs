@@ -3,19 +3,13 @@
 //! existing outputs without `-f`, float outputs from the 8-bit GL readback; and it writes PNG
 //! to stdout with `-o -`, says PASS/FAIL in `compare`, names the file of a bad cameras.json.
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::Command;
 
 fn splatgl(args: &[&str]) -> (i32, Vec<u8>, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        out.status.code().unwrap_or(-1),
-        out.stdout,
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::cli::run(args);
+    (r.code, r.stdout, r.stderr)
 }
 
 fn dir(name: &str) -> PathBuf {

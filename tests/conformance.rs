@@ -3,6 +3,8 @@
 //! runner's exit codes and causes, the Khronos glTF-Validator on every asset, and the HTML
 //! report in headless Chromium.
 
+mod common;
+
 use splatgl::conformance::manifest::Manifest;
 use splatgl::conformance::{Erratum, generate, model, render, runner};
 use splatgl::image::Image;
@@ -12,13 +14,8 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 fn splatgl(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(args)
-        .output()
-        .expect("runs");
-    let text =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    (out.status.code().unwrap_or(-1), text)
+    let r = common::cli::run(args);
+    (r.code, r.all())
 }
 
 fn tmp(name: &str) -> PathBuf {

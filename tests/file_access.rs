@@ -29,13 +29,8 @@ fn scene_with_uri(asset: &Path, uri: &str) -> (PathBuf, Vec<u8>) {
 }
 
 fn splatgl(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(args)
-        .output()
-        .expect("runs");
-    let text =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    (out.status.code().unwrap_or(-1), text)
+    let r = common::cli::run(args);
+    (r.code, r.all())
 }
 
 /// A folder `root` with `root/asset/` (the glTF's folder) and `root/outside.bin`.

@@ -87,14 +87,8 @@ fn writing_over_an_input_is_refused_through_any_name() {
 }
 
 fn splatgl(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::cli::run(args);
+    (r.code, r.stderr)
 }
 
 #[test]

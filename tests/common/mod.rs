@@ -1,6 +1,7 @@
 //! Shared test helpers: the seeded generator and random clouds (from `splatgl::scene`), the
 //! real-data folder, cameras and single-colour SH. The GL helpers (headless renderer, scores,
-//! error bounds) are in [`gl`]; test-side encoders of the packed formats in [`packed`].
+//! error bounds) are in [`gl`]; test-side encoders of the packed formats in [`packed`]; running
+//! the binary in [`cli`].
 #![allow(dead_code, unused_imports)]
 
 use glam::Vec3;
@@ -9,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 pub use splatgl::scene::{Rng, random_cloud};
 
+pub mod cli;
 #[cfg(feature = "gl")]
 pub mod gl;
 pub mod packed;
