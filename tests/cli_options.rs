@@ -336,3 +336,23 @@ fn camera_options_that_would_be_ignored_or_overflow_are_errors() {
     assert!(err.contains("--json"), "{err}");
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn every_orbit_frame_is_checked_before_the_first_is_rendered() {
+    let d = dir("orbit-exists");
+    let s = ply(&d);
+    let pattern = d.join("t_{index}.png");
+    std::fs::write(d.join("t_3.png"), b"keep").unwrap();
+    let args = [
+        "render", &s, "--orbit", "4", "--width", "8", "--height", "8",
+    ];
+    let (code, _, err) = splatgl(&[&args[..], &["-o", pattern.to_str().unwrap()]].concat());
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("t_3.png exists"), "{err}");
+    assert!(
+        !d.join("t_0.png").exists(),
+        "frame 0 was rendered before the check"
+    );
+    assert_eq!(std::fs::read(d.join("t_3.png")).unwrap(), b"keep");
+    std::fs::remove_dir_all(&d).ok();
+}

@@ -270,7 +270,8 @@ fn preflight(a: &Args) -> Result<(Outputs, Wanted, [f32; 3]), String> {
     }
     let bg = background(&a.background)?;
     let _ = a.cam.options()?; // --look-at syntax
-    out.check_files(1, &a.inputs(), a.force)?;
+    // An orbit's image count is known now; a --view / --gltf-camera batch's after loading.
+    out.check_files(a.orbit.map_or(1, |n| n as usize), &a.inputs(), a.force)?;
     Ok((out, wanted, bg))
 }
 

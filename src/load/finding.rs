@@ -5,8 +5,9 @@
 use std::collections::HashMap;
 use std::fmt;
 
-/// How bad a finding is.
+/// How bad a finding is (more may come: match with a wildcard arm).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[non_exhaustive]
 pub enum Severity {
     /// The file breaks a MUST of glTF 2.0 or of `KHR_gaussian_splatting` (RC).
     Error,
