@@ -308,22 +308,7 @@ fn apply(doc: &mut Value, bin: &mut [u8], e: &Edit) {
 fn serialize(mut doc: Value, bin: Vec<u8>, glb: bool) -> Vec<u8> {
     let b0 = doc.pointer_mut("/buffers/0").filter(|b| b.is_object());
     if glb {
-        let mut json = serde_json::to_vec(&doc).unwrap();
-        json.resize(json.len().next_multiple_of(4), b' ');
-        let mut bin = bin;
-        bin.resize(bin.len().next_multiple_of(4), 0);
-        let total = 12 + 8 + json.len() + 8 + bin.len();
-        let mut out = Vec::with_capacity(total);
-        out.extend_from_slice(b"glTF");
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&(total as u32).to_le_bytes());
-        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&json);
-        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&bin);
-        return out;
+        return splatgl::write::glb_bytes(&doc, &bin);
     }
     if let Some(b) = b0
         && b.get("uri").is_none()

@@ -322,8 +322,10 @@ pub(crate) fn gltf_bytes(mut doc: Value, bin: &[u8]) -> Vec<u8> {
     serde_json::to_vec_pretty(&doc).unwrap_or_default()
 }
 
-/// `.glb` bytes of a document whose buffer 0 is `bin` (the BIN chunk zero-padded to 4 bytes).
-pub(crate) fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
+/// `.glb` bytes of a document whose buffer 0 is `bin` (the JSON chunk space-padded and the
+/// BIN chunk zero-padded to 4 bytes). Public for the tests' and fuzzers' generated documents.
+#[doc(hidden)]
+pub fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
     let mut json = serde_json::to_vec(doc).unwrap_or_default();
     while !json.len().is_multiple_of(4) {
         json.push(b' ');
