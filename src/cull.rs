@@ -212,7 +212,14 @@ impl Frustum {
             let lim = JACOBIAN_CLAMP as f32 * tan.abs();
             CULL_RADIUS_FACTOR * f.abs() * (1.0 + lim * lim).sqrt()
         };
-        let (kx, ky) = (k(focal.x, tan_half_fov.x), k(focal.y, tan_half_fov.y));
+        // The planes live in camera space, where a world radius R spans up to σ_max(W)·R: a
+        // host view matrix may scale (`draw_with_matrices` takes any invertible affine one)
+        // and the projected footprint does not shrink with it (J's 1/z and W cancel).
+        let stretch = radius_scale(world_to_camera);
+        let (kx, ky) = (
+            k(focal.x, tan_half_fov.x) * stretch,
+            k(focal.y, tan_half_fov.y) * stretch,
+        );
         // Camera-space planes (a, b, c, d)·(X, Y, Z, 1) with their radius factor.
         let cam = [
             (Vec4::new(focal.x, 0.0, principal.x + m, 0.0), kx),

@@ -290,3 +290,52 @@ fn failed_conformance_writes_leave_the_previous_suite_and_report_byte_identical(
     assert!(json.starts_with('{'), "{json}");
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[cfg(unix)]
+#[test]
+fn writes_follow_symlinks_keep_permissions_and_refuse_special_files() {
+    use splatgl::write::write_bytes_atomic;
+    use std::os::unix::fs::PermissionsExt;
+    let d = dir("special-dest");
+    // A symlinked output: the target is replaced, the link stays a link.
+    let target = d.join("target.png");
+    std::fs::write(&target, b"old").unwrap();
+    let link = d.join("link.png");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    write_bytes_atomic(&link, &[], b"new").unwrap();
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    // An existing file keeps its permissions.
+    let kept = d.join("kept.png");
+    std::fs::write(&kept, b"old").unwrap();
+    std::fs::set_permissions(&kept, std::fs::Permissions::from_mode(0o640)).unwrap();
+    write_bytes_atomic(&kept, &[], b"new").unwrap();
+    let mode = std::fs::metadata(&kept).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o640);
+    // A FIFO (or a device) is not replaced by a regular file.
+    let fifo = d.join("fifo.png");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+    let e = write_bytes_atomic(&fifo, &[], b"x")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not a regular file"), "{e}");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    assert_eq!(
+        entries(&d),
+        ["fifo.png", "kept.png", "link.png", "target.png"]
+    );
+    std::fs::remove_dir_all(&d).ok();
+}

@@ -148,3 +148,45 @@ fn radius_is_the_3_sigma_sphere_or_never() {
         assert!((a * v).length() <= radius_scale(shear));
     }
 }
+
+#[test]
+fn a_scaled_view_matrix_keeps_what_the_rigid_one_keeps() {
+    // A host view of 2·V projects every point and every footprint as V does (x = f·X/Z with
+    // X and Z both doubled; J's 1/z cancels W's scale), so it must keep at least the same
+    // splats.
+    let c = Camera::look_at(
+        Vec3::new(0.0, 0.0, 10.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        0.8,
+        1000,
+        750,
+    );
+    let rigid = Frustum::from_camera(&c, 0.2);
+    let scaled = Frustum::new(
+        Mat4::from_scale(Vec3::splat(2.0)) * c.world_to_camera,
+        Vec2::new(c.fx, c.fy),
+        Vec2::new(c.cx, c.cy),
+        Vec2::new(c.width as f32, c.height as f32),
+        c.tan_half_fov(),
+        0.2,
+    );
+    let mut rng = crate::scene::Rng::new(11);
+    let mut kept = 0;
+    for _ in 0..20_000 {
+        let p = [
+            rng.range(-30.0, 30.0),
+            rng.range(-30.0, 30.0),
+            rng.range(-10.0, 9.0),
+        ];
+        let r = rng.range(0.0, 3.0);
+        if rigid.may_see(p, r) {
+            kept += 1;
+            assert!(
+                scaled.may_see(p, r),
+                "{p:?} r {r}: kept by V, culled by 2·V"
+            );
+        }
+    }
+    assert!(kept > 1000 && kept < 20_000, "{kept}");
+}

@@ -160,6 +160,9 @@ impl PrePass {
             gl.buffer_data_size(glow::ARRAY_BUFFER, bytes as i32, glow::DYNAMIC_COPY);
             gl.bind_buffer(glow::ARRAY_BUFFER, host);
         }
+        // After a failed glBufferData the buffer's size is undefined: claim nothing, so no
+        // draw takes the pre-pass path until a reservation succeeds.
+        self.capacity = 0;
         errors.end("allocating the pre-pass records")?;
         self.capacity = capacity;
         Ok(())

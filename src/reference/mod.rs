@@ -45,7 +45,7 @@ pub struct RenderOptions {
     pub background: [f32; 3],
     /// Blending order.
     pub sort: SortMode,
-    /// Splats with view z ≤ max(`near_cull`, camera.near) are culled (3DGS: 0.2).
+    /// Splats with view z ≤ max(`near_cull`, camera.near, 0) are culled (3DGS: 0.2).
     pub near_cull: f32,
 }
 
@@ -62,9 +62,10 @@ impl Default for RenderOptions {
 
 impl RenderOptions {
     /// The depth at or below which splats are culled for `camera`:
-    /// `max(near_cull, camera.near)`.
+    /// `max(near_cull, camera.near, 0)` — never behind the eye, where a pinhole projection
+    /// flips (and `NaN` settings fall back to 0).
     pub fn cull_depth(&self, camera: &Camera) -> f32 {
-        self.near_cull.max(camera.near)
+        self.near_cull.max(camera.near).max(0.0)
     }
 }
 

@@ -40,6 +40,31 @@ fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata) -> bool {
     false
 }
 
+/// Where [`write_atomic`] really writes `path`, and the permissions the new file keeps: a
+/// symlink is followed (its target is replaced and the link stays), an existing regular file
+/// keeps its permissions, and anything else that exists there (a device such as `/dev/null`,
+/// a FIFO, a directory) is refused — renaming over it would replace the node itself.
+fn destination(path: &Path) -> io::Result<(PathBuf, Option<std::fs::Permissions>)> {
+    let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    let target = if link {
+        std::fs::canonicalize(path)?
+    } else {
+        path.to_owned()
+    };
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_file() => Ok((target, Some(m.permissions()))),
+        Ok(_) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} exists and is not a regular file (a device, FIFO or directory); splatgl \
+                 writes regular files only (`-o -` writes a PNG to standard output)",
+                path.display()
+            ),
+        )),
+        Err(_) => Ok((target, None)),
+    }
+}
+
 /// A temporary name beside `path`: `.NAME.splatgl-tmp-PID-N`.
 fn temp_path(path: &Path) -> io::Result<PathBuf> {
     static N: AtomicU64 = AtomicU64::new(0);
@@ -67,6 +92,8 @@ pub fn write_atomic(
     fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {
     refuse_overwriting_inputs(path, inputs)?;
+    let (path, permissions) = destination(path)?;
+    let path = path.as_path();
     let tmp = temp_path(path)?;
     let file = OpenOptions::new().write(true).create_new(true).open(&tmp)?;
     // Removes the temporary file on every way out but success, a panic in `fill` included.
@@ -80,6 +107,9 @@ pub fn write_atomic(
     }
     let mut cleanup = Cleanup(&tmp, false);
     let result = (|| {
+        if let Some(p) = permissions {
+            file.set_permissions(p)?;
+        }
         let mut w = BufWriter::new(file);
         fill(&mut w)?;
         let file: File = w.into_inner().map_err(|e| e.into_error())?;

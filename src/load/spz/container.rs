@@ -83,7 +83,10 @@ pub(crate) fn gunzip_legacy(
         .take(total - 16)
         .read_to_end(&mut out)
         .map_err(gz)?;
-    let left = limit - total - cloud_bytes(h.count as u64, h.degree.min(3));
+    // `check` bounded the payload and the cloud, not the 16 header bytes: saturate.
+    let left = limit
+        .saturating_sub(total)
+        .saturating_sub(cloud_bytes(h.count as u64, h.degree.min(3)));
     let over = || SpzError::Gzip(InflateError::OverBudget { limit });
     if h.flags & FLAG_EXTENSIONS != 0 {
         // Extension records are small (a coordinate system, a camera): at most 1 MiB.
