@@ -349,6 +349,13 @@ fn limits_are_enforced_named_and_printed() {
             && out.contains("max_bytes               2097152"),
         "{out}"
     );
+    let (code, out) = splatgl(&["validate", "-v", s]);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("max_bytes               4294967296"), "{out}");
+    let (code, out) = splatgl(&["validate", "-v", "--json", s]);
+    assert_eq!(code, 0, "{out}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["limits"]["max_json_depth"], 64);
     let (code, out) = splatgl(&["info", "-v", "--json", s]);
     assert_eq!(code, 0, "{out}");
     let v: Value = serde_json::from_str(&out).unwrap();

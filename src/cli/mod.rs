@@ -38,7 +38,7 @@ enum Command {
     #[command(mut_arg("file", |a| a.help(
         "The file to check (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json)"
     )))]
-    #[command(mut_arg("verbose", |a| a.hide(true)))]
+    #[command(mut_arg("verbose", |a| a.help("Also print the loader's limits (`limits` in JSON)")))]
     Validate(FileArgs),
     /// Render an image (without a scene: the bundled default scene).
     /// Exit status: 0, or 2 on any error (message on stderr).
