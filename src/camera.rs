@@ -295,24 +295,7 @@ impl Camera {
         if forward.cross(up).length_squared() <= 1e-12 {
             return None;
         }
-        let mut axes: [Vec<f32>; 3] = Default::default();
-        for p in points.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
-            for (a, v) in axes.iter_mut().zip(p) {
-                a.push(*v);
-            }
-        }
-        if axes[0].is_empty() {
-            return None;
-        }
-        let (mut lo, mut hi) = ([0.0f32; 3], [0.0f32; 3]);
-        for k in 0..3 {
-            let a = &mut axes[k];
-            let n = a.len();
-            let (i0, i1) = ((n - 1) / 100, n - 1 - (n - 1) / 100);
-            lo[k] = *a.select_nth_unstable_by(i0, f32::total_cmp).1;
-            hi[k] = *a.select_nth_unstable_by(i1, f32::total_cmp).1;
-        }
-        let (lo, hi) = (Vec3::from_array(lo), Vec3::from_array(hi));
+        let (lo, hi) = frame::points_box(points.iter())?;
         let centre = 0.5 * (lo + hi);
         // A single point (or coincident ones) has no extent: frame a unit sphere around it, so
         // the camera stays outside the near cull.

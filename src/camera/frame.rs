@@ -113,26 +113,53 @@ pub const Z_UP_BELOW: f32 = 0.05;
 
 /// Per axis, the 1st and 99th percentile of the drawable splats' centres.
 fn centre_box(cloud: &SplatCloud) -> Option<(Vec3, Vec3)> {
+    let drawable = |(_, o): &(&[f32; 3], &f32)| **o >= crate::profile::ALPHA_MIN;
+    points_box(
+        cloud
+            .positions
+            .iter()
+            .zip(&cloud.opacities)
+            .filter(drawable)
+            .map(|(p, _)| p),
+    )
+}
+
+/// Per axis, the 1st and 99th percentile of the finite ones of `points` (`None` without
+/// any): the box framing takes, robust to a few stray points on each side.
+pub(crate) fn points_box<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> Option<(Vec3, Vec3)> {
     let mut axes: [Vec<f32>; 3] = Default::default();
-    for (p, &o) in cloud.positions.iter().zip(&cloud.opacities) {
-        if o >= crate::profile::ALPHA_MIN && p.iter().all(|v| v.is_finite()) {
-            for (a, v) in axes.iter_mut().zip(p) {
-                a.push(*v);
-            }
+    for p in points.filter(|p| p.iter().all(|v| v.is_finite())) {
+        for (a, v) in axes.iter_mut().zip(p) {
+            a.push(*v);
         }
     }
-    let n = axes[0].len();
-    if n == 0 {
+    if axes[0].is_empty() {
         return None;
     }
-    let (i0, i1) = ((n - 1) / 100, n - 1 - (n - 1) / 100);
-    let mut lo = Vec3::ZERO;
-    let mut hi = Vec3::ZERO;
-    for (k, a) in axes.iter_mut().enumerate() {
-        lo[k] = *a.select_nth_unstable_by(i0, f32::total_cmp).1;
-        hi[k] = *a.select_nth_unstable_by(i1, f32::total_cmp).1;
-    }
+    let [x, y, z] = &mut axes;
+    let lo = Vec3::new(
+        percentile(x, false),
+        percentile(y, false),
+        percentile(z, false),
+    );
+    let hi = Vec3::new(
+        percentile(x, true),
+        percentile(y, true),
+        percentile(z, true),
+    );
     Some((lo, hi))
+}
+
+/// The 1st (`upper = false`) or the 99th percentile (`upper`) of the non-empty `v`, as
+/// framing takes them (index `(n − 1) / 100` from either end).
+fn percentile(v: &mut [f32], upper: bool) -> f32 {
+    let n = v.len();
+    let i = if upper {
+        n - 1 - (n - 1) / 100
+    } else {
+        (n - 1) / 100
+    };
+    *v.select_nth_unstable_by(i, f32::total_cmp).1
 }
 
 /// The box a default view frames: per axis, the 1st percentile of the splats' 3σ box minima
@@ -177,16 +204,21 @@ impl Extent {
                 hi[a].push(p[a] + h);
             }
         }
-        let n = lo[0].len();
-        if n == 0 {
+        if lo[0].is_empty() {
             return None;
         }
-        let (i0, i1) = ((n - 1) / 100, n - 1 - (n - 1) / 100);
-        let pick = |v: &mut Vec<f32>, i: usize| *v.select_nth_unstable_by(i, f32::total_cmp).1;
         let [l0, l1, l2] = &mut lo;
         let [h0, h1, h2] = &mut hi;
-        let lo = Vec3::new(pick(l0, i0), pick(l1, i0), pick(l2, i0));
-        let hi = Vec3::new(pick(h0, i1), pick(h1, i1), pick(h2, i1));
+        let lo = Vec3::new(
+            percentile(l0, false),
+            percentile(l1, false),
+            percentile(l2, false),
+        );
+        let hi = Vec3::new(
+            percentile(h0, true),
+            percentile(h1, true),
+            percentile(h2, true),
+        );
         // Percentiles taken per side can cross for a near-degenerate axis: keep lo ≤ hi.
         Some(Extent {
             lo: lo.min(hi),
