@@ -629,23 +629,13 @@ fn differences_from_the_former_path(
 /// the GL image of the real scenes (framed, and from inside with about half in view).
 #[test]
 fn new_draw_paths_leave_real_scenes_bit_identical() {
-    let Some(paths) = real_files() else { return };
+    let Some(scenes) = common::large_real_scenes() else {
+        return;
+    };
     let Some(mut r) = headless() else { return };
     let (mut checked, mut covered_views) = (0, 0);
-    for path in paths {
-        let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
-            continue;
-        };
-        let cloud = l.cloud;
-        if cloud.len() < 1000 {
-            continue;
-        }
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let (fwd, up) = (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y);
-        let framed = Camera::frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120).unwrap();
-        let centre = Vec3::from_array(cloud.bounds().unwrap().center());
-        let inside = Camera::look_at(centre, centre + Vec3::X, up, 1.2, 160, 120);
-        for (view, cam) in [("framed", framed), ("inside", inside)] {
+    for common::RealScene { name, cloud, views } in scenes {
+        for (view, cam) in views {
             let diffs = differences_from_the_former_path(&mut r, &cloud, &cam);
             eprintln!("{name} {view}: {diffs:?}");
             for (what, n, max) in diffs {

@@ -681,22 +681,12 @@ fn same_image_by_every_path(what: &str, cloud: &SplatCloud, cam: &Camera) -> (us
 #[test]
 fn opacity_aware_extent_and_cull_leave_real_scenes_bit_identical() {
     use splatgl::cull::{CullBounds, Frustum, visible_into};
-    let Some(paths) = real_files() else { return };
+    let Some(scenes) = common::large_real_scenes() else {
+        return;
+    };
     let mut checked = 0;
-    for path in paths {
-        let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
-            continue;
-        };
-        let cloud = l.cloud;
-        if cloud.len() < 1000 {
-            continue;
-        }
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let (fwd, up) = (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y);
-        let framed = Camera::frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120).unwrap();
-        // From the scene's centre, looking sideways: roughly half the scene in view.
-        let centre = Vec3::from_array(cloud.bounds().unwrap().center());
-        let inside = Camera::look_at(centre, centre + Vec3::X, up, 1.2, 160, 120);
+    for common::RealScene { name, cloud, views } in scenes {
+        let [(_, framed), (_, inside)] = views;
         let bounds = CullBounds::new(&cloud);
         let mut ids = Vec::new();
         let frustum = Frustum::from_camera(&inside, 0.2);

@@ -44,6 +44,45 @@ pub fn real_files() -> Option<Vec<PathBuf>> {
     Some(paths)
 }
 
+/// A real scene of at least 1000 splats with its two 160×120 test views: `framed` (the whole
+/// scene from the front in PLY axes, −Y up) and `inside` (from its centre, looking sideways:
+/// roughly half of it in view).
+pub struct RealScene {
+    /// The file name.
+    pub name: String,
+    /// Its splats.
+    pub cloud: splatgl::SplatCloud,
+    /// `framed` and `inside`.
+    pub views: [(&'static str, Camera); 2],
+}
+
+/// Every real file that loads with at least 1000 splats, as a [`RealScene`] (None, with a
+/// note, when the real-data folder is absent).
+pub fn large_real_scenes() -> Option<Vec<RealScene>> {
+    let mut out = Vec::new();
+    for path in real_files()? {
+        let Ok(l) = splatgl::load::load_path(&path, &Default::default()) else {
+            continue;
+        };
+        let cloud = l.cloud;
+        if cloud.len() < 1000 {
+            continue;
+        }
+        let (fwd, up) = (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y);
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let framed = Camera::frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120)
+            .unwrap_or_else(|| panic!("{name}: no camera frames it"));
+        let centre = Vec3::from_array(cloud.bounds().unwrap().center());
+        let inside = Camera::look_at(centre, centre + Vec3::X, up, 1.2, 160, 120);
+        out.push(RealScene {
+            name,
+            cloud,
+            views: [("framed", framed), ("inside", inside)],
+        });
+    }
+    Some(out)
+}
+
 /// A camera at `eye` looking at `target` (up +Y) with vertical field of view `fov_deg` degrees.
 pub fn look_at_fov_deg(eye: Vec3, target: Vec3, fov_deg: f32, w: u32, h: u32) -> Camera {
     Camera::look_at(eye, target, Vec3::Y, fov_deg.to_radians(), w, h)
