@@ -244,11 +244,5 @@ fn go(a: &Args) -> Result<(), String> {
 
 /// Runs it. Exit status 0 on success, 2 on any error.
 pub fn run(a: Args) -> ExitCode {
-    match go(&a) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
+    super::exit_status(go(&a))
 }

@@ -184,6 +184,17 @@ impl LoadCommonArgs {
     }
 }
 
+/// The exit status of a command that succeeds with 0 or fails with an `error:` line and 2.
+pub(crate) fn exit_status(result: Result<(), String>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
 /// Parses the arguments and runs the subcommand.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();

@@ -131,11 +131,5 @@ fn go(a: Args) -> Result<(), String> {
 
 /// Runs it. Exit status 0 when the window is closed, 2 on errors.
 pub fn run(a: Args) -> ExitCode {
-    match go(a) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
+    super::exit_status(go(a))
 }

@@ -20,7 +20,7 @@
 //! the library maps only when asked (`LoadOptions::memory_map`; the `splatgl` command asks),
 //! and `SPLATGL_NO_MMAP=1` reads into memory even then.
 
-use std::io::{self, Read};
+use std::io;
 use std::ops::Deref;
 use std::path::Path;
 use std::sync::Mutex;
@@ -140,20 +140,7 @@ pub fn read_file_bytes(path: &Path, limit: u64, what: &str, map: bool) -> io::Re
 
 /// Reads standard input up to `limit` bytes; more is an error naming `what`.
 pub fn read_stdin_bounded(limit: u64, what: &str) -> io::Result<Vec<u8>> {
-    let mut data = Vec::new();
-    io::stdin()
-        .lock()
-        .take(limit.saturating_add(1))
-        .read_to_end(&mut data)?;
-    if data.len() as u64 > limit {
-        return Err(super::too_large(
-            what,
-            data.len() as u64,
-            limit,
-            "limits.max_bytes, --max-bytes",
-        ));
-    }
-    Ok(data)
+    super::read_at_most(io::stdin().lock(), limit, what)
 }
 
 /// Tells the kernel that a decoder has finished with `bytes` and will not read them again:

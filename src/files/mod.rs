@@ -90,8 +90,9 @@ pub(crate) fn too_large(what: &str, size: u64, limit: u64, flag: &str) -> io::Er
     )
 }
 
-/// Reads at most `limit` bytes of `file` into memory; more is an error.
-pub(crate) fn read_at_most(file: File, limit: u64, what: &str) -> io::Result<Vec<u8>> {
+/// Reads at most `limit` bytes of `file` (a file, standard input) into memory; more is an
+/// error.
+pub(crate) fn read_at_most(file: impl Read, limit: u64, what: &str) -> io::Result<Vec<u8>> {
     let mut data = Vec::new();
     file.take(limit.saturating_add(1)).read_to_end(&mut data)?;
     if data.len() as u64 > limit {
@@ -99,7 +100,7 @@ pub(crate) fn read_at_most(file: File, limit: u64, what: &str) -> io::Result<Vec
             what,
             data.len() as u64,
             limit,
-            "limits.max_bytes",
+            "limits.max_bytes, --max-bytes",
         ));
     }
     Ok(data)
