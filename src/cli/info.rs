@@ -49,13 +49,8 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     if let Some(obj) = info.as_object_mut() {
         obj.extend(splatgl::load::Details::json_keys(details));
     }
-    let limits = opts.limits.entries();
     if a.verbose {
-        let map: serde_json::Map<_, _> = limits
-            .iter()
-            .map(|&(k, v)| (k.to_owned(), serde_json::json!(v)))
-            .collect();
-        info["limits"] = serde_json::Value::Object(map);
+        info["limits"] = super::limits_json(&opts.limits);
     }
     if a.json {
         println!("{info:#}");
@@ -86,10 +81,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         print_details(d);
     }
     if a.verbose {
-        println!("limits:");
-        for (k, v) in limits {
-            println!("  {k:<24}{v}");
-        }
+        super::print_limits(&opts.limits);
     }
     if r.non_finite_opacities > 0 {
         println!(

@@ -184,6 +184,22 @@ impl LoadCommonArgs {
     }
 }
 
+/// The loader's limits as `info -v` / `validate -v` show them: a JSON object (`limits`).
+pub(crate) fn limits_json(limits: &Limits) -> serde_json::Value {
+    let map: serde_json::Map<_, _> = (limits.entries().iter())
+        .map(|&(k, v)| (k.to_owned(), serde_json::json!(v)))
+        .collect();
+    serde_json::Value::Object(map)
+}
+
+/// The loader's limits as text lines (`limits:` then one per limit).
+pub(crate) fn print_limits(limits: &Limits) {
+    println!("limits:");
+    for (k, v) in limits.entries() {
+        println!("  {k:<24}{v}");
+    }
+}
+
 /// The exit status of a command that succeeds with 0 or fails with an `error:` line and 2.
 pub(crate) fn exit_status(result: Result<(), String>) -> ExitCode {
     match result {

@@ -22,10 +22,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     if a.json {
         let mut json = report.to_json(&a.file);
         if a.verbose {
-            let map: serde_json::Map<_, _> = (opts.limits.entries().iter())
-                .map(|&(k, v)| (k.to_owned(), serde_json::json!(v)))
-                .collect();
-            json["limits"] = serde_json::Value::Object(map);
+            json["limits"] = super::limits_json(&opts.limits);
         }
         println!("{json:#}");
     } else {
@@ -52,10 +49,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         }
         println!("{}: {verdict} ({counts})", a.file.display());
         if a.verbose {
-            println!("limits:");
-            for (k, v) in opts.limits.entries() {
-                println!("  {k:<24}{v}");
-            }
+            super::print_limits(&opts.limits);
         }
         if report.unsupported() > 0 && status == splatgl::load::validate::Status::Valid && !a.quiet
         {
