@@ -43,7 +43,7 @@ fn gl_available() -> bool {
     match splatgl::headless::HeadlessContext::new() {
         Ok(_) => true,
         Err(e) => {
-            eprintln!("SKIPPED GL part: {e}");
+            common::skip(&format!("the GL part: {e}"));
             false
         }
     }
@@ -180,10 +180,10 @@ fn every_asset_passes_the_khronos_validator_and_splatgl_validate() {
     let pkg = Path::new(env!("CARGO_MANIFEST_DIR")).join(".npm-tools/node_modules/gltf-validator");
     let khronos = pkg.exists() && Command::new("node").arg("--version").output().is_ok();
     if !khronos {
-        eprintln!(
-            "SKIPPED glTF-Validator: {} or node missing (.ci/run installs them)",
+        common::skip(&format!(
+            "glTF-Validator: {} or node missing (.ci/run and scripts/test.sh install them)",
             pkg.display()
-        );
+        ));
     }
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gltf_validate.mjs");
     for a in &m.assets {
@@ -370,7 +370,7 @@ fn html_report_renders_in_headless_chromium() {
         .into_iter()
         .find(|b| Command::new(b).arg("--version").output().is_ok())
     else {
-        eprintln!("SKIPPED: chromium is not installed (.ci/run installs it)");
+        common::skip("chromium is not installed (.ci/run installs it)");
         return;
     };
     let page = format!("file://{}", out.join("report.html").display());

@@ -14,7 +14,7 @@ use splatgl::gl::{ColorFormat, GlError, OffscreenTarget, ReadbackTarget, SplatRe
 fn failed_context_creation_is_an_error() {
     let r = HeadlessContext::with_api_version(GlApi::DesktopCompat, (9, 0));
     match r {
-        Err(HeadlessError::EglUnavailable(m)) => eprintln!("SKIPPED: no EGL ({m})"),
+        Err(HeadlessError::EglUnavailable(m)) => common::skip(&format!("no EGL ({m})")),
         Err(HeadlessError::Egl { call, .. }) => assert_eq!(call, "eglCreateContext"),
         other => panic!("a GL 9.0 context: {other:?}"),
     }

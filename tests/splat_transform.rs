@@ -217,8 +217,8 @@ fn spz_check(name: &str, reference: &SplatCloud, got: &SplatCloud, version: u32)
 #[test]
 fn splat_transform_and_splatgl_agree_on_every_format() {
     let Some(st) = tool("SPLAT_TRANSFORM", ".bin/splat-transform") else {
-        eprintln!(
-            "skipped: splat-transform not installed (run .ci/run, or npm install --prefix .npm-tools @playcanvas/splat-transform)"
+        common::skip(
+            "splat-transform not installed (run .ci/run or scripts/test.sh, or npm install --prefix .npm-tools @playcanvas/splat-transform)",
         );
         return;
     };
@@ -453,7 +453,7 @@ fn ksplat(f: &dyn Fn(&str) -> PathBuf, ply: &SplatCloud) {
         "GAUSSIAN_SPLATS_3D",
         "@mkkellogg/gaussian-splats-3d/build/gaussian-splats-3d.module.js",
     ) else {
-        eprintln!("skipped .ksplat: @mkkellogg/gaussian-splats-3d not installed");
+        common::skip(".ksplat: @mkkellogg/gaussian-splats-3d not installed");
         return;
     };
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/create_ksplat.mjs");

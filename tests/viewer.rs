@@ -3,6 +3,8 @@
 //! say, and a file that fails to load keeps the previous scene. Every viewer gets a hard
 //! timeout and is killed; without `xvfb-run` / `xdotool` / `import` the tests skip with a note.
 
+mod common;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -46,7 +48,9 @@ fn tools_or_skip() -> bool {
     if missing.is_empty() {
         return true;
     }
-    eprintln!("skipping the viewer test: {missing:?} not installed (.ci/run installs them)");
+    common::skip(&format!(
+        "the viewer test: {missing:?} not installed (.ci/run installs them)"
+    ));
     false
 }
 
@@ -298,7 +302,7 @@ fn reference(cwd: &Path) -> Option<Image> {
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     if !o.status.success() && err.contains("EGL unavailable") {
-        eprintln!("skipping the viewer test: {err}");
+        common::skip(&format!("the viewer test: {err}"));
         return None;
     }
     assert!(o.status.success(), "{err}");

@@ -52,7 +52,7 @@ pub fn or_skip<T>(r: Result<T, HeadlessError>, what: &str) -> Option<T> {
     match r {
         Ok(v) => Some(v),
         Err(HeadlessError::EglUnavailable(msg)) => {
-            eprintln!("SKIPPED: EGL cannot be opened here ({msg})");
+            super::skip(&format!("EGL cannot be opened here ({msg})"));
             None
         }
         Err(e) => panic!("{what}: {e}"),
