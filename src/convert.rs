@@ -11,10 +11,13 @@
 //! `min`/`max`, and a `COLOR_0` fallback computed as the RC's note says (SH0·Y₀₀ + 0.5,
 //! clamped, sRGB-decoded for `srgb_rec709_display`, alpha = opacity).
 
+use crate::camera::{Camera, CamerasJsonEntry, UpAxis};
 use crate::cloud::{ColorSpace, Known, SplatCloud, sh_coeff_count};
+use crate::load::Format;
 use crate::write::quantize::dequantize_node;
+use crate::write::scene::{CameraNode, PerspectiveCamera, add_camera_nodes};
 use crate::write::{self, Comp, GltfWriteOptions};
-use glam::{DMat3, DMat4};
+use glam::{DMat3, DMat4, DQuat, DVec3};
 
 /// Output formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,13 +115,23 @@ impl Quantize {
     }
 }
 
-/// The up axis of an input, converted to glTF's +Y (`--up`).
+/// The up axis of an input (`--up`): [`Up::Auto`] follows each format's convention, an
+/// explicit axis is turned into glTF's +Y whatever the output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Up {
-    /// +Y (glTF): nothing to do.
+    /// Each format's convention (`--up auto`, the default): the input's up is
+    /// [`UpAxis::for_cloud`]'s (glTF +Y; PLY and the packed formats −Y, COLMAP axes, unless the
+    /// content stands on z = 0 and is clearly taller along +Z); glTF outputs are +Y up, PLY,
+    /// SPZ and `.splat` outputs −Y. Between two formats of the same convention nothing turns;
+    /// a PLY-side input written as glTF turns its up to +Y ([`Up::rotation`]: 180° about Z for
+    /// −Y, as `@playcanvas/splat-transform` does), a glTF input written as PLY, SPZ or
+    /// `.splat` turns by the same 180° about Z back to −Y.
     #[default]
+    Auto,
+    /// +Y (glTF): nothing to do.
     PosY,
-    /// −Y (INRIA / COLMAP captures): 180° about X.
+    /// −Y (INRIA / COLMAP captures): 180° about Z, (x, y, z) → (−x, −y, z), the rotation
+    /// splat-transform applies (it keeps +Z, the side default views look from, in front).
     NegY,
     /// +Z: −90° about X.
     PosZ,
@@ -134,28 +147,54 @@ impl std::str::FromStr for Up {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         Ok(match s {
+            "auto" => Up::Auto,
             "y" | "+y" => Up::PosY,
             "-y" => Up::NegY,
             "z" | "+z" => Up::PosZ,
             "-z" => Up::NegZ,
             "x" | "+x" => Up::PosX,
             "-x" => Up::NegX,
-            _ => return Err(format!("expected y, -y, z, -z, x or -x, found {s:?}")),
+            _ => return Err(format!("expected auto, y, -y, z, -z, x or -x, found {s:?}")),
         })
     }
 }
 
+impl From<UpAxis> for Up {
+    fn from(a: UpAxis) -> Self {
+        match a {
+            UpAxis::Y => Up::PosY,
+            UpAxis::NegY => Up::NegY,
+            UpAxis::Z => Up::PosZ,
+        }
+    }
+}
+
 impl Up {
-    /// The rotation taking this axis to +Y.
+    /// The rotation taking this axis to +Y, exact (a signed permutation: every entry 0 or ±1,
+    /// so positions, quaternions and the SH of a 180° turn move without rounding).
+    /// [`Up::Auto`] has none of its own: see [`ConvertOptions::rotation_for`].
     pub fn rotation(self) -> DMat3 {
-        use std::f64::consts::{FRAC_PI_2, PI};
+        let m = |cols: [[f64; 3]; 3]| DMat3::from_cols_array_2d(&cols);
         match self {
-            Up::PosY => DMat3::IDENTITY,
-            Up::NegY => DMat3::from_rotation_x(PI),
-            Up::PosZ => DMat3::from_rotation_x(-FRAC_PI_2),
-            Up::NegZ => DMat3::from_rotation_x(FRAC_PI_2),
-            Up::PosX => DMat3::from_rotation_z(FRAC_PI_2),
-            Up::NegX => DMat3::from_rotation_z(-FRAC_PI_2),
+            Up::Auto | Up::PosY => DMat3::IDENTITY,
+            Up::NegY => m([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]),
+            // Columns are the images of x, y, z.
+            Up::PosZ => m([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]),
+            Up::NegZ => m([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
+            Up::PosX => m([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+            Up::NegX => m([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+        }
+    }
+
+    /// The rotation of `--up auto` from an input of `input` format (with up `input_up`, from
+    /// [`UpAxis::for_cloud`]) to an output in `output` format. See [`Up::Auto`].
+    pub fn auto_rotation(input: Format, input_up: UpAxis, output: OutputFormat) -> DMat3 {
+        let input_gltf = matches!(input, Format::Gltf | Format::Glb);
+        match (input_gltf, output.is_gltf()) {
+            (true, true) | (false, false) => DMat3::IDENTITY,
+            (false, true) => Up::from(input_up).rotation(),
+            // glTF's +Y to the PLY side's −Y: 180° about Z is its own inverse.
+            (true, false) => Up::NegY.rotation().transpose(),
         }
     }
 }
@@ -181,13 +220,29 @@ pub struct ConvertOptions {
 }
 
 impl ConvertOptions {
-    /// The rotation applied to the cloud: `Rz · Ry · Rx · R_up`.
+    /// The rotation applied to the cloud with `up` taken as given: `Rz · Ry · Rx · R_up`
+    /// ([`Up::Auto`] counts as no rotation here; [`ConvertOptions::rotation_for`] resolves it).
     pub fn rotation(&self) -> DMat3 {
+        self.extra_rotation() * self.up.rotation()
+    }
+
+    /// The rotation applied to `cloud`, read as `input`, when written as `output`:
+    /// `Rz · Ry · Rx · R_up`, with [`Up::Auto`] resolved by [`Up::auto_rotation`].
+    pub fn rotation_for(&self, input: Format, cloud: &SplatCloud, output: OutputFormat) -> DMat3 {
+        let up = match self.up {
+            Up::Auto => Up::auto_rotation(input, UpAxis::for_cloud(Some(input), cloud), output),
+            explicit => explicit.rotation(),
+        };
+        self.extra_rotation() * up
+    }
+
+    /// `--rotate-x/-y/-z`: `Rz · Ry · Rx` (the identity, exactly, when all are 0).
+    fn extra_rotation(&self) -> DMat3 {
         let [x, y, z] = self.rotate_deg.map(f64::to_radians);
-        DMat3::from_rotation_z(z)
-            * DMat3::from_rotation_y(y)
-            * DMat3::from_rotation_x(x)
-            * self.up.rotation()
+        let turn = |d: f64, f: fn(f64) -> DMat3| if d == 0.0 { DMat3::IDENTITY } else { f(d) };
+        turn(z, DMat3::from_rotation_z)
+            * turn(y, DMat3::from_rotation_y)
+            * turn(x, DMat3::from_rotation_x)
     }
 }
 
@@ -251,6 +306,20 @@ pub fn encode(
     format: OutputFormat,
     o: &ConvertOptions,
 ) -> Result<(Vec<u8>, Vec<String>), String> {
+    encode_with_cameras(cloud, format, o, &[])
+}
+
+/// [`encode`], with `cameras` as perspective camera nodes of a glTF output (see
+/// [`camera_node`]). Cameras need a glTF output: other formats are an error.
+pub fn encode_with_cameras(
+    cloud: &SplatCloud,
+    format: OutputFormat,
+    o: &ConvertOptions,
+    cameras: &[CameraNode],
+) -> Result<(Vec<u8>, Vec<String>), String> {
+    if !cameras.is_empty() && !format.is_gltf() {
+        return Err("camera nodes need a .glb or .gltf output".into());
+    }
     let mut notes = Vec::new();
     let spz_err = |e: write::SpzWriteError| format!("cannot write SPZ: {e}");
     match format {
@@ -268,7 +337,10 @@ pub fn encode(
             return Ok((write::to_splat(cloud), notes));
         }
         OutputFormat::Glb if o.spz_compress => {
-            return Ok((write::to_glb_spz(cloud).map_err(spz_err)?, notes));
+            let (mut doc, spz) =
+                write::build_glb_spz(cloud, &write::SpzWriteOptions::default()).map_err(spz_err)?;
+            add_camera_nodes(&mut doc, cameras);
+            return Ok((write::glb_bytes(&doc, &spz), notes));
         }
         OutputFormat::Glb | OutputFormat::Gltf => {}
     }
@@ -290,9 +362,60 @@ pub fn encode(
         color0: true,
         ..Default::default()
     };
+    let (mut doc, bin) = write::build(&d.cloud, &w);
+    add_camera_nodes(&mut doc, cameras);
     let bytes = match format {
-        OutputFormat::Glb => write::to_glb(&d.cloud, &w),
-        _ => write::to_gltf(&d.cloud, &w),
+        OutputFormat::Glb => write::glb_bytes(&doc, &bin),
+        _ => write::gltf_bytes(doc, &bin),
     };
     Ok((bytes, notes))
+}
+
+/// The glTF camera node of one `cameras.json` view of a cloud that is written turned by `r`
+/// ([`ConvertOptions::rotation_for`]), so that `render OUT --gltf-camera N` shows what
+/// `render IN --camera cameras.json --view N` shows: the node sits at `r ·` the view's centre
+/// with `r ·` its camera → world rotation, OpenCV axes turned to glTF's (Y and Z negated);
+/// `yfov = 2·atan(height / (2·fy))`, `aspectRatio = width·fy / (height·fx)` (so `fx ≠ fy`
+/// survives when the image keeps the view's aspect ratio), near 0.01 and far 100 as the 3DGS
+/// trainer's. Named after `img_name` (`view N` without one). The note says what glTF cannot
+/// hold: a principal point off the image centre.
+pub fn camera_node(
+    e: &CamerasJsonEntry,
+    index: usize,
+    r: DMat3,
+) -> Result<(CameraNode, Option<String>), String> {
+    let cam = Camera::from_3dgs(e).map_err(|err| format!("view {index}: {err}"))?;
+    // The entry's own f64 numbers (Camera::from_3dgs has checked them): rows of camera → world.
+    let c2w = DMat3::from_cols_array_2d(&e.rotation).transpose();
+    let axes = r * c2w * DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0));
+    let q = DQuat::from_mat3(&axes).normalize();
+    let eye = r * DVec3::from_array(e.position);
+    // Near and far as the decimal numbers the trainer's 0.01 / 100 are, not their f32 values.
+    let decimal = |v: f32| v.to_string().parse::<f64>().unwrap_or(v as f64);
+    let (w, h) = (e.width as f64, e.height as f64);
+    let camera = PerspectiveCamera {
+        yfov: 2.0 * (0.5 * h / e.fy).atan(),
+        aspect_ratio: Some(w * e.fy / (h * e.fx)),
+        znear: decimal(cam.near),
+        zfar: Some(decimal(cam.far)),
+    };
+    let name = match e.img_name.as_str() {
+        "" => format!("view {index}"),
+        n => n.to_owned(),
+    };
+    let off = |c: Option<f64>, size: f64| c.is_some_and(|c| (c - 0.5 * size).abs() > 1e-4 * size);
+    let note = (off(e.cx, w) || off(e.cy, h)).then(|| {
+        format!(
+            "view {index} ({name}): principal point ({}, {}) is off the image centre; a glTF camera keeps it centred",
+            e.cx.unwrap_or(0.5 * w),
+            e.cy.unwrap_or(0.5 * h)
+        )
+    });
+    let node = CameraNode {
+        name,
+        camera,
+        translation: eye.to_array(),
+        rotation: [q.x, q.y, q.z, q.w],
+    };
+    Ok((node, note))
 }

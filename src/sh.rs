@@ -122,6 +122,15 @@ impl ShRotation {
                 }
             }
             solve(&mut a, &mut b, n);
+            // Entries within solver noise of 0 or ±1 are those values: a turn by a signed
+            // permutation (an exact axis turn such as 180° about Z) then moves coefficients
+            // without rounding.
+            for v in &mut b {
+                let r = v.round();
+                if r.abs() <= 1.0 && (*v - r).abs() <= 1e-12 {
+                    *v = r;
+                }
+            }
             b
         });
         ShRotation { d }

@@ -119,13 +119,9 @@ fn default_framing_covers_a_fifth_of_the_frame_on_every_real_file() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// The jsplat cube's corners are coloured by position (red = x/10, green = −y/10, blue =
-/// −z/10): with its −Y up (PLY), the green corners (y = −10) are at the top of the image.
-/// The Z-up fox is framed with +Z up, the COLMAP-axis biker with −Y up.
-#[test]
-fn default_framing_is_upright() {
-    let d = dir("upright");
-    let (img, err) = render_default(&real("jsplat_unitCube-ascii.ply"), &d);
+/// Mean rows of the jsplat cube's green pixels and of its dark ones (un-premultiplied green of
+/// the opaque-enough pixels above 0.6 or below 0.4).
+fn green_and_dark_rows(img: &Image) -> (f64, f64) {
     let (mut green, mut dark) = ((0.0, 0), (0.0, 0));
     for y in 0..img.height {
         for x in 0..img.width {
@@ -133,7 +129,6 @@ fn default_framing_is_upright() {
             if p[3] < 0.5 {
                 continue;
             }
-            // Un-premultiplied green of an opaque-enough pixel.
             let g = p[1] / p[3];
             let bin = if g > 0.6 {
                 &mut green
@@ -147,7 +142,17 @@ fn default_framing_is_upright() {
         }
     }
     assert!(green.1 > 0 && dark.1 > 0, "{green:?} {dark:?}");
-    let (g, k) = (green.0 / green.1 as f64, dark.0 / dark.1 as f64);
+    (green.0 / green.1 as f64, dark.0 / dark.1 as f64)
+}
+
+/// The jsplat cube's corners are coloured by position (red = x/10, green = −y/10, blue =
+/// −z/10): with its −Y up (PLY), the green corners (y = −10) are at the top of the image.
+/// The Z-up fox is framed with +Z up, the COLMAP-axis biker with −Y up.
+#[test]
+fn default_framing_is_upright() {
+    let d = dir("upright");
+    let (img, err) = render_default(&real("jsplat_unitCube-ascii.ply"), &d);
+    let (g, k) = green_and_dark_rows(&img);
     assert!(
         g + 4.0 < k,
         "green corners (y = −10) at mean row {g}, the others at {k}"
@@ -160,5 +165,48 @@ fn default_framing_is_upright() {
     let (_, err) = render_default(&real("playcanvas_biker.compressed.ply"), &d);
     let up = printed_up(&err);
     assert!(up[1] < -0.9, "biker up {up:?}: {err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// `convert FILE.ply OUT.glb` (`--up auto`) then `render OUT.glb`: the glTF is +Y up, framed
+/// with +Y up, and shows the same upright picture as `render FILE.ply` (≥ 60 dB): the cube's
+/// green corners stay at the top, the −Y-up biker and the +Z-up fox come out upright.
+#[test]
+fn converted_to_gltf_the_real_files_stay_upright() {
+    let d = dir("converted");
+    for name in [
+        "jsplat_unitCube-ascii.ply",
+        "playcanvas_biker.compressed.ply",
+        "mujoco_warp_fox_sh0.ply",
+    ] {
+        let glb = d.join(format!("{name}.glb"));
+        let o = Command::new(env!("CARGO_BIN_EXE_splatgl"))
+            .args([
+                "convert",
+                real(name).to_str().unwrap(),
+                glb.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let (from_ply, _) = render_default(&real(name), &d);
+        let (from_glb, err) = render_default(&glb, &d);
+        let up = printed_up(&err);
+        assert!(up[1] > 0.9, "{name} converted: up {up:?}: {err}");
+        let psnr = splatgl::compare::compare(&from_ply, &from_glb, 1.0 / 255.0)
+            .unwrap()
+            .psnr;
+        assert!(
+            psnr >= 60.0,
+            "{name}: converted renders {psnr:.1} dB from the PLY"
+        );
+        if name.starts_with("jsplat") {
+            let (g, k) = green_and_dark_rows(&from_glb);
+            assert!(
+                g + 4.0 < k,
+                "converted cube: green at row {g}, others at {k}"
+            );
+        }
+    }
     std::fs::remove_dir_all(&d).ok();
 }

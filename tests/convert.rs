@@ -33,16 +33,16 @@ pub fn khronos_validate(file: &Path) -> Option<serde_json::Value> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gltf_validate.mjs");
     let pkg = Path::new(env!("CARGO_MANIFEST_DIR")).join(".npm-tools/node_modules/gltf-validator");
     if !pkg.exists() {
-        eprintln!(
-            "SKIPPED glTF-Validator: {} not installed (.ci/run installs it)",
+        common::skip(&format!(
+            "glTF-Validator: {} not installed (.ci/run and scripts/test.sh install it)",
             pkg.display()
-        );
+        ));
         return None;
     }
     let out = match Command::new("node").arg(&script).arg(file).output() {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("SKIPPED glTF-Validator: node not runnable ({e})");
+            common::skip(&format!("glTF-Validator: node not runnable ({e})"));
             return None;
         }
     };
@@ -112,23 +112,84 @@ fn max_diff<const N: usize>(a: &[[f32; N]], b: &[[f32; N]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// `cloud` turned by 180° about Z, written out independently of the converter: (x, y, z) →
+/// (−x, −y, z); the quaternion (0, 0, 1, 0) · q = (−y, x, w, −z) in xyzw (up to sign: both
+/// are the same rotation); each SH coefficient of order m times (−1)^m (the real SH of order
+/// m go as cos(mφ) or sin(|m|φ), and φ → φ + π).
+fn turned_about_z(cloud: &SplatCloud) -> SplatCloud {
+    let mut t = cloud.clone();
+    for p in &mut t.positions {
+        *p = [-p[0], -p[1], p[2]];
+    }
+    for q in &mut t.rotations {
+        *q = [-q[1], q[0], q[3], -q[2]];
+    }
+    let k = t.coeffs_per_splat();
+    for c in t.sh.chunks_exact_mut(k) {
+        for l in 1..=t.sh_degree as usize {
+            for (i, v) in c[l * l..l * l + 2 * l + 1].iter_mut().enumerate() {
+                if (i as i64 - l as i64) % 2 != 0 {
+                    *v = v.map(|x| -x);
+                }
+            }
+        }
+    }
+    t
+}
+
+/// Quaternions compared up to sign (q and −q are one rotation), the rest bit for bit.
+fn differences_up_to_quaternion_sign(a: &SplatCloud, b: &SplatCloud) -> Vec<String> {
+    let mut b = b.clone();
+    for (q, p) in b.rotations.iter_mut().zip(&a.rotations) {
+        if q.map(|v| -v) == *p {
+            *q = *p;
+        }
+    }
+    differences(a, &b)
+}
+
 #[test]
 fn float_round_trip_ply_glb_ply_is_exact() {
     let d = dir("float");
     let (input, want) = source(&d);
+    let turned = turned_about_z(&want);
     for ext in ["glb", "gltf"] {
         let mid = d.join(format!("mid.{ext}"));
         let out = d.join(format!("out-{ext}.ply"));
         assert_eq!(splatgl(&["convert", s(&input), s(&mid)]).0, 0);
-        let d1 = differences(&load(&mid), &want);
+        // --up auto: the PLY's −Y up becomes glTF's +Y by 180° about Z, without rounding.
+        let d1 = differences_up_to_quaternion_sign(&load(&mid), &turned);
         assert!(d1.is_empty(), "PLY → {ext}: {d1:?}");
         assert_eq!(splatgl(&["convert", s(&mid), s(&out)]).0, 0);
-        let d2 = differences(&load(&out), &want);
+        let d2 = differences_up_to_quaternion_sign(&load(&out), &want);
         assert!(d2.is_empty(), "PLY → {ext} → PLY: {d2:?}");
         khronos_validate(&mid);
         let (code, text) = splatgl(&["validate", s(&mid)]);
         assert_eq!(code, 0, "{text}");
     }
+}
+
+/// An explicit `--up y` keeps the numbers as they are (what `convert` did before `auto`), and
+/// `--up -y` is the rotation `auto` picks for a PLY.
+#[test]
+fn explicit_up_y_keeps_the_axes_and_up_minus_y_is_what_auto_does_for_ply() {
+    let d = dir("up-explicit");
+    let (input, want) = source(&d);
+    let (kept, neg) = (d.join("kept.glb"), d.join("neg.glb"));
+    assert_eq!(splatgl(&["convert", s(&input), s(&kept), "--up", "y"]).0, 0);
+    let d1 = differences(&load(&kept), &want);
+    assert!(d1.is_empty(), "--up y: {d1:?}");
+    assert_eq!(splatgl(&["convert", s(&input), s(&neg), "--up", "-y"]).0, 0);
+    let d2 = differences_up_to_quaternion_sign(&load(&neg), &turned_about_z(&want));
+    assert!(d2.is_empty(), "--up -y: {d2:?}");
+    // A glTF input written as PLY turns back to −Y; one written as glTF does not turn.
+    let (ply, glb) = (d.join("back.ply"), d.join("again.glb"));
+    assert_eq!(splatgl(&["convert", s(&kept), s(&ply)]).0, 0);
+    let d3 = differences_up_to_quaternion_sign(&load(&ply), &turned_about_z(&want));
+    assert!(d3.is_empty(), "glTF → PLY: {d3:?}");
+    assert_eq!(splatgl(&["convert", s(&kept), s(&glb)]).0, 0);
+    let d4 = differences(&load(&glb), &want);
+    assert!(d4.is_empty(), "glTF → glTF: {d4:?}");
 }
 
 /// Quantizing one attribute moves it by at most half a step (plus f32 rounding), where a
@@ -171,8 +232,10 @@ fn quantized_round_trip_stays_within_one_step_per_component_type() {
                 max_diff(&back.positions, &want.positions),
                 max_diff(&back.scales, &want.scales),
             );
+            // Up to sign: the round trip turns by 180° about Z twice, q → −q.
+            let flipped: Vec<[f32; 4]> = back.rotations.iter().map(|q| q.map(|v| -v)).collect();
             let (dr, dop) = (
-                max_diff(&back.rotations, &want.rotations),
+                max_diff(&back.rotations, &want.rotations).min(max_diff(&flipped, &want.rotations)),
                 back.opacities
                     .iter()
                     .zip(&want.opacities)
@@ -247,7 +310,13 @@ fn spz_splat_and_spz_compressed_glb_outputs_load_back_within_their_quantization(
         }
         let back = load(&out);
         assert_eq!(back.len(), src.len(), "{name}");
-        let err = max_diff(&back.positions, &src.positions);
+        // The .glb is glTF's +Y up (--up auto): 180° about Z from the PLY's −Y.
+        let want = if name.ends_with(".glb") {
+            turned_about_z(&src)
+        } else {
+            src.clone()
+        };
+        let err = max_diff(&back.positions, &want.positions);
         assert!(
             err <= pos_bound,
             "{name}: position error {err} > {pos_bound}"
@@ -273,4 +342,125 @@ fn spz_options_that_do_not_apply_are_errors() {
         assert!(text.contains(want), "{text}");
         assert!(!out.exists());
     }
+}
+
+/// `convert IN OUT.glb --camera cameras.json` embeds the views as camera nodes named after
+/// `img_name`, turned with the scene: `render OUT --gltf-camera all` shows what `render IN
+/// --camera cameras.json --view all` shows (≥ 50 dB per view), for a real SH-3 scene and a
+/// real compressed PLY, with views of several sizes and one with fx ≠ fy.
+#[test]
+fn camera_nodes_reproduce_the_training_views() {
+    use glam::Vec3;
+    use splatgl::camera::Camera;
+    let d = dir("cameras");
+    for name in [
+        "supersplat_fruit_drops_minimal_sh3.ply",
+        "playcanvas_biker.compressed.ply",
+    ] {
+        let Some(input) = common::real(name) else {
+            return;
+        };
+        let cloud = load(&input);
+        let b = cloud.bounds().unwrap();
+        let (c, size) = (
+            Vec3::from_array(b.center()),
+            Vec3::from_array(b.max) - Vec3::from_array(b.min),
+        );
+        let r = 1.5 * size.max_element();
+        // Views in the PLY's axes (−Y up), as a trainer writes them.
+        let views = [
+            ("front.png", Vec3::new(0.2, -0.3, -1.0), 320, 240),
+            ("side.png", Vec3::new(1.0, -0.5, 0.1), 200, 300),
+            ("", Vec3::new(-0.4, -1.0, 0.6), 256, 256),
+        ];
+        let mut json = Vec::new();
+        for (i, (img, dir, w, h)) in views.into_iter().enumerate() {
+            let cam = Camera::look_at(c + r * dir.normalize(), c, -Vec3::Y, 0.8, w, h);
+            let mut e = cam.to_3dgs_json(i as i64, img);
+            if i == 1 {
+                e["fx"] = (cam.fx * 0.9).into();
+            }
+            json.push(e);
+        }
+        let cams = d.join(format!("{name}.cameras.json"));
+        std::fs::write(&cams, serde_json::to_string(&json).unwrap()).unwrap();
+        let out = d.join(format!("{name}.glb"));
+        let (code, text) = splatgl(&["convert", s(&input), s(&out), "--camera", s(&cams)]);
+        assert_eq!(code, 0, "{text}");
+        khronos_validate(&out);
+        let glb = std::fs::read(&out).unwrap();
+        let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+        let doc: serde_json::Value = serde_json::from_slice(&glb[20..20 + len]).unwrap();
+        let names: Vec<&str> = doc["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|n| n.get("camera").is_some())
+            .map(|n| n["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(names, ["front.png", "side.png", "view 2"], "{name}");
+        let size = [
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--backend",
+            "reference",
+            "-f",
+        ];
+        let a = d.join(format!("{name}.a_{{index}}.pfm"));
+        let b = d.join(format!("{name}.b_{{index}}.pfm"));
+        let from_json = [
+            "render",
+            s(&input),
+            "--camera",
+            s(&cams),
+            "--view",
+            "all",
+            "-o",
+            s(&a),
+        ];
+        let (code, text) = splatgl(&[&from_json[..], &size].concat());
+        assert_eq!(code, 0, "{text}");
+        let from_nodes = ["render", s(&out), "--gltf-camera", "all", "-o", s(&b)];
+        let (code, text) = splatgl(&[&from_nodes[..], &size].concat());
+        assert_eq!(code, 0, "{text}");
+        for i in 0..3 {
+            let at = |p: &Path| PathBuf::from(s(p).replace("{index}", &i.to_string()));
+            let (x, y) = (
+                splatgl::image::Image::read(at(&a)).unwrap(),
+                splatgl::image::Image::read(at(&b)).unwrap(),
+            );
+            let psnr = splatgl::compare::compare(&x, &y, 1.0 / 255.0).unwrap().psnr;
+            let lit = x
+                .pixels
+                .iter()
+                .filter(|p| p[0] + p[1] + p[2] > 0.02)
+                .count() as f64
+                / x.pixels.len() as f64;
+            eprintln!("{name} view {i}: {psnr:.1} dB, {:.0} % lit", 100.0 * lit);
+            assert!(psnr >= 50.0, "{name} view {i}: {psnr:.1} dB");
+            assert!(lit > 0.05, "{name} view {i}: the scene is not in view");
+        }
+    }
+}
+
+#[test]
+fn camera_needs_a_gltf_output_and_a_readable_cameras_json() {
+    let d = dir("cameras-errors");
+    let (input, _) = source(&d);
+    let (cams, out) = (d.join("cams.json"), d.join("o.ply"));
+    std::fs::write(&cams, "[]").unwrap();
+    let (code, text) = splatgl(&["convert", s(&input), s(&out), "--camera", s(&cams)]);
+    assert_eq!(code, 2, "{text}");
+    assert!(
+        text.contains("--camera applies to .glb/.gltf outputs"),
+        "{text}"
+    );
+    std::fs::write(&cams, r#"[{"id": 0}]"#).unwrap();
+    let glb = d.join("o.glb");
+    let (code, text) = splatgl(&["convert", s(&input), s(&glb), "--camera", s(&cams)]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("cams.json") && text.contains("[0]"), "{text}");
+    assert!(!glb.exists() && !out.exists());
 }

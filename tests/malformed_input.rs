@@ -429,12 +429,33 @@ fn spec_violations_the_loader_survives_are_validation_errors() {
         .find(|f| f.message.contains("not unit length"))
         .expect("finding");
     assert_eq!(f.index, Some(2));
+    assert_eq!(
+        f.severity,
+        splatgl::load::Severity::Error,
+        "as glTF-Validator's ROTATION_NON_UNIT"
+    );
     assert!(
         f.path
             .ends_with("attributes[\"KHR_gaussian_splatting:ROTATION\"]"),
         "{}",
         f.path
     );
+    // …and names the file's writer when the asset says who that was.
+    let written = gltf_with(|d, b| {
+        d["asset"]["generator"] = "splat-transform 3.7.0".into();
+        let a = attr(d, &format!("{P}ROTATION"));
+        let v = d["accessors"][a]["bufferView"].as_u64().unwrap() as usize;
+        let o = d["bufferViews"][v]["byteOffset"].as_u64().unwrap() as usize;
+        b[o..o + 16].copy_from_slice(bytemuck::cast_slice(&[0.0f32, 0.0, 0.0, 2.0]));
+    });
+    assert!(
+        msgs(&written).iter().any(
+            |m| m.contains("not unit length") && m.contains("written by splat-transform 3.7.0")
+        ),
+        "{:?}",
+        msgs(&written)
+    );
+    assert!(f.message.contains("written by splatgl"), "{}", f.message);
     // Negative scale: log space under auto, an error under --scale-space linear.
     let neg = gltf_with(|d, b| {
         let a = attr(d, &format!("{P}SCALE"));

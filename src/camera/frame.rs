@@ -58,6 +58,17 @@ impl UpAxis {
         }
     }
 
+    /// [`UpAxis::for_cloud`] and the rule that chose it, in words (what `info` prints).
+    pub fn for_cloud_explained(format: Option<Format>, cloud: &SplatCloud) -> (Self, &'static str) {
+        let up = Self::for_cloud(format, cloud);
+        let why = match up {
+            UpAxis::Y => "glTF: +Y up by the glTF specification",
+            UpAxis::Z => "stands on z = 0 and is clearly taller along +Z than wide",
+            UpAxis::NegY => "3DGS training output in COLMAP axes (PLY and the packed formats)",
+        };
+        (up, why)
+    }
+
     /// The unit vector.
     pub fn vector(self) -> Vec3 {
         match self {

@@ -49,15 +49,24 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     pub rotate_z: f64,
-    /// The input's up axis, turned into glTF's +Y: y (default, unchanged), -y (y-down
-    /// captures: INRIA / COLMAP), z, -z, x, -x.
+    /// The input's up axis. auto (default): each format's convention, as render frames it —
+    /// glTF is +Y up, PLY and the packed formats -Y (COLMAP axes; +Z when the content stands
+    /// on z = 0 and is clearly taller along z); a PLY-side input written as glTF is turned to
+    /// +Y (180° about Z for -Y, as splat-transform does), a glTF input written as .ply/.spz/
+    /// .splat turned back to -Y. An explicit axis is turned into +Y whatever the output: y
+    /// (unchanged), -y (180° about Z), z, -z, x, -x.
     #[arg(
         long,
-        default_value = "y",
+        default_value = "auto",
         value_name = "AXIS",
         allow_hyphen_values = true
     )]
     pub up: Up,
+    /// Embed the views of a 3DGS cameras.json (in the input's axes) as glTF perspective
+    /// camera nodes named after img_name, turned with the scene (.glb/.gltf outputs), so
+    /// `render OUT --gltf-camera all` shows the training views.
+    #[arg(long, value_name = "cameras.json")]
+    pub camera: Option<PathBuf>,
     /// SPZ version of a .spz output: 2 (gzip; what KHR_gaussian_splatting_compression_spz_2
     /// pins and most readers take), 3 (gzip, smallest-three quaternions) or 4 (zstd).
     #[arg(long, value_name = "2|3|4", value_parser = clap::value_parser!(u32).range(2..=4))]
@@ -145,9 +154,8 @@ fn options(a: &Args) -> Result<ConvertOptions, String> {
     })
 }
 
-/// Rotates in chunks (progress per chunk).
-fn rotate(cloud: SplatCloud, o: &ConvertOptions, p: &Progress) -> Result<SplatCloud, String> {
-    let r = o.rotation();
+/// Rotates by `r` in chunks (progress per chunk).
+fn rotate(cloud: SplatCloud, r: glam::DMat3, p: &Progress) -> Result<SplatCloud, String> {
     if r == glam::DMat3::IDENTITY {
         return Ok(cloud);
     }
@@ -205,7 +213,16 @@ fn go(a: &Args) -> Result<(), String> {
     if a.spz_version.is_some() && format != OutputFormat::Spz {
         return Err("--spz-version applies to .spz outputs only".into());
     }
+    if a.camera.is_some() && !format.is_gltf() {
+        return Err("--camera applies to .glb/.gltf outputs only (camera nodes)".into());
+    }
     check_output(&a.output, &a.input, a.force)?;
+    let limits = a.load.options().limits;
+    let views = match &a.camera {
+        Some(path) => splatgl::camera::load_cameras_json_limited(path, &limits)
+            .map_err(|e| format!("--camera: {e}"))?,
+        None => Vec::new(),
+    };
     let scene = splatgl::load::load_path(&a.input, &a.load.options()).map_err(|e| e.to_string())?;
     a.load
         .common
@@ -224,9 +241,18 @@ fn go(a: &Args) -> Result<(), String> {
         t0.elapsed().as_secs_f64()
     ));
     convert::relabel(&mut cloud, &o);
-    let cloud = rotate(cloud, &o, &p)?;
+    let r = o.rotation_for(scene.report.format, &cloud, format);
+    let mut cameras = Vec::with_capacity(views.len());
+    for (i, e) in views.iter().enumerate() {
+        let (node, note) = convert::camera_node(e, i, r)?;
+        if let Some(n) = note {
+            eprintln!("note: {n}");
+        }
+        cameras.push(node);
+    }
+    let cloud = rotate(cloud, r, &p)?;
     p.stage("encoding");
-    let (bytes, notes) = convert::encode(&cloud, format, &o)?;
+    let (bytes, notes) = convert::encode_with_cameras(&cloud, format, &o, &cameras)?;
     for n in notes {
         eprintln!("note: {n}");
     }

@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 /// Help of `info --json`.
 pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, color_space, \
-    kernel, projection, sorting_method, bounds_min, bounds_max, scale_space, \
+    kernel, projection, sorting_method, bounds_min, bounds_max, up, up_rule, scale_space, \
     non_unit_quaternions, non_finite_opacities, memory_bytes, warnings, notes; for quantized containers also container, \
     container_version, compression, gltf_extension, quantization[{attribute, bits, encoding}], \
     lossy, antialiased — null otherwise; with -v also limits)";
@@ -27,6 +27,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     let b = c.bounds();
+    let (up, up_rule) = splatgl::camera::UpAxis::for_cloud_explained(Some(r.format), c);
     let mut info = serde_json::json!({
         "file": a.file.display().to_string(),
         "format": r.format.name(),
@@ -38,6 +39,8 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "sorting_method": c.meta.sorting_method.to_string_with(SortingMethod::as_str),
         "bounds_min": b.map(|b| b.min),
         "bounds_max": b.map(|b| b.max),
+        "up": up.name(),
+        "up_rule": up_rule,
         "scale_space": r.scale_space.map(|s| s.name()),
         "non_unit_quaternions": r.non_unit_quaternions,
         "non_finite_opacities": r.non_finite_opacities,
@@ -69,6 +72,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         Some(b) => println!("bounds:         {:?} .. {:?}", b.min, b.max),
         None => println!("bounds:         (empty)"),
     }
+    println!("up:             {} ({up_rule})", up.name());
     println!(
         "scale space:    {}",
         r.scale_space.map_or("-", |s| s.name())

@@ -25,6 +25,16 @@ pub fn to_glb_spz(cloud: &SplatCloud) -> Result<Vec<u8>, SpzWriteError> {
 /// be [`super::SpzVersion::V2`], the one the extension pins; `o.axes` raw skips the LUF → RUB
 /// conversion (glTF-axis numbers in the payload, as CesiumJS reads it).
 pub fn to_glb_spz_with(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8>, SpzWriteError> {
+    let (doc, spz) = build_glb_spz(cloud, o)?;
+    Ok(glb_bytes(&doc, &spz))
+}
+
+/// The document and the BIN chunk (the SPZ payload) of [`to_glb_spz_with`], for writers that
+/// add to the document (camera nodes) before framing it with [`glb_bytes`].
+pub(crate) fn build_glb_spz(
+    cloud: &SplatCloud,
+    o: &SpzWriteOptions,
+) -> Result<(Value, Vec<u8>), SpzWriteError> {
     if o.version != super::SpzVersion::V2 {
         return Err(SpzWriteError::Options(format!(
             "{SPZ_2} pins SPZ version 2, not {}",
@@ -72,7 +82,7 @@ pub fn to_glb_spz_with(cloud: &SplatCloud, o: &SpzWriteOptions) -> Result<Vec<u8
         "bufferViews": [{"buffer": 0, "byteLength": spz.len()}],
         "accessors": accessors,
     });
-    Ok(glb_bytes(&doc, &spz))
+    Ok((doc, spz))
 }
 
 /// Bounds of the positions as a reader decodes them: rounded to steps of 2^-bits (the axis

@@ -25,6 +25,7 @@ pub use ply::{to_inria_ply, to_inria_ply_with_normals};
 mod glb_spz;
 mod splat;
 mod spz;
+pub(crate) use glb_spz::build_glb_spz;
 pub use glb_spz::{to_glb_spz, to_glb_spz_with};
 pub use splat::to_splat;
 pub use spz::{SpzVersion, SpzWriteError, SpzWriteOptions, to_spz, to_spz_with};

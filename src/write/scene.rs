@@ -205,3 +205,57 @@ fn camera_json(c: &PerspectiveCamera) -> Value {
     }
     json!({"type": "perspective", "perspective": p})
 }
+
+/// A perspective camera on a root node of its own: what `splatgl convert --camera` embeds
+/// for each training view.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraNode {
+    /// The node's and the camera's `name` (the view's `img_name`).
+    pub name: String,
+    /// The camera.
+    pub camera: PerspectiveCamera,
+    /// The node's `translation`: the eye.
+    pub translation: [f64; 3],
+    /// The node's `rotation` (unit quaternion `[x, y, z, w]`): the camera's axes, glTF
+    /// convention (+X right, +Y up, looking along −Z).
+    pub rotation: [f64; 4],
+}
+
+/// Appends `cameras` to a document made by [`super::build`] (or any document with a scene 0):
+/// one camera each, on a new root node of scene 0.
+pub fn add_camera_nodes(doc: &mut Value, cameras: &[CameraNode]) {
+    if cameras.is_empty() {
+        return;
+    }
+    let (first_node, first_camera) = (
+        doc["nodes"].as_array().map_or(0, Vec::len),
+        doc["cameras"].as_array().map_or(0, Vec::len),
+    );
+    for (i, c) in cameras.iter().enumerate() {
+        let node = SceneNode {
+            name: Some(c.name.clone()),
+            camera: Some(first_camera + i),
+            transform: NodeTransform::Trs {
+                translation: c.translation,
+                rotation: c.rotation,
+                scale: [1.0; 3],
+            },
+            ..Default::default()
+        };
+        let mut camera = camera_json(&c.camera);
+        camera["name"] = json!(c.name);
+        push(doc, "nodes", node_json(&node));
+        push(doc, "cameras", camera);
+        push(&mut doc["scenes"][0], "nodes", json!(first_node + i));
+    }
+}
+
+/// Appends `v` to the array `doc[key]` (made if absent).
+fn push(doc: &mut Value, key: &str, v: Value) {
+    if !doc[key].is_array() {
+        doc[key] = json!([]);
+    }
+    if let Some(a) = doc[key].as_array_mut() {
+        a.push(v);
+    }
+}

@@ -318,7 +318,23 @@ fn assemble(
         cloud.push(a.position.get(i), s, q, o, &sh);
     }
     let strict = ctx.opts.strict;
-    let unit = |n| format!("{n} quaternions are not unit length (tolerance {tol}); normalised");
+    // The RC: "Rotation values are stored as unit quaternions" (so that renderers need not
+    // renormalise); glTF-Validator holds node rotations and animated rotations to the same
+    // rule as errors (ROTATION_NON_UNIT). Naming the writer tells the user whom to ask.
+    let by = match ctx.doc.as_json().asset.generator.as_deref() {
+        Some(g) if !g.trim().is_empty() => {
+            // A file's own text: control characters shown as '?', at most 80 characters.
+            let g: String = g
+                .trim()
+                .chars()
+                .take(80)
+                .map(|c| if c.is_control() { '?' } else { c })
+                .collect();
+            format!(" (the file was written by {g})")
+        }
+        _ => String::new(),
+    };
+    let unit = |n| format!("{n} quaternions are not unit length (tolerance {tol}); normalised{by}");
     non_unit.report(&rot_path, unit, false, f);
     let then = |n: usize| match (strict, n) {
         (true, _) => "strict mode".to_owned(),

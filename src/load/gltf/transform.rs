@@ -65,8 +65,13 @@ pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Findi
                 for (s, q) in out.scales.iter_mut().zip(out.rotations.iter_mut()) {
                     *s = s.map(|v| (v as f64 * k) as f32);
                     let ql = DQuat::from_xyzw(q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64);
-                    let g = (qm * ql).normalize();
-                    *q = [g.x as f32, g.y as f32, g.z as f32, g.w as f32];
+                    // |qm · ql| = |ql|: the product is rounded to f32 and normalised only
+                    // where f32 rounding is not all that separates it from unit length, so a
+                    // signed-permutation matrix (an exact axis turn) moves quaternions
+                    // without rounding.
+                    let g = qm * ql;
+                    let g = [g.x as f32, g.y as f32, g.z as f32, g.w as f32];
+                    *q = crate::load::normalize_quat(g).map_or(g, |(n, _)| n);
                 }
             }
             None => {

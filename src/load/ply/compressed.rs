@@ -90,27 +90,33 @@ impl<'a> Columns<'a> {
     }
 }
 
-fn unorm(v: u32, bits: u32) -> f32 {
+/// The decoding is in f64, each value rounded to f32 once, as the format's own JavaScript
+/// readers compute it (an f32 lerp rounds three times, which `exp` of a log scale turns into
+/// ~1e-6 relative).
+fn unorm(v: u32, bits: u32) -> f64 {
     let max = (1u32 << bits) - 1;
-    (v & max) as f32 / max as f32
+    (v & max) as f64 / max as f64
 }
 
-fn lerp(a: f32, b: f32, t: f32) -> f32 {
-    a * (1.0 - t) + b * t
+/// `a·(1 − t) + b·t`, rounded once.
+fn lerp(a: f32, b: f32, t: f64) -> f32 {
+    let (a, b) = (a as f64, b as f64);
+    (a * (1.0 - t) + b * t) as f32
 }
 
 /// 11/10/11 unorm triple (x in the high bits).
-fn unpack_111011(v: u32) -> [f32; 3] {
+fn unpack_111011(v: u32) -> [f64; 3] {
     [unorm(v >> 21, 11), unorm(v >> 11, 10), unorm(v, 11)]
 }
 
 /// Smallest-three quaternion → the four stored components in the file's order.
 fn unpack_rotation(v: u32) -> [f32; 4] {
-    let k = std::f32::consts::SQRT_2; // components lie in [−1/√2, 1/√2]
+    let k = std::f64::consts::SQRT_2; // components lie in [−1/√2, 1/√2]
     let a = (unorm(v >> 20, 10) - 0.5) * k;
     let b = (unorm(v >> 10, 10) - 0.5) * k;
     let c = (unorm(v, 10) - 0.5) * k;
     let m = (1.0 - (a * a + b * b + c * c)).max(0.0).sqrt();
+    let [a, b, c, m] = [a, b, c, m].map(|x| x as f32);
     match v >> 30 {
         0 => [m, a, b, c],
         1 => [a, m, b, c],
@@ -269,12 +275,13 @@ fn push_splat(
     let c = i / CHUNK;
     let chunk_val = |off: usize| chunks.f32_at(c, off);
     let range =
-        |offs: &[usize; 6], a: usize, t: f32| lerp(chunk_val(offs[a]), chunk_val(offs[a + 3]), t);
+        |offs: &[usize; 6], a: usize, t: f64| lerp(chunk_val(offs[a]), chunk_val(offs[a + 3]), t);
     let [pp, pr, ps, pc] = fields.packed;
     let p = unpack_111011(verts.u32_at(i, pp));
     let pos: [f32; 3] = std::array::from_fn(|a| range(&fields.bounds, a, p[a]));
     let s = unpack_111011(verts.u32_at(i, ps));
-    let scale: [f32; 3] = std::array::from_fn(|a| range(&fields.scales, a, s[a]).exp());
+    let scale: [f32; 3] =
+        std::array::from_fn(|a| (range(&fields.scales, a, s[a]) as f64).exp() as f32);
     let [w, x, y, z] = unpack_rotation(verts.u32_at(i, pr));
     let Some((rot, _)) = super::super::normalize_quat([x, y, z, w]) else {
         return Err(PlyError::Value {
@@ -293,7 +300,7 @@ fn push_splat(
     for ch in 0..3 {
         let v = match (fields.colours[ch], fields.colours[ch + 3]) {
             (Some(lo), Some(hi)) => lerp(chunk_val(lo), chunk_val(hi), rgba[ch]),
-            _ => rgba[ch],
+            _ => rgba[ch] as f32,
         };
         coeffs[0][ch] = crate::sh::dc_from_color(v as f64);
     }
@@ -309,7 +316,7 @@ fn push_splat(
             message: "decode to a non-finite position, scale or colour".into(),
         });
     }
-    cloud.push(pos, scale, rot, rgba[3], coeffs);
+    cloud.push(pos, scale, rot, rgba[3] as f32, coeffs);
     Ok(())
 }
 
