@@ -52,9 +52,9 @@ pub struct Args {
     /// The input's up axis. auto (default): each format's convention, as render frames it —
     /// glTF is +Y up, PLY and the packed formats -Y (COLMAP axes; +Z when the content stands
     /// on z = 0 and is clearly taller along z); a PLY-side input written as glTF is turned to
-    /// +Y (180° about Z for -Y, as splat-transform does), a glTF input written as .ply/.spz/
-    /// .splat turned back to -Y. An explicit axis is turned into +Y whatever the output: y
-    /// (unchanged), -y (180° about Z), z, -z, x, -x.
+    /// +Y (180° about Z for -Y, as splat-transform does), a glTF input written as .ply,
+    /// .spz or .splat turned back to -Y. An explicit axis is turned into +Y whatever the
+    /// output: y (unchanged), -y (180° about Z), z, -z, x, -x.
     #[arg(
         long,
         default_value = "auto",
