@@ -132,6 +132,19 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// The view of the bundled default scene (`splatgl render` without a file): from
+    /// (3.3, 2.4, 4.2) towards (0, 0.65, 0), +Y up, 40° vertical fov.
+    pub fn default_scene_view(width: u32, height: u32) -> Self {
+        Camera::look_at(
+            Vec3::new(3.3, 2.4, 4.2),
+            Vec3::new(0.0, 0.65, 0.0),
+            Vec3::Y,
+            40f32.to_radians(),
+            width,
+            height,
+        )
+    }
+
     /// A camera at `eye` looking at `target`, `up` roughly up in the image, vertical field of
     /// view `fov_y` in radians, principal point at the image centre, square pixels.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_y: f32, width: u32, height: u32) -> Self {

@@ -173,16 +173,9 @@ pub fn default_scene() -> SplatCloud {
     cloud
 }
 
-/// The default scene's camera: from (3.3, 2.4, 4.2) towards (0, 0.65, 0), 40° vertical fov.
+/// The default scene's camera ([`Camera::default_scene_view`]).
 pub fn default_camera(width: u32, height: u32) -> Camera {
-    Camera::look_at(
-        Vec3::new(3.3, 2.4, 4.2),
-        Vec3::new(0.0, 0.65, 0.0),
-        Vec3::Y,
-        40f32.to_radians(),
-        width,
-        height,
-    )
+    Camera::default_scene_view(width, height)
 }
 
 #[cfg(test)]

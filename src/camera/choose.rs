@@ -7,8 +7,7 @@ use std::path::PathBuf;
 use super::frame::UpAxis;
 use super::{Camera, CameraError, CamerasJsonEntry, GltfPerspective, load_cameras_json_limited};
 use crate::cloud::SplatCloud;
-use crate::load::Format;
-use crate::load::Limits;
+use crate::files::{Format, Limits};
 
 /// What a view is chosen for: the cloud, the format it was read from (`None`: the bundled
 /// default scene) and the glTF camera nodes of its file.
@@ -206,7 +205,7 @@ impl ViewOptions {
             return Camera::look_at(l.eye, l.target, up, fov, w, h).validated();
         }
         if scene.format.is_none() && self.up.is_none() {
-            return Ok(crate::scene::default_camera(w, h));
+            return Ok(Camera::default_scene_view(w, h));
         }
         Camera::frame_cloud(scene.cloud, up, fov, w, h)
             .ok_or_else(|| {

@@ -6,7 +6,7 @@ use glam::{Mat3, Quat, Vec3};
 
 use super::Camera;
 use crate::cloud::SplatCloud;
-use crate::load::Format;
+use crate::files::Format;
 
 /// The world axis that is up in a scene: the orbit axis of the viewer, the default `up` of
 /// `--look-at` and the up of automatic framing.

@@ -2,7 +2,7 @@
 //! `{id, img_name, width, height, position[3], rotation[3][3], fx, fy}` with optional `cx`, `cy`.
 
 use super::CameraError;
-use crate::load::{Limits, check_json_depth};
+use crate::files::{Limits, check_json_depth};
 use serde_json::Value;
 
 /// One view of a `cameras.json`, values as written (f64).

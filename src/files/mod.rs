@@ -19,7 +19,11 @@
 //! path. [`map_bounded`] is the memory-mapped variant with the same contract ([`open_regular`]
 //! first, then the size against the limit before mapping), used for scene files (`map.rs`).
 
+mod format;
+mod limits;
 mod map;
+pub use format::Format;
+pub use limits::{LimitExceeded, Limits, check_json_depth};
 pub use map::{FileBytes, Mapping, NO_MMAP_ENV, map_bounded, read_file_bytes, read_stdin_bounded};
 pub(crate) use map::{advise_huge, release_consumed};
 

@@ -5,58 +5,16 @@
 //! `.splat` (which has no header) last, by plausibility. A file whose extension names another
 //! format than its content loads as its content, with a warning naming both.
 //!
-//! To add a format: a [`Format`] variant with its [`Format::name`], [`Format::magic`] (and a
-//! [`confirmed`] rule if that magic is shared) and [`Format::extensions`], and its reader in
-//! [`super::read`].
+//! To add a format: a [`Format`] variant (in `files/format.rs`) with its [`Format::name`] and
+//! `Format::extensions`, its `Format::magic` here (and a [`confirmed`] rule if that magic is
+//! shared), and its reader in [`super::read`].
 
 use super::{ksplat, sog, splat, spz};
+use crate::files::Format;
 use std::io::Read;
 use std::path::Path;
 
-/// The file formats splatgl reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    /// glTF JSON (`.gltf`).
-    Gltf,
-    /// Binary glTF (`.glb`).
-    Glb,
-    /// INRIA 3DGS PLY (binary little/big endian or ASCII), and PlayCanvas compressed PLY.
-    Ply,
-    /// Niantic SPZ, versions 1–4.
-    Spz,
-    /// antimatter15 `.splat`.
-    Splat,
-    /// mkkellogg `.ksplat`.
-    Ksplat,
-    /// PlayCanvas SOG (bundled `.sog` or `meta.json` + WebP).
-    Sog,
-}
-
 impl Format {
-    /// Every format, in the order detection tries their magic bytes.
-    const ALL: [Format; 7] = [
-        Format::Gltf,
-        Format::Glb,
-        Format::Ply,
-        Format::Spz,
-        Format::Splat,
-        Format::Ksplat,
-        Format::Sog,
-    ];
-
-    /// Short lowercase name used in `info` output.
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Gltf => "gltf",
-            Format::Glb => "glb",
-            Format::Ply => "ply",
-            Format::Spz => "spz",
-            Format::Splat => "splat",
-            Format::Ksplat => "ksplat",
-            Format::Sog => "sog",
-        }
-    }
-
     /// Leading bytes that identify the format whatever the file is called (gzip and zip only
     /// once [`confirmed`]).
     fn magic(self) -> &'static [&'static [u8]] {
@@ -66,19 +24,6 @@ impl Format {
             Format::Ply => &[b"ply\n", b"ply\r\n"],
             Format::Spz => &[spz::MAGIC, GZIP],
             Format::Sog => &[b"PK\x03\x04"],
-        }
-    }
-
-    /// File extensions (lowercase, without the dot); `meta.json` and other `.json`: SOG.
-    fn extensions(self) -> &'static [&'static str] {
-        match self {
-            Format::Gltf => &["gltf"],
-            Format::Glb => &["glb"],
-            Format::Ply => &["ply"],
-            Format::Spz => &["spz"],
-            Format::Splat => &["splat"],
-            Format::Ksplat => &["ksplat"],
-            Format::Sog => &["sog", "json"],
         }
     }
 }

@@ -24,7 +24,6 @@ mod format;
 pub mod gltf;
 pub(crate) mod hygiene;
 pub mod ksplat;
-mod limits;
 pub mod ply;
 mod report;
 pub mod sog;
@@ -32,10 +31,11 @@ pub mod splat;
 pub mod spz;
 pub mod validate;
 
+pub use crate::files::Format;
+pub use crate::files::{LimitExceeded, Limits, check_json_depth};
 pub use details::{AttributeBits, Details};
 pub use finding::{Finding, Severity};
-pub use format::{Format, detect_format};
-pub use limits::{LimitExceeded, Limits, check_json_depth};
+pub use format::detect_format;
 pub use report::{LoadReport, ScaleSeen};
 
 use crate::camera::GltfPerspective;
