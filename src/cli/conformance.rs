@@ -113,9 +113,13 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
     )?;
     let s = report::summary(&results);
     for r in results.iter().filter(|r| !r.skipped && !r.pass()) {
+        let word = match r.asset.checks {
+            splatgl::conformance::manifest::Checks::Rc => "FAIL",
+            splatgl::conformance::manifest::Checks::Profile => "DIFFERS (profile, informative)",
+        };
         for c in r.cameras.iter().filter(|c| !c.pass) {
             println!(
-                "FAIL {}/{}: {}",
+                "{word} {}/{}: {}",
                 r.asset.name,
                 c.camera.name,
                 c.cause.as_deref().unwrap_or("")
@@ -123,10 +127,12 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
         }
     }
     println!(
-        "{} passed, {} failed, {} skipped -> {}",
+        "{} passed, {} failed, {} skipped (RC rules); profile: {} match, {} differ -> {}",
         s.passed,
         s.failed,
         s.skipped,
+        s.profile_matched,
+        s.profile_differ,
         out.join("report.html").display()
     );
     Ok(s.failed == 0)

@@ -6,6 +6,7 @@
 //! `docs/conformance.md` lists them with the rule and the RC section each checks.
 
 use super::Erratum;
+use super::manifest::Checks;
 use crate::cloud::SplatCloud;
 use crate::sh::dc_from_color;
 use crate::write::quantize::dequantize_node;
@@ -57,6 +58,8 @@ pub struct AssetSpec {
     pub doc: SceneDoc,
     /// Its cameras.
     pub cameras: Vec<CameraSpec>,
+    /// A rule of the RC, or a choice the RC leaves open (splatgl's profile).
+    pub checks: Checks,
     /// Errata the asset is designed to catch (the generator checks that it does).
     pub designed_for: &'static [Erratum],
     /// Not required of an RC implementation (legacy compatibility).
@@ -83,6 +86,7 @@ impl AssetSpec {
             failure_means,
             doc,
             cameras,
+            checks: Checks::Rc,
             designed_for: &[],
             optional: false,
             rc_valid: true,
@@ -91,6 +95,11 @@ impl AssetSpec {
     }
     pub(crate) fn catches(mut self, e: &'static [Erratum]) -> Self {
         self.designed_for = e;
+        self
+    }
+    /// Marks the asset as checking a choice the RC leaves open (reported apart, never fails).
+    pub(crate) fn profile(mut self) -> Self {
+        self.checks = Checks::Profile;
         self
     }
 }
@@ -116,13 +125,6 @@ pub(crate) fn splat(
 }
 
 pub(crate) const ID: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
-
-/// Adds a sub-pixel white splat at `p`: where an asset's own content would catch erratum i
-/// (no dilation) only within the margin of its tolerance, the probe makes the outcome clear
-/// (it vanishes without dilation).
-pub(crate) fn subpixel_probe(c: &mut SplatCloud, p: [f32; 3]) {
-    splat(c, p, [0.002; 3], ID, 1.0, [1.0, 1.0, 1.0]);
-}
 
 /// A primitive with default (float) options.
 pub(crate) fn prim(cloud: SplatCloud) -> SplatPrimitive {

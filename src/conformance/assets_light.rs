@@ -1,7 +1,7 @@
 //! The suite's assets, part 2: lighting (SH) and fallbacks.
 
 use super::Erratum;
-use super::assets::{AssetSpec, CameraSpec, ID, cam, prim, quat, single, splat, subpixel_probe};
+use super::assets::{AssetSpec, CameraSpec, ID, cam, prim, quat, single, splat};
 use crate::cloud::{Known, SplatCloud};
 use crate::write::GltfWriteOptions;
 use crate::write::scene::{NodeTransform, SceneDoc, SceneNode, SplatPrimitive};
@@ -116,7 +116,6 @@ fn color0() -> AssetSpec {
         );
         c.sh[4 * k + 2] = [0.25, 0.1, -0.2];
     }
-    subpixel_probe(&mut c, [0.9, 0.75, 0.0]);
     let p = SplatPrimitive {
         cloud: c,
         options: GltfWriteOptions {

@@ -40,6 +40,27 @@ pub struct CameraEntry {
     pub tolerance: Tolerance,
 }
 
+/// What an asset checks: a rule of the RC, or a choice the RC leaves open.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Checks {
+    /// A rule of the Release Candidate (`"checks": "rc"`): a failure fails the run.
+    #[default]
+    Rc,
+    /// A choice the RC leaves to the renderer, here splatgl's profile (3DGS's choice; `"checks":
+    /// "profile"`): reported apart, informative, never fails a run.
+    Profile,
+}
+
+impl Checks {
+    /// The manifest's spelling: `rc` or `profile`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Checks::Rc => "rc",
+            Checks::Profile => "profile",
+        }
+    }
+}
+
 /// One asset.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AssetEntry {
@@ -55,6 +76,8 @@ pub struct AssetEntry {
     pub rc_section: String,
     /// What a failure usually means.
     pub failure_means: String,
+    /// A rule of the RC or a profile choice.
+    pub checks: Checks,
     /// Errata on which a renderer fails this asset (derived, see [`super::model`]).
     pub catches: Vec<Erratum>,
     /// Not required of RC implementations.
@@ -80,8 +103,24 @@ fn terms_json(t: &Terms) -> Value {
     json!({
         "output_quantization": t.output, "blend_rounding": t.blend, "cutoff_edge": t.cutoff,
         "alpha_threshold": t.threshold, "alpha_cap": t.cap, "sh_f16": t.sh_f16,
-        "overbright": t.overbright, "float": t.float,
+        "overbright": t.overbright, "float": t.float, "dilation": t.dilation,
     })
+}
+
+/// The terms as written by [`terms_json`] (a missing key reads as 0: older manifests).
+fn terms_from_json(v: &Value) -> Terms {
+    let f = |k: &str| v[k].as_f64().unwrap_or(0.0);
+    Terms {
+        output: f("output_quantization"),
+        blend: f("blend_rounding"),
+        cutoff: f("cutoff_edge"),
+        threshold: f("alpha_threshold"),
+        cap: f("alpha_cap"),
+        sh_f16: f("sh_f16"),
+        overbright: f("overbright"),
+        float: f("float"),
+        dilation: f("dilation"),
+    }
 }
 
 impl Manifest {
@@ -110,7 +149,8 @@ impl Manifest {
                     .collect();
                 json!({
                     "name": a.name, "file": a.file, "cameras_json": a.cameras_json,
-                    "rule": a.rule, "rc_section": a.rc_section, "failure_means": a.failure_means,
+                    "rule": a.rule, "rc_section": a.rc_section, "checks": a.checks.name(),
+                    "failure_means": a.failure_means,
                     "catches": a.catches.iter().map(|e| e.letter()).collect::<Vec<_>>(),
                     "optional": a.optional, "rc_valid": a.rc_valid, "cameras": cams,
                 })
@@ -159,7 +199,7 @@ impl Manifest {
                     tolerance: Tolerance {
                         max_abs: f(t, "max_abs")?,
                         min_psnr: f(t, "min_psnr")?,
-                        terms: Terms::default(),
+                        terms: terms_from_json(&t["terms"]),
                     },
                 });
             }
@@ -171,7 +211,17 @@ impl Manifest {
                         .ok_or_else(|| format!("manifest: unknown erratum {e}"))
                 })
                 .collect::<Result<_, _>>()?;
+            let checks = match a["checks"].as_str() {
+                None | Some("rc") => Checks::Rc,
+                Some("profile") => Checks::Profile,
+                Some(other) => {
+                    return Err(format!(
+                        "manifest: `checks` is {other:?}, expected \"rc\" or \"profile\""
+                    ));
+                }
+            };
             assets.push(AssetEntry {
+                checks,
                 name: s(&a, "name")?,
                 file: s(&a, "file")?,
                 cameras_json: s(&a, "cameras_json")?,

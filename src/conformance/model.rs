@@ -54,6 +54,9 @@ pub struct Terms {
     pub overbright: f64,
     /// f32 arithmetic.
     pub float: f64,
+    /// RC-silent choices a required asset admits (set by the generator, not by [`render`]):
+    /// the difference the model shows without the 0.3 px² dilation.
+    pub dilation: f64,
 }
 
 impl Terms {
@@ -67,8 +70,9 @@ impl Terms {
             + self.sh_f16
             + self.overbright
             + self.float
+            + self.dilation
     }
-    fn max(self, o: Terms) -> Terms {
+    pub(crate) fn max(self, o: Terms) -> Terms {
         Terms {
             output: self.output.max(o.output),
             blend: self.blend.max(o.blend),
@@ -78,6 +82,7 @@ impl Terms {
             sh_f16: self.sh_f16.max(o.sh_f16),
             overbright: self.overbright.max(o.overbright),
             float: self.float.max(o.float),
+            dilation: self.dilation.max(o.dilation),
         }
     }
 }

@@ -1,33 +1,42 @@
 //! `report.html` (self-contained: thumbnails embedded as data URIs, so the folder can be
 //! zipped and shared) and `report.json`.
 
+use super::manifest::Checks;
 use super::runner::AssetResult;
 use crate::compare::diff_image;
 use crate::image::{Image, PngDepth};
 use base64::Engine;
 use serde_json::{Value, json};
 
-/// Counts over a run.
+/// Counts over a run. `passed`, `failed` and `skipped` count the assets that check a rule of
+/// the RC (`"checks": "rc"`); the profile assets (choices the RC leaves open) are counted
+/// apart and never fail a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Summary {
-    /// Assets that passed.
+    /// RC assets that passed.
     pub passed: usize,
-    /// Assets that failed (optional ones included when their images were given).
+    /// RC assets that failed (optional ones included when their images were given).
     pub failed: usize,
     /// Optional assets without images.
     pub skipped: usize,
+    /// Profile assets whose images match splatgl's choice.
+    pub profile_matched: usize,
+    /// Profile assets whose images differ from it (informative: another RC-silent choice, or
+    /// an error the RC assets do not see).
+    pub profile_differ: usize,
 }
 
 /// Counts the results.
 pub fn summary(results: &[AssetResult]) -> Summary {
     let mut s = Summary::default();
     for r in results {
-        if r.skipped {
-            s.skipped += 1;
-        } else if r.pass() {
-            s.passed += 1;
-        } else {
-            s.failed += 1;
+        let profile = r.asset.checks == Checks::Profile;
+        match (r.skipped, profile, r.pass()) {
+            (true, _, _) => s.skipped += 1,
+            (false, true, true) => s.profile_matched += 1,
+            (false, true, false) => s.profile_differ += 1,
+            (false, false, true) => s.passed += 1,
+            (false, false, false) => s.failed += 1,
         }
     }
     s
@@ -40,9 +49,10 @@ fn num(v: Option<f64>) -> Value {
     }
 }
 
-/// `report.json`: `assets` (per asset `name`, `rule`, `pass`, `psnr`, `max_abs`, `skipped`,
-/// `catches`, `cameras` with the same per camera plus the tolerance and `cause`), `passed`,
-/// `failed`, `skipped` (counts), `source`.
+/// `report.json`: `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
+/// `skipped`, `catches`, `cameras` with the same per camera plus the tolerance and `cause`),
+/// `passed`, `failed`, `skipped` (counts of the RC assets), `profile` {`matched`, `differ`},
+/// `source`.
 pub fn to_json(results: &[AssetResult], source: &str) -> Value {
     let s = summary(results);
     let assets: Vec<Value> = results
@@ -64,6 +74,7 @@ pub fn to_json(results: &[AssetResult], source: &str) -> Value {
                 .collect();
             json!({
                 "name": r.asset.name, "rule": r.asset.rule, "rc_section": r.asset.rc_section,
+                "checks": r.asset.checks.name(),
                 "pass": !r.skipped && r.pass(), "skipped": r.skipped, "optional": r.asset.optional,
                 "psnr": num(r.psnr()), "max_abs": num(r.max_abs()),
                 "catches": r.asset.catches.iter().map(|e| e.letter()).collect::<Vec<_>>(),
@@ -76,6 +87,7 @@ pub fn to_json(results: &[AssetResult], source: &str) -> Value {
         "passed": s.passed,
         "failed": s.failed,
         "skipped": s.skipped,
+        "profile": {"matched": s.profile_matched, "differ": s.profile_differ},
         "assets": assets,
     })
 }
@@ -101,10 +113,13 @@ pub fn to_html(results: &[AssetResult], source: &str) -> String {
     let mut rows = String::new();
     for r in results {
         for c in &r.cameras {
-            let (status, class) = match (r.skipped, c.pass) {
-                (true, _) => ("skipped", "skip"),
-                (false, true) => ("pass", "pass"),
-                (false, false) => ("FAIL", "fail"),
+            let profile = r.asset.checks == Checks::Profile;
+            let (status, class) = match (r.skipped, c.pass, profile) {
+                (true, _, _) => ("skipped", "skip"),
+                (false, true, false) => ("pass", "pass"),
+                (false, false, false) => ("FAIL", "fail"),
+                (false, true, true) => ("matches profile", "pass"),
+                (false, false, true) => ("differs (profile, informative)", "skip"),
             };
             let img = |i: &Image| format!("<img src=\"{}\" alt=\"\">", data_uri(i));
             let actual = c.actual.as_ref().map_or("—".into(), img);
@@ -144,6 +159,8 @@ pub fn to_html(results: &[AssetResult], source: &str) -> String {
          .pass{{color:#060}} .fail{{color:#b00;font-weight:bold}} .skip{{color:#777}}\
          </style></head><body>\n<h1>KHR_gaussian_splatting conformance report</h1>\n\
          <p id=\"summary\">{} passed, {} failed, {} skipped — images: {}</p>\n\
+         <p id=\"profile\">Profile assets (choices the RC leaves open; informative, never a \
+         failure): {} match splatgl's choice, {} differ.</p>\n\
          <p>Expected: splatgl's reference; diff: per-pixel error, white at the tolerance.</p>\n\
          <table id=\"results\"><thead><tr><th>asset / camera / rule</th><th>RC section</th>\
          <th>expected</th><th>actual</th><th>diff</th><th>PSNR</th><th>max error</th>\
@@ -152,6 +169,8 @@ pub fn to_html(results: &[AssetResult], source: &str) -> String {
         s.passed,
         s.failed,
         s.skipped,
-        esc(source)
+        esc(source),
+        s.profile_matched,
+        s.profile_differ
     )
 }
