@@ -64,16 +64,17 @@ fn generated_suite_covers_every_erratum_and_writes_its_files() {
         assert!(d.join(&a.file).is_file() && d.join(&a.cameras_json).is_file());
         for c in &a.cameras {
             assert!(d.join(&c.reference_png).is_file() && d.join(&c.reference_pfm).is_file());
-            // Tight bounds, but for where an RC-silent choice (no dilation) moves a pixel:
-            // there the bound admits it (`dilation`), most at the edges of the thinnest splats.
+            // Tight bounds, but for where a deviation the asset does not test moves a pixel
+            // (isolation): there the bound admits it (`dilation`, `cutoff_shape`,
+            // `sort_order`), most at the edges of the thinnest splats.
             let t = &c.tolerance;
+            let admitted = t.terms.dilation + t.terms.cutoff_shape + t.terms.sort_order;
             assert!(
-                t.max_abs > 0.0 && t.max_abs - t.terms.dilation < 0.1,
+                t.max_abs > 0.0 && t.max_abs - admitted < 0.1,
                 "{}: {t:?}",
                 a.name
             );
-            let floor = if t.terms.dilation > 0.1 { 30.0 } else { 35.0 };
-            assert!(t.min_psnr > floor, "{}: {}", a.name, t.min_psnr);
+            assert!(t.min_psnr > 30.0, "{}: {}", a.name, t.min_psnr);
         }
     }
     let again = Manifest::read(d).unwrap();

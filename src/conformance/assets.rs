@@ -7,6 +7,7 @@
 
 use super::Erratum;
 use super::manifest::Checks;
+use super::model::Variant;
 use crate::cloud::SplatCloud;
 use crate::sh::dc_from_color;
 use crate::write::quantize::dequantize_node;
@@ -62,6 +63,9 @@ pub struct AssetSpec {
     pub checks: Checks,
     /// Errata the asset is designed to catch (the generator checks that it does).
     pub designed_for: &'static [Erratum],
+    /// Implementation variants the asset is designed to detect (its bound does not admit
+    /// them; the generator checks that it detects them).
+    pub detects: &'static [Variant],
     /// Not required of an RC implementation (legacy compatibility).
     pub optional: bool,
     /// Whether the file is valid per the RC (`splatgl validate` passes it).
@@ -88,6 +92,7 @@ impl AssetSpec {
             cameras,
             checks: Checks::Rc,
             designed_for: &[],
+            detects: &[],
             optional: false,
             rc_valid: true,
             json: false,
@@ -95,6 +100,11 @@ impl AssetSpec {
     }
     pub(crate) fn catches(mut self, e: &'static [Erratum]) -> Self {
         self.designed_for = e;
+        self
+    }
+    /// Variants the asset is designed to detect.
+    pub(crate) fn detects(mut self, v: &'static [Variant]) -> Self {
+        self.detects = v;
         self
     }
     /// Marks the asset as checking a choice the RC leaves open (reported apart, never fails).

@@ -2,6 +2,7 @@
 
 use super::Erratum;
 use super::assets::{AssetSpec, CameraSpec, ID, cam, palette, prim, quat, single, splat};
+use super::model::Variant;
 use crate::cloud::SplatCloud;
 
 fn near_plane() -> AssetSpec {
@@ -207,6 +208,7 @@ fn cutoff() -> AssetSpec {
         vec![cam("front", [0.0, 0.0, 3.0])],
     )
     .catches(&[Erratum::F])
+    .detects(&[Variant::BoxCut])
 }
 
 fn blend_order() -> AssetSpec {

@@ -4,6 +4,7 @@ use super::Erratum;
 use super::assets::{
     AssetSpec, CameraSpec, ID, add_quantized, cam, palette, prim, quat, single, splat,
 };
+use super::model::Variant;
 use crate::cloud::{Known, SplatCloud};
 use crate::write::scene::{NodeTransform, SceneDoc, SceneNode, SplatPrimitive};
 use crate::write::{Comp, GltfWriteOptions};
@@ -333,6 +334,7 @@ pub(super) fn instanced_mesh() -> AssetSpec {
     )
 }
 
+/// Isotropic splats: the asset is about the order, so the covariance errata (a, b) leave it.
 pub(super) fn interleaved_primitives() -> AssetSpec {
     let (mut a, mut b) = (SplatCloud::new(0), SplatCloud::new(0));
     for k in 0..3 {
@@ -340,7 +342,7 @@ pub(super) fn interleaved_primitives() -> AssetSpec {
         splat(
             &mut a,
             [0.15 * k as f32 - 0.15, 0.0, z],
-            [0.35, 0.3, 0.3],
+            [0.32; 3],
             ID,
             0.7,
             [0.9, 0.15, 0.1],
@@ -351,7 +353,7 @@ pub(super) fn interleaved_primitives() -> AssetSpec {
         splat(
             &mut b,
             [0.1 - 0.2 * k as f32, 0.1, z],
-            [0.35, 0.3, 0.3],
+            [0.32; 3],
             ID,
             0.7,
             [0.1, 0.3, 0.95],
@@ -399,6 +401,7 @@ pub(super) fn distance_vs_depth() -> AssetSpec {
             ..cam("front", [0.0, 0.0, 0.0])
         }],
     )
+    .detects(&[Variant::ViewDepthOrder])
 }
 
 pub(super) fn color_space(linear: bool) -> AssetSpec {

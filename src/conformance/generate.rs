@@ -3,6 +3,7 @@
 
 use super::assets::{AssetSpec, CameraSpec};
 use super::manifest::{AssetEntry, CameraEntry, Manifest, Tolerance};
+use super::model::Variant;
 use super::{Erratum, HEIGHT, WIDTH, model};
 use crate::camera::Camera;
 use crate::compare::{Comparison, compare};
@@ -135,43 +136,78 @@ fn tolerance(m: &model::ModelImage) -> Tolerance {
     }
 }
 
-/// Errata that are RC-silent choices rather than errors: the RC leaves Σ' to "the same forward
-/// pass algorithm used during training", so the 0.3 px² dilation (erratum i) is splatgl's
-/// profile. Every asset but the one designed for it (`subpixel_dilation`, a profile asset)
-/// admits it in its bound, so a renderer without it fails that asset alone.
-const RC_SILENT_ERRATA: [Erratum; 1] = [Erratum::I];
+/// A deviation an asset's bound can admit: an erratum or an implementation variant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Admitted {
+    Erratum(Erratum),
+    Variant(Variant),
+}
 
-/// The RC-silent choices `spec`'s bound admits: all but those it is designed to check.
-fn admitted_choices(spec: &AssetSpec) -> Vec<Erratum> {
-    RC_SILENT_ERRATA
-        .into_iter()
-        .filter(|e| !spec.designed_for.contains(e))
+/// The field of [`model::Terms`] a deviation widens.
+type TermField = fn(&mut model::Terms) -> &mut f64;
+
+/// The deviations every asset admits unless it is designed to detect them, each with the
+/// [`model::Terms`] field it widens. Isolation: a renderer that makes one of them fails the
+/// assets designed for it and no other.
+/// - the 0.3 px² dilation (erratum i): an RC-silent choice (the RC leaves Σ' to "the same
+///   forward pass algorithm used during training"), detected by `subpixel_dilation`;
+/// - the shape of the cut-off (erratum f's 2.83σ, a 3.33σ bounding box): an RC rule,
+///   detected by `cutoff_three_sigma` alone;
+/// - the order by view depth instead of camera distance: an RC rule, detected by the sorting
+///   assets.
+const ISOLATED: [(Admitted, TermField); 4] = [
+    (Admitted::Erratum(Erratum::I), |t| &mut t.dilation),
+    (Admitted::Erratum(Erratum::F), |t| &mut t.cutoff_shape),
+    (Admitted::Variant(Variant::BoxCut), |t| &mut t.cutoff_shape),
+    (Admitted::Variant(Variant::ViewDepthOrder), |t| {
+        &mut t.sort_order
+    }),
+];
+
+/// Whether `spec` is designed to detect `d` (then its bound does not admit it).
+fn detects(spec: &AssetSpec, d: Admitted) -> bool {
+    match d {
+        Admitted::Erratum(e) => spec.designed_for.contains(&e),
+        Admitted::Variant(v) => spec.detects.contains(&v),
+    }
+}
+
+/// The errata `spec`'s bound admits (their margin check is skipped: they are not its to
+/// catch).
+fn admitted_errata(spec: &AssetSpec) -> Vec<Erratum> {
+    ISOLATED
+        .iter()
+        .filter_map(|(d, _)| match d {
+            Admitted::Erratum(e) if !detects(spec, *d) => Some(*e),
+            _ => None,
+        })
         .collect()
 }
 
-/// Widens a required asset's bound so that a renderer making another RC-silent choice passes:
-/// per pixel, the largest channel difference between the model with and without the
-/// dilation (the `dilation` term).
-fn admit_rc_silent_choices(exact: &mut model::ModelImage, cloud: &crate::SplatCloud, cam: &Camera) {
-    let without = model::render(cloud, cam, &[Erratum::I]).image;
-    let mut worst = 0.0f64;
-    for ((b, p), q) in exact
-        .bound
-        .iter_mut()
-        .zip(&exact.image.pixels)
-        .zip(&without.pixels)
-    {
-        let d = 1.0
-            * (0..3)
+/// Widens the bound by every deviation `spec` admits: per pixel, the largest channel
+/// difference between the model with and without it, added to its term.
+fn admit(exact: &mut model::ModelImage, spec: &AssetSpec, cloud: &crate::SplatCloud, cam: &Camera) {
+    let mut worst = model::Terms::default();
+    for (d, field) in ISOLATED.iter().filter(|(d, _)| !detects(spec, *d)) {
+        let other = match d {
+            Admitted::Erratum(e) => model::render(cloud, cam, &[*e]).image,
+            Admitted::Variant(v) => model::render_with(cloud, cam, &[], &[*v]).image,
+        };
+        // Terms of one field (the two cut-off shapes) take the larger difference.
+        let mut per_field = model::Terms::default();
+        for (i, (p, q)) in exact.image.pixels.iter().zip(&other.pixels).enumerate() {
+            let diff = (0..3)
                 .map(|k| (p[k] as f64 - q[k] as f64).abs())
                 .fold(0.0, f64::max);
-        *b += d;
-        worst = worst.max(d);
+            let extra = (diff - *field(&mut exact.extra[i])).max(0.0);
+            *field(&mut exact.extra[i]) += extra;
+            exact.bound[i] += extra;
+            let w = field(&mut per_field);
+            *w = w.max(*field(&mut exact.extra[i]));
+        }
+        worst = worst.max(per_field);
     }
-    exact.worst = exact.worst.max(model::Terms {
-        dilation: worst,
-        ..Default::default()
-    });
+    exact.worst = exact.worst.max(worst);
 }
 
 /// The asset's cameras as perspective camera nodes (roots, after the content).
@@ -249,10 +285,8 @@ fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
         )?;
         write(&dir.join(&pfm), &reference.encode_pfm())?;
         let mut exact = model::render(cloud, &cam, &[]);
-        let admitted = admitted_choices(spec);
-        if !admitted.is_empty() {
-            admit_rc_silent_choices(&mut exact, cloud, &cam);
-        }
+        let admitted = admitted_errata(spec);
+        admit(&mut exact, spec, cloud, &cam);
         let tolerance = tolerance(&exact);
         let bound_pfm = format!("reference/{image}.bound.pfm");
         let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
@@ -278,6 +312,17 @@ fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
                         margin_text(&img, &reference, &bound, &tolerance)
                     )));
                 }
+            }
+        }
+        for &v in spec.detects {
+            let img = model::render_with(cloud, &cam, &[], &[v]).image;
+            if verdict(&img, &reference, &bound, &tolerance) != Some(true) {
+                return Err(design(format!(
+                    "camera {}: designed to detect {} but its model does not fail clearly ({})",
+                    spec_cam.name,
+                    v.name(),
+                    margin_text(&img, &reference, &bound, &tolerance)
+                )));
             }
         }
         let c2w = DMat3::from_mat4(cam.world_to_camera.as_dmat4()).transpose();

@@ -104,6 +104,7 @@ fn terms_json(t: &Terms) -> Value {
         "output_quantization": t.output, "blend_rounding": t.blend, "cutoff_edge": t.cutoff,
         "alpha_threshold": t.threshold, "alpha_cap": t.cap, "sh_f16": t.sh_f16,
         "overbright": t.overbright, "float": t.float, "dilation": t.dilation,
+        "cutoff_shape": t.cutoff_shape, "sort_order": t.sort_order,
     })
 }
 
@@ -120,6 +121,8 @@ fn terms_from_json(v: &Value) -> Terms {
         overbright: f("overbright"),
         float: f("float"),
         dilation: f("dilation"),
+        cutoff_shape: f("cutoff_shape"),
+        sort_order: f("sort_order"),
     }
 }
 

@@ -20,6 +20,112 @@ use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2, JACOBIAN_CLA
 use crate::reference::{SortMode, back_to_front};
 use glam::{DMat3, DQuat, DVec3};
 
+/// Implementation variants beside the errata: choices and mistakes seen in real renderers,
+/// which the runner's diagnosis tests an image against ([`render_with`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Variant {
+    /// Splats cut by their oriented 3.33σ bounding box instead of the 3σ ellipse.
+    BoxCut,
+    /// Blending order by view depth (camera-space z; per tile or global, the same per pixel)
+    /// instead of camera distance.
+    ViewDepthOrder,
+    /// Opacity scaled by √(det Σ' / det(Σ' + 0.3 I)) (Mip-Splatting / gsplat antialiasing).
+    AaCompensation,
+    /// SH evaluated up to degree 0 only (the RC: "MAY ignore higher-degree coefficients").
+    ShDegree0,
+    /// SH evaluated up to degree 1 only (allowed likewise).
+    ShDegree1,
+    /// SH evaluated up to degree 2 only (allowed likewise).
+    ShDegree2,
+    /// ROTATION read as `(w, x, y, z)` instead of glTF's `(x, y, z, w)`.
+    QuatWxyz,
+    /// SCALE read as log-space (`exp(s)`, the review draft) instead of linear.
+    LogScale,
+    /// Colour as `sigmoid(Σ SH·Y)` instead of `Σ SH·Y + 0.5`.
+    SigmoidColour,
+}
+
+impl Variant {
+    /// All of them.
+    pub const ALL: [Variant; 9] = [
+        Variant::BoxCut,
+        Variant::ViewDepthOrder,
+        Variant::AaCompensation,
+        Variant::ShDegree0,
+        Variant::ShDegree1,
+        Variant::ShDegree2,
+        Variant::QuatWxyz,
+        Variant::LogScale,
+        Variant::SigmoidColour,
+    ];
+    /// A short identifier (the diagnosis's `rule`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::BoxCut => "bounding_box_cutoff",
+            Variant::ViewDepthOrder => "view_depth_order",
+            Variant::AaCompensation => "antialiasing_compensation",
+            Variant::ShDegree0 => "sh_ignored_above_degree_0",
+            Variant::ShDegree1 => "sh_ignored_above_degree_1",
+            Variant::ShDegree2 => "sh_ignored_above_degree_2",
+            Variant::QuatWxyz => "quaternion_read_as_wxyz",
+            Variant::LogScale => "scale_read_as_log",
+            Variant::SigmoidColour => "sigmoid_colour",
+        }
+    }
+    /// What a renderer with this variant does, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Variant::BoxCut => "splats cut by a 3.33σ bounding box instead of the 3σ ellipse",
+            Variant::ViewDepthOrder => {
+                "splats ordered by view depth (camera-space z) instead of distance to the camera"
+            }
+            Variant::AaCompensation => {
+                "opacity scaled by √(det Σ' / det(Σ' + 0.3 I)) (antialiased kernel)"
+            }
+            Variant::ShDegree0 => "SH coefficients above degree 0 ignored",
+            Variant::ShDegree1 => "SH coefficients above degree 1 ignored",
+            Variant::ShDegree2 => "SH coefficients above degree 2 ignored",
+            Variant::QuatWxyz => "ROTATION read as (w, x, y, z) instead of (x, y, z, w)",
+            Variant::LogScale => "SCALE read as ln(scale) (the review draft) instead of linear",
+            Variant::SigmoidColour => "colour = sigmoid(Σ SH·Y) instead of Σ SH·Y + 0.5",
+        }
+    }
+    /// The RC section whose rule the variant departs from.
+    pub fn rc_section(self) -> &'static str {
+        match self {
+            Variant::BoxCut => "RC Ellipse Kernel Rendering (3σ cut-off)",
+            Variant::ViewDepthOrder => "RC Sorting Method (cameraDistance)",
+            Variant::AaCompensation => "RC Ellipse Kernel Rendering (α = opacity · G(x))",
+            Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2 => {
+                "RC Splat Projection: \"Implementations MAY ignore higher-degree coefficients\""
+            }
+            Variant::QuatWxyz => "RC Attributes (ROTATION: xyzw, the usual glTF order)",
+            Variant::LogScale => "RC Attributes (SCALE: linear)",
+            Variant::SigmoidColour => "RC Lighting (colour = Σ SH·Y + 0.5)",
+        }
+    }
+    /// Whether the RC allows it: an image that matches it passes.
+    pub fn rc_allowed(self) -> bool {
+        matches!(
+            self,
+            Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2
+        )
+    }
+    /// The highest SH degree evaluated (3: all).
+    fn sh_cap(v: &[Variant]) -> usize {
+        [
+            (Variant::ShDegree0, 0),
+            (Variant::ShDegree1, 1),
+            (Variant::ShDegree2, 2),
+        ]
+        .into_iter()
+        .filter(|(x, _)| v.contains(x))
+        .map(|(_, d)| d)
+        .min()
+        .unwrap_or(3)
+    }
+}
+
 /// One projected splat.
 #[derive(Debug, Clone, Copy)]
 struct Layer {
@@ -33,6 +139,8 @@ struct Layer {
     f16_err: f64,
     /// Pixels `[x0, x1] × [y0, y1]` (centres, inclusive float bounds) the splat may touch.
     rect: [f64; 4],
+    /// [`Variant::BoxCut`]: the box's half axes (pixels), `None` for the ellipse cut.
+    box_axes: Option<[[f64; 2]; 2]>,
 }
 
 /// Per-pixel error terms, each a worst case over the pixel (see `docs/conformance.md`).
@@ -54,9 +162,13 @@ pub struct Terms {
     pub overbright: f64,
     /// f32 arithmetic.
     pub float: f64,
-    /// RC-silent choices a required asset admits (set by the generator, not by [`render`]):
-    /// the difference the model shows without the 0.3 px² dilation.
+    /// Deviations an asset admits because it does not test them (set by the generator, not by
+    /// [`render`]; isolation): the difference the model shows without the 0.3 px² dilation,
     pub dilation: f64,
+    /// …with another cut-off shape (2.83σ, a 3.33σ bounding box),
+    pub cutoff_shape: f64,
+    /// …and with splats ordered by view depth.
+    pub sort_order: f64,
 }
 
 impl Terms {
@@ -71,6 +183,8 @@ impl Terms {
             + self.overbright
             + self.float
             + self.dilation
+            + self.cutoff_shape
+            + self.sort_order
     }
     pub(crate) fn max(self, o: Terms) -> Terms {
         Terms {
@@ -83,6 +197,8 @@ impl Terms {
             overbright: self.overbright.max(o.overbright),
             float: self.float.max(o.float),
             dilation: self.dilation.max(o.dilation),
+            cutoff_shape: self.cutoff_shape.max(o.cutoff_shape),
+            sort_order: self.sort_order.max(o.sort_order),
         }
     }
 }
@@ -96,6 +212,9 @@ pub struct ModelImage {
     pub bound: Vec<f64>,
     /// The largest value of each term over the image.
     pub worst: Terms,
+    /// Per pixel, the admitted-deviation terms (`dilation`, `cutoff_shape`, `sort_order`)
+    /// the generator added to `bound`.
+    pub extra: Vec<Terms>,
 }
 
 /// Relative width of the band around the 3σ cut and the α threshold where f32 and f64
@@ -112,8 +231,10 @@ fn appendix_basis(d: [f64; 3]) -> [f64; 16] {
     y
 }
 
-fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool) -> ([f64; 3], f64) {
-    let coeffs = cloud.sh_of(i);
+fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool, v: &[Variant]) -> ([f64; 3], f64) {
+    let cap = Variant::sh_cap(v);
+    let all = cloud.sh_of(i);
+    let coeffs = &all[..all.len().min((cap + 1) * (cap + 1))];
     let y = if e {
         appendix_basis(dir)
     } else {
@@ -131,7 +252,7 @@ fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool) -> ([f64; 3], f6
             .fold(0.0, f64::max);
     }
     let f16_err = f16 * 2f64.powi(-11);
-    let c = if e {
+    let c = if e || v.contains(&Variant::SigmoidColour) {
         sum.map(|v| 1.0 / (1.0 + (-v).exp()))
     } else {
         sum.map(|v| (v + crate::profile::SH_DC_BIAS).max(0.0))
@@ -139,8 +260,9 @@ fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool) -> ([f64; 3], f6
     (c, f16_err)
 }
 
-fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> Vec<Layer> {
+fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], vars: &[Variant]) -> Vec<Layer> {
     let on = |e| x.contains(&e);
+    let var = |w| vars.contains(&w);
     let w2c = cam.world_to_camera.as_dmat4();
     let w_cv = DMat3::from_mat4(w2c);
     let flip = DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0));
@@ -159,7 +281,12 @@ fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> Vec<Layer> {
         [JACOBIAN_CLAMP * tan.x, JACOBIAN_CLAMP * tan.y]
     };
     let cull = (NEAR_CULL).max(cam.near as f64);
-    let mut order = back_to_front(&cloud.positions, cam, SortMode::Distance);
+    let mode = if var(Variant::ViewDepthOrder) {
+        SortMode::ViewDepth
+    } else {
+        SortMode::Distance
+    };
+    let mut order = back_to_front(&cloud.positions, cam, mode);
     if on(Erratum::G) {
         order.reverse(); // the appendix's front-to-back
     }
@@ -174,11 +301,19 @@ fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> Vec<Layer> {
             continue;
         }
         let mut q = cloud.rotations[i];
+        if var(Variant::QuatWxyz) {
+            q = [q[1], q[2], q[3], q[0]]; // the stored x taken as w
+        }
         if on(Erratum::A) {
             let c = DQuat::from_array(q.map(f64::from)).conjugate(); // Rᵀ = R(q*)
             q = [c.x as f32, c.y as f32, c.z as f32, c.w as f32];
         }
-        let c = c_matrix(cloud.scales[i], q);
+        let scale = if var(Variant::LogScale) {
+            cloud.scales[i].map(f32::exp)
+        } else {
+            cloud.scales[i]
+        };
+        let c = c_matrix(scale, q);
         let txtz = (t.x / t.z).clamp(-lim[0], lim[0]);
         let tytz = (t.y / t.z).clamp(-lim[1], lim[1]);
         let j0 = DVec3::new(fx / t.z, 0.0, -fx * txtz / t.z);
@@ -193,7 +328,13 @@ fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> Vec<Layer> {
         }
         let (u, v) = (fx * t.x / t.z + cx, fy * t.y / t.z + cy);
         let dir = (mean - eye).normalize().to_array();
-        let (color, f16_err) = colour(cloud, i, dir, on(Erratum::E));
+        let (color, f16_err) = colour(cloud, i, dir, on(Erratum::E), vars);
+        let mut opacity = cloud.opacities[i] as f64;
+        if var(Variant::AaCompensation) {
+            let det0 = p0.cross(p1).length_squared();
+            opacity *= (det0 / det).max(0.0).sqrt();
+        }
+        let box_axes = var(Variant::BoxCut).then(|| box_half_axes(a, b, cc));
         let (rx, ry) = (3.0 * a.sqrt(), 3.0 * cc.sqrt());
         let (centre, rect) = if on(Erratum::D) {
             // Quad ± radius/focal in NDC around the mean; centre (ndc/2 + 1/2)·w/P·2.
@@ -208,25 +349,56 @@ fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> Vec<Layer> {
             let h = cam.height as f64;
             let centre = [u * t.z / fx, h - (h - v) * t.z / fy];
             (centre, [u - hx, u + hx, v - hy, v + hy])
+        } else if let Some([e1, e2]) = box_axes {
+            let (hx, hy) = (e1[0].abs() + e2[0].abs(), e1[1].abs() + e2[1].abs());
+            ([u, v], [u - hx, u + hx, v - hy, v + hy])
         } else {
             ([u, v], [u - rx, u + rx, v - ry, v + ry])
         };
         out.push(Layer {
             centre,
             conic: [cc / det, -b / det, a / det],
-            opacity: cloud.opacities[i] as f64,
+            opacity,
             color,
             f16_err,
             rect,
+            box_axes,
         });
     }
     out
 }
 
+/// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
+/// scaled by 3.33·√λ.
+fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
+    let (mid, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
+    let (l1, l2) = (mid + half, (mid - half).max(0.0));
+    let e1 = if b.abs() > 1e-12 * (a.abs() + c.abs()) {
+        let (x, y) = (b, l1 - a);
+        let n = (x * x + y * y).sqrt();
+        [x / n, y / n]
+    } else if a >= c {
+        [1.0, 0.0]
+    } else {
+        [0.0, 1.0]
+    };
+    let e2 = [-e1[1], e1[0]];
+    let k = 3.33;
+    [
+        [k * l1.sqrt() * e1[0], k * l1.sqrt() * e1[1]],
+        [k * l2.sqrt() * e2[0], k * l2.sqrt() * e2[1]],
+    ]
+}
+
 /// Renders `cloud` (global space, as loaded) from `cam` over a black background with the
 /// errata `x` switched on; with `x` empty also computes the per-pixel bound.
 pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
-    let layers = project(cloud, cam, x);
+    render_with(cloud, cam, x, &[])
+}
+
+/// [`render`] with implementation [`Variant`]s `v` switched on too.
+pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant]) -> ModelImage {
+    let layers = project(cloud, cam, x, v);
     let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display;
     let (f, k, g) = (
         x.contains(&Erratum::F),
@@ -259,7 +431,15 @@ pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
                 if (m2 - cut).abs() <= EDGE_BAND * cut {
                     t.cutoff += raw.min(ALPHA_MAX as f64);
                 }
-                if !(0.0..=cut).contains(&m2) {
+                let inside = match l.box_axes {
+                    // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
+                    Some(ax) => ax.iter().all(|h| {
+                        let n2 = h[0] * h[0] + h[1] * h[1];
+                        (dx * h[0] + dy * h[1]).abs() <= n2 + 1e-12
+                    }),
+                    None => (0.0..=cut).contains(&m2),
+                };
+                if !inside {
                     continue;
                 }
                 let alpha = if k { raw } else { raw.min(ALPHA_MAX as f64) };
@@ -319,6 +499,7 @@ pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
         }
     }
     ModelImage {
+        extra: vec![Terms::default(); bound.len()],
         image,
         bound,
         worst,
