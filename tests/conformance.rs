@@ -172,10 +172,21 @@ fn erratum_proof_gl_fails_exactly_the_assets_that_catch_it() {
             "erratum {}: GL fail set (left) vs derived `catches` (right)",
             e.letter()
         );
-        // The designated assets say which erratum they saw.
+        // The designated assets say which erratum they saw, and the diagnosis names it.
         for r in results.iter().filter(|r| !r.pass()) {
             assert!(r.cameras.iter().any(|c| c.cause.is_some()));
         }
+        let named: Vec<String> = runner::diagnosis(&results)
+            .iter()
+            .map(|x| x.deviation.name())
+            .collect();
+        table.push(format!("   diagnosis: {named:?}"));
+        assert_eq!(
+            named,
+            [format!("erratum_{}", e.letter())],
+            "erratum {}",
+            e.letter()
+        );
     }
     eprintln!("{}", table.join("\n"));
 }
@@ -388,6 +399,103 @@ fn a_renderer_without_dilation_passes_every_rc_asset_and_differs_on_its_profile_
     assert_eq!(differ, [("subpixel_dilation", Checks::Profile)]);
     let s = splatgl::conformance::report::summary(&r);
     assert_eq!((s.failed, s.profile_differ), (0, 1), "{s:?}");
+}
+
+/// The suite rendered by `render(cloud, camera)` for every camera, run through the runner.
+fn run_rendered(
+    render_one: &dyn Fn(&splatgl::SplatCloud, &splatgl::camera::Camera) -> Image,
+) -> Vec<runner::AssetResult> {
+    let (d, m) = suite();
+    let mut images = std::collections::HashMap::new();
+    for ai in 0..m.assets.len() {
+        let (scene, cams) = render::load_asset(d, m, ai).unwrap();
+        for (c, cam) in m.assets[ai].cameras.iter().zip(&cams) {
+            images.insert(c.image.clone(), render_one(&scene.cloud, cam));
+        }
+    }
+    runner::run(d, m, |c| images.get(&c.image).cloned().map(Ok)).unwrap()
+}
+
+/// The RC assets that fail, and the deviations the diagnosis names.
+fn verdict(results: &[runner::AssetResult]) -> (BTreeSet<String>, Vec<String>) {
+    let failed = results
+        .iter()
+        .filter(|r| r.asset.checks == Checks::Rc && !r.pass())
+        .map(|r| r.asset.name.clone())
+        .collect();
+    let named = runner::diagnosis(results)
+        .iter()
+        .map(|x| x.deviation.name())
+        .collect();
+    (failed, named)
+}
+
+/// The planted-bug proof for the implementation variants: the suite rendered with each
+/// variant switched on (the f64 model's implementation) fails exactly the RC assets designed
+/// to detect it where there are such (the isolated ones: box cut-off, view-depth order), no
+/// RC asset where the RC allows it (SH degree caps), and the diagnosis names it. The same
+/// for view-depth order from an implementation that is not the model (the reference
+/// rasterizer's `SortMode::ViewDepth`), and for the pair a real renderer had (3.33σ boxes and
+/// view-depth order together).
+#[test]
+fn planted_variants_fail_only_their_rule_and_the_diagnosis_names_them() {
+    use splatgl::conformance::model::Variant;
+    let (_, m) = suite();
+    let detecting = |names: &[&str]| -> BTreeSet<String> {
+        m.assets
+            .iter()
+            .filter(|a| a.detects.iter().any(|d| names.contains(&d.as_str())))
+            .map(|a| a.name.clone())
+            .collect()
+    };
+    let mut table = Vec::new();
+    for v in Variant::ALL {
+        let r = run_rendered(&|cl, c| model::render_with(cl, c, &[], &[v]).image);
+        let (failed, named) = verdict(&r);
+        table.push(format!(
+            "{}: {} RC assets fail, diagnosis {named:?}",
+            v.name(),
+            failed.len()
+        ));
+        if v.rc_allowed() {
+            assert!(failed.is_empty(), "{}: {failed:?}", v.name());
+            continue;
+        }
+        let designed = detecting(&[v.name()]);
+        if !designed.is_empty() {
+            assert_eq!(
+                failed,
+                designed,
+                "{}: fail set vs the assets that detect it",
+                v.name()
+            );
+        }
+        assert!(!failed.is_empty(), "{}: no RC asset fails", v.name());
+        assert_eq!(named, [v.name()], "{}", v.name());
+    }
+    eprintln!("{}", table.join("\n"));
+    // An independent implementation of view-depth order.
+    use splatgl::reference::{RenderOptions, SortMode, render_display};
+    let r = run_rendered(&|cl, c| {
+        let o = RenderOptions {
+            sort: SortMode::ViewDepth,
+            ..Default::default()
+        };
+        render_display(cl, c, &o, cl.meta.color_space.effective()).0
+    });
+    let (failed, named) = verdict(&r);
+    assert_eq!(failed, detecting(&["view_depth_order"]));
+    assert_eq!(named, ["view_depth_order"]);
+    // Two deviations at once: each fails its own assets, and both are named.
+    let pair = [Variant::BoxCut, Variant::ViewDepthOrder];
+    let r = run_rendered(&|cl, c| model::render_with(cl, c, &[], &pair).image);
+    let (failed, mut named) = verdict(&r);
+    named.sort();
+    assert_eq!(
+        failed,
+        detecting(&["bounding_box_cutoff", "view_depth_order"])
+    );
+    assert_eq!(named, ["bounding_box_cutoff", "view_depth_order"]);
 }
 
 /// The HTML report opens in headless Chromium: the title and one table row per camera.

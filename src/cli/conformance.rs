@@ -112,6 +112,15 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
         report::to_html(&results, &source).as_bytes(),
     )?;
     let s = report::summary(&results);
+    for d in splatgl::conformance::runner::diagnosis(&results) {
+        println!(
+            "DIAGNOSIS {}: {} [{}] — assets: {}",
+            d.deviation.name(),
+            d.deviation.describe(),
+            d.deviation.rc_section(),
+            d.assets.join(", ")
+        );
+    }
     for r in results.iter().filter(|r| !r.skipped && !r.pass()) {
         let word = match r.asset.checks {
             splatgl::conformance::manifest::Checks::Rc => "FAIL",

@@ -361,6 +361,7 @@ fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
         rc_section: spec.section.to_owned(),
         failure_means: spec.failure_means.to_owned(),
         checks: spec.checks,
+        detects: spec.detects.iter().map(|v| v.name().to_owned()).collect(),
         catches: catches.into_iter().collect(),
         optional: spec.optional,
         rc_valid: spec.rc_valid,

@@ -80,6 +80,9 @@ pub struct AssetEntry {
     pub checks: Checks,
     /// Errata on which a renderer fails this asset (derived, see [`super::model`]).
     pub catches: Vec<Erratum>,
+    /// Implementation variants this asset is designed to detect (their
+    /// [`super::model::Variant::name`]s); every other asset's bound admits them.
+    pub detects: Vec<String>,
     /// Not required of RC implementations.
     pub optional: bool,
     /// Valid per the RC (`splatgl validate` passes it).
@@ -155,6 +158,7 @@ impl Manifest {
                     "rule": a.rule, "rc_section": a.rc_section, "checks": a.checks.name(),
                     "failure_means": a.failure_means,
                     "catches": a.catches.iter().map(|e| e.letter()).collect::<Vec<_>>(),
+                    "detects": a.detects,
                     "optional": a.optional, "rc_valid": a.rc_valid, "cameras": cams,
                 })
             })
@@ -223,8 +227,17 @@ impl Manifest {
                     ));
                 }
             };
+            let detects = a["detects"]
+                .as_array()
+                .map(|l| {
+                    l.iter()
+                        .filter_map(|x| x.as_str().map(str::to_owned))
+                        .collect()
+                })
+                .unwrap_or_default();
             assets.push(AssetEntry {
                 checks,
+                detects,
                 name: s(&a, "name")?,
                 file: s(&a, "file")?,
                 cameras_json: s(&a, "cameras_json")?,

@@ -13,6 +13,7 @@ pub mod assets;
 mod assets_light;
 mod assets_pixel;
 mod assets_scene;
+pub mod diagnosis;
 mod generate;
 pub mod manifest;
 pub mod model;

@@ -1,8 +1,9 @@
 //! `report.html` (self-contained: thumbnails embedded as data URIs, so the folder can be
 //! zipped and shared) and `report.json`.
 
+use super::diagnosis::Diagnosis;
 use super::manifest::Checks;
-use super::runner::AssetResult;
+use super::runner::{AssetResult, diagnosis};
 use crate::compare::diff_image;
 use crate::image::{Image, PngDepth};
 use base64::Engine;
@@ -49,7 +50,8 @@ fn num(v: Option<f64>) -> Value {
     }
 }
 
-/// `report.json`: `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
+/// `report.json`: `diagnosis` (the smallest set of deviations that explains every failing
+/// camera, [`diagnosis_json`]), `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
 /// `skipped`, `catches`, `cameras` with the same per camera plus the tolerance and `cause`),
 /// `passed`, `failed`, `skipped` (counts of the RC assets), `profile` {`matched`, `differ`},
 /// `source`.
@@ -84,12 +86,63 @@ pub fn to_json(results: &[AssetResult], source: &str) -> Value {
         .collect();
     json!({
         "source": source,
+        "diagnosis": diagnosis(results).iter().map(diagnosis_json).collect::<Vec<_>>(),
         "passed": s.passed,
         "failed": s.failed,
         "skipped": s.skipped,
         "profile": {"matched": s.profile_matched, "differ": s.profile_differ},
         "assets": assets,
     })
+}
+
+/// One `diagnosis` entry: `rule`, `rc_section`, `description`, `rc_allowed`, `assets`,
+/// `evidence` (per camera `image`, `psnr_reference`, `max_abs_reference`, `psnr_model`,
+/// `max_abs_model`).
+fn diagnosis_json(d: &Diagnosis) -> Value {
+    let evidence: Vec<Value> = d
+        .evidence
+        .iter()
+        .map(|e| {
+            json!({
+                "image": e.image,
+                "psnr_reference": num(Some(e.reference.0)), "max_abs_reference": e.reference.1,
+                "psnr_model": num(Some(e.model.0)), "max_abs_model": e.model.1,
+            })
+        })
+        .collect();
+    json!({
+        "rule": d.deviation.name(), "rc_section": d.deviation.rc_section(),
+        "description": d.deviation.describe(), "rc_allowed": d.deviation.rc_allowed(),
+        "assets": d.assets, "evidence": evidence,
+    })
+}
+
+/// The HTML list that leads the report: each deviation found, its RC section, the assets.
+fn diagnosis_html(results: &[AssetResult]) -> String {
+    let d = diagnosis(results);
+    if d.is_empty() {
+        return "<p id=\"diagnosis\">Diagnosis: no failure to explain.</p>\n".into();
+    }
+    let items: String = d
+        .iter()
+        .map(|x| {
+            let worst = x
+                .evidence
+                .iter()
+                .map(|e| e.reference.0)
+                .fold(f64::INFINITY, f64::min);
+            format!(
+                "<li><b>{}</b> — {} <small>({})</small><br>assets: {}<br>\
+                 <small>worst camera {worst:.1} dB against the reference; each explained camera \
+                 passes against the model with this deviation</small></li>\n",
+                esc(&x.deviation.name()),
+                esc(&x.deviation.describe()),
+                esc(&x.deviation.rc_section()),
+                esc(&x.assets.join(", ")),
+            )
+        })
+        .collect();
+    format!("<h2>Diagnosis</h2>\n<ul id=\"diagnosis\">\n{items}</ul>\n")
 }
 
 fn data_uri(img: &Image) -> String {
@@ -158,7 +211,7 @@ pub fn to_html(results: &[AssetResult], source: &str) -> String {
          td small{{color:#555}} img{{image-rendering:pixelated;width:128px}}\
          .pass{{color:#060}} .fail{{color:#b00;font-weight:bold}} .skip{{color:#777}}\
          </style></head><body>\n<h1>KHR_gaussian_splatting conformance report</h1>\n\
-         <p id=\"summary\">{} passed, {} failed, {} skipped — images: {}</p>\n\
+         {}<p id=\"summary\">{} passed, {} failed, {} skipped — images: {}</p>\n\
          <p id=\"profile\">Profile assets (choices the RC leaves open; informative, never a \
          failure): {} match splatgl's choice, {} differ.</p>\n\
          <p>Expected: splatgl's reference; diff: per-pixel error, white at the tolerance.</p>\n\
@@ -166,6 +219,7 @@ pub fn to_html(results: &[AssetResult], source: &str) -> String {
          <th>expected</th><th>actual</th><th>diff</th><th>PSNR</th><th>max error</th>\
          <th>result</th><th>likely cause</th></tr></thead><tbody>\n{rows}</tbody></table>\
          </body></html>\n",
+        diagnosis_html(results),
         s.passed,
         s.failed,
         s.skipped,

@@ -1,0 +1,313 @@
+//! Explaining failures with models: each failing camera's image is tested against the f64
+//! model ([`super::model`]) with known deviations switched on — the review draft's errata,
+//! the implementation [`Variant`]s, flipped images — singly and in pairs; then the smallest
+//! set of deviations that explains every failing camera is chosen ([`diagnose`]).
+//!
+//! A deviation *explains* a camera when the image passes that camera's tolerance (per-pixel
+//! bound, `max_abs`, `min_psnr`) against the model rendered with the deviation instead of
+//! against the reference.
+
+use super::Erratum;
+use super::generate::fails;
+use super::manifest::{AssetEntry, CameraEntry};
+use super::model::{self, Variant};
+use crate::SplatCloud;
+use crate::camera::Camera;
+use crate::compare::compare;
+use crate::image::Image;
+
+/// A way of rendering differently from the RC that the diagnosis knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Deviation {
+    /// A review-draft Appendix A erratum.
+    Erratum(Erratum),
+    /// An implementation variant.
+    Variant(Variant),
+    /// The image upside down (rows not flipped after a GL read-back, or y up vs down).
+    UpsideDown,
+    /// The image mirrored left-right (handedness or x axis flipped).
+    Mirrored,
+}
+
+impl Deviation {
+    /// Every deviation tried singly.
+    pub fn all() -> Vec<Deviation> {
+        let mut v: Vec<Deviation> = Erratum::ALL.into_iter().map(Deviation::Erratum).collect();
+        v.extend(Variant::ALL.into_iter().map(Deviation::Variant));
+        v.extend([Deviation::UpsideDown, Deviation::Mirrored]);
+        v
+    }
+    /// A short identifier (`rule` in `report.json`'s `diagnosis`).
+    pub fn name(self) -> String {
+        match self {
+            Deviation::Erratum(e) => format!("erratum_{}", e.letter()),
+            Deviation::Variant(v) => v.name().to_owned(),
+            Deviation::UpsideDown => "upside_down".into(),
+            Deviation::Mirrored => "mirrored".into(),
+        }
+    }
+    /// What the renderer does, in words.
+    pub fn describe(self) -> String {
+        match self {
+            Deviation::Erratum(e) => {
+                format!("review-draft erratum {}: {}", e.letter(), e.describe())
+            }
+            Deviation::Variant(v) => v.describe().to_owned(),
+            Deviation::UpsideDown => {
+                "the image is upside down (rows not flipped after a GL read-back, or y up vs down)"
+                    .into()
+            }
+            Deviation::Mirrored => {
+                "the image is mirrored left-right (handedness or x axis flipped)".into()
+            }
+        }
+    }
+    /// The section of the RC whose rule it breaks (or allows, for the SH degree caps).
+    pub fn rc_section(self) -> String {
+        match self {
+            Deviation::Erratum(e) => match e {
+                Erratum::A => "RC Splat Reconstruction (C = R(q)·S)",
+                Erratum::B => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
+                Erratum::D => "RC Splat Projection (pixel mapping)",
+                Erratum::E => "RC Lighting (basis with Condon–Shortley signs, Σ SH·Y + 0.5)",
+                Erratum::F => "RC Ellipse Kernel Rendering (3σ cut-off)",
+                Erratum::G => "RC Splat Composition (premultiplied, back to front)",
+                Erratum::I => "profile: dilation (RC: the training forward pass)",
+                Erratum::K => "profile: J clamp and α cap (3DGS computeCov2D)",
+            }
+            .into(),
+            Deviation::Variant(v) => v.rc_section().into(),
+            Deviation::UpsideDown | Deviation::Mirrored => {
+                "glTF 2.0 §3.4 coordinate system; image rows top to bottom".into()
+            }
+        }
+    }
+    /// Whether the RC allows it (an image matching it passes).
+    pub fn rc_allowed(self) -> bool {
+        matches!(self, Deviation::Variant(v) if v.rc_allowed())
+    }
+}
+
+/// One candidate that explains a camera, with its evidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Explanation {
+    /// The deviations switched on (one or two).
+    pub deviations: Vec<Deviation>,
+    /// PSNR of the image against the model with them.
+    pub psnr: f64,
+    /// Largest error against it.
+    pub max_abs: f64,
+}
+
+/// The image a renderer with `devs` draws for `cam` (the model's, display RGB).
+pub fn model_image(cloud: &SplatCloud, cam: &Camera, devs: &[Deviation]) -> Image {
+    let errata: Vec<Erratum> = devs
+        .iter()
+        .filter_map(|d| match d {
+            Deviation::Erratum(e) => Some(*e),
+            _ => None,
+        })
+        .collect();
+    let variants: Vec<Variant> = devs
+        .iter()
+        .filter_map(|d| match d {
+            Deviation::Variant(v) => Some(*v),
+            _ => None,
+        })
+        .collect();
+    let mut img = model::render_with(cloud, cam, &errata, &variants).image;
+    if devs.contains(&Deviation::UpsideDown) {
+        img = flipped(&img, true);
+    }
+    if devs.contains(&Deviation::Mirrored) {
+        img = flipped(&img, false);
+    }
+    img
+}
+
+/// `img` flipped vertically (`vertical`) or mirrored left-right.
+pub fn flipped(img: &Image, vertical: bool) -> Image {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let mut out = img.clone();
+    for y in 0..h {
+        for x in 0..w {
+            let (sx, sy) = if vertical {
+                (x, h - 1 - y)
+            } else {
+                (w - 1 - x, y)
+            };
+            out.pixels[y * w + x] = img.pixels[sy * w + sx];
+        }
+    }
+    out
+}
+
+/// At most this many of the single deviations that bring the image closest are paired.
+const PAIRED: usize = 4;
+
+/// The candidates (single deviations, then pairs of the closest singles) that explain a
+/// failing camera: `actual` passes `camera`'s tolerance against the model with them.
+pub fn explain(
+    cloud: &SplatCloud,
+    cam: &Camera,
+    camera: &CameraEntry,
+    actual: &Image,
+    bound: &[f64],
+) -> Vec<Explanation> {
+    let t = &camera.tolerance;
+    let score = |devs: &[Deviation]| {
+        let m = model_image(cloud, cam, devs);
+        let c = compare(actual, &m, 0.0).ok()?;
+        let ok = !fails(actual, &m, bound, t);
+        Some((ok, c.psnr, c.max_abs as f64))
+    };
+    let mut singles = Vec::new();
+    let mut out = Vec::new();
+    for d in Deviation::all() {
+        let Some((ok, psnr, max_abs)) = score(&[d]) else {
+            continue;
+        };
+        if ok {
+            out.push(Explanation {
+                deviations: vec![d],
+                psnr,
+                max_abs,
+            });
+        }
+        singles.push((psnr, d));
+    }
+    if !out.is_empty() {
+        return out;
+    }
+    singles.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let best: Vec<Deviation> = singles.iter().take(PAIRED).map(|(_, d)| *d).collect();
+    for (i, a) in best.iter().enumerate() {
+        for b in &best[i + 1..] {
+            if let Some((true, psnr, max_abs)) = score(&[*a, *b]) {
+                out.push(Explanation {
+                    deviations: vec![*a, *b],
+                    psnr,
+                    max_abs,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Evidence for one camera: the image against the reference and against the deviation's
+/// model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evidence {
+    /// `ASSET/CAMERA`.
+    pub image: String,
+    /// PSNR and max error against splatgl's reference.
+    pub reference: (f64, f64),
+    /// PSNR and max error against the model with the deviation(s).
+    pub model: (f64, f64),
+}
+
+/// One entry of the diagnosis: a deviation and the failing cameras it explains.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnosis {
+    /// The deviation.
+    pub deviation: Deviation,
+    /// Assets with a camera it explains.
+    pub assets: Vec<String>,
+    /// Per explained camera.
+    pub evidence: Vec<Evidence>,
+}
+
+/// A failing camera and what explains it.
+#[derive(Debug, Clone)]
+pub struct Failure<'a> {
+    /// Its asset.
+    pub asset: &'a AssetEntry,
+    /// The camera.
+    pub camera: &'a CameraEntry,
+    /// PSNR and max error against the reference.
+    pub reference: (f64, f64),
+    /// The candidates that explain it.
+    pub explained_by: &'a [Explanation],
+}
+
+/// The smallest set of deviations that explains the failures, greedily: the candidate that
+/// explains most of the cameras not yet explained is taken (a pair brings both its
+/// deviations), until no candidate explains another; ties go to the earlier deviation.
+/// Returns the entries and, per failure, the candidate chosen for it (`None`: unexplained).
+pub fn diagnose(failures: &[Failure]) -> (Vec<Diagnosis>, Vec<Option<Explanation>>) {
+    let mut chosen: Vec<Deviation> = Vec::new();
+    let mut assigned: Vec<Option<Explanation>> = vec![None; failures.len()];
+    loop {
+        let covered =
+            |e: &Explanation, with: &[Deviation]| e.deviations.iter().all(|d| with.contains(d));
+        // Candidates: every explanation's deviation set; score = cameras it would newly cover.
+        let mut best: Option<(usize, Vec<Deviation>)> = None;
+        for f in failures.iter().zip(&assigned).filter(|(_, a)| a.is_none()) {
+            for e in f.0.explained_by {
+                let mut with = chosen.clone();
+                with.extend(e.deviations.iter().copied());
+                let n = failures
+                    .iter()
+                    .zip(&assigned)
+                    .filter(|(g, a)| {
+                        a.is_none() && g.explained_by.iter().any(|x| covered(x, &with))
+                    })
+                    .count();
+                let better = match &best {
+                    None => true,
+                    Some((m, d)) => n > *m || (n == *m && e.deviations < *d),
+                };
+                if better {
+                    best = Some((n, e.deviations.clone()));
+                }
+            }
+        }
+        let Some((n, devs)) = best else { break };
+        if n == 0 {
+            break;
+        }
+        chosen.extend(
+            devs.iter()
+                .copied()
+                .filter(|d| !chosen.contains(d))
+                .collect::<Vec<_>>(),
+        );
+        for (f, a) in failures.iter().zip(assigned.iter_mut()) {
+            if a.is_none() {
+                *a = f
+                    .explained_by
+                    .iter()
+                    .filter(|x| covered(x, &chosen))
+                    .max_by(|x, y| x.psnr.total_cmp(&y.psnr))
+                    .cloned();
+            }
+        }
+    }
+    let mut entries: Vec<Diagnosis> = Vec::new();
+    for (f, a) in failures.iter().zip(&assigned) {
+        let Some(e) = a else { continue };
+        for d in &e.deviations {
+            let entry = match entries.iter_mut().position(|x| x.deviation == *d) {
+                Some(i) => &mut entries[i],
+                None => {
+                    entries.push(Diagnosis {
+                        deviation: *d,
+                        assets: Vec::new(),
+                        evidence: Vec::new(),
+                    });
+                    entries.last_mut().expect("just pushed")
+                }
+            };
+            if !entry.assets.contains(&f.asset.name) {
+                entry.assets.push(f.asset.name.clone());
+            }
+            entry.evidence.push(Evidence {
+                image: f.camera.image.clone(),
+                reference: f.reference,
+                model: (e.psnr, e.max_abs),
+            });
+        }
+    }
+    (entries, assigned)
+}
