@@ -51,7 +51,7 @@ fn num(v: Option<f64>) -> Value {
 }
 
 /// `report.json`: `diagnosis` (the smallest set of deviations that explains every failing
-/// camera, [`diagnosis_json`]), `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
+/// camera: `rule`, `rc_section`, `description`, `rc_allowed`, `assets`, `evidence`), `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
 /// `skipped`, `catches`, `cameras` with the same per camera plus the tolerance and `cause`),
 /// `passed`, `failed`, `skipped` (counts of the RC assets), `profile` {`matched`, `differ`},
 /// `source`.

@@ -108,7 +108,7 @@ fn allowed_choice(
 
 /// Compares the images `get(camera)` returns (`None`: missing; `Err`: unreadable) with the
 /// references in `dir`; a failing camera is explained with the diagnosis's models, and its
-/// `cause` names the deviation the whole run's [`diagnosis`] attributes it to (or says
+/// `cause` names the deviation the whole run's [`diagnosis()`] attributes it to (or says
 /// `unexplained`, with the asset's stock hint). `Err` only when a reference cannot be read
 /// (a broken suite).
 pub fn run(
