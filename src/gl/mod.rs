@@ -49,8 +49,13 @@ mod context;
 pub(crate) mod data;
 mod draw;
 mod error;
+// Fault injection for the GL tests: public (hidden) only with the `testing` feature; without
+// it every lookup is a constant and nothing thread-local is read on a production path.
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub mod fault;
+#[cfg(not(feature = "testing"))]
+mod fault;
 mod glsl;
 mod objects;
 mod prepass;
