@@ -49,6 +49,7 @@ mod context;
 pub(crate) mod data;
 mod draw;
 mod error;
+pub mod frame;
 // Fault injection for the GL tests: public (hidden) only with the `testing` feature; without
 // it every lookup is a constant and nothing thread-local is read on a production path.
 #[cfg(feature = "testing")]

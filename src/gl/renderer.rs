@@ -309,6 +309,12 @@ impl SplatRenderer {
         self.color_space
     }
 
+    /// Whether this context can switch `GL_FRAMEBUFFER_SRGB` (desktop GL, or GLES with
+    /// `EXT_sRGB_write_control`): then an sRGB framebuffer encodes only with it on.
+    pub fn srgb_write_switch(&self) -> bool {
+        self.ctx.srgb_switch
+    }
+
     /// SH degree of the uploaded cloud.
     pub fn cloud_sh_degree(&self) -> u8 {
         self.cloud_degree

@@ -5,9 +5,9 @@ use super::{HeadlessContext, HeadlessError};
 use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
 use crate::cull::CullBounds;
+use crate::gl::frame::{Blend, FrameTargets, Output};
 use crate::gl::{
-    ColorFormat, DistanceSorter, DrawPath, DrawSettings, Errata, GlError, OffscreenTarget,
-    ReadbackTarget, SplatRenderer, frustum_for_camera,
+    DistanceSorter, DrawPath, DrawSettings, Errata, SplatRenderer, frustum_for_camera,
 };
 use crate::image::Image;
 use glow::HasContext;
@@ -50,8 +50,7 @@ pub struct HeadlessOptions {
 #[derive(Debug)]
 pub struct HeadlessRenderer {
     renderer: SplatRenderer,
-    target: Option<ReadbackTarget>,
-    offscreen: Option<OffscreenTarget>,
+    targets: FrameTargets,
     /// Means and cull radii of the uploaded cloud, for the sorter.
     positions: Vec<[f32; 3]>,
     bounds: CullBounds,
@@ -90,8 +89,7 @@ impl HeadlessRenderer {
         let renderer = SplatRenderer::with_errata(ctx.gl(), errata)?;
         Ok(HeadlessRenderer {
             renderer,
-            target: None,
-            offscreen: None,
+            targets: FrameTargets::default(),
             positions: Vec::new(),
             bounds: CullBounds::default(),
             cull: errata == Errata::default(),
@@ -162,99 +160,33 @@ impl HeadlessRenderer {
         order: &[u32],
     ) -> Result<Image, HeadlessError> {
         self.ctx.make_current()?;
-        let space = opts.color_space.unwrap_or(self.renderer.color_space());
-        let linear = space == ColorSpace::LinRec709Display;
         let (w, h) = (camera.width, camera.height);
         if w == 0 || h == 0 {
             return Ok(Image::filled(w, h, [0.0; 4])); // no pixels (a 0-sized FBO is incomplete)
         }
-        let srgb_fbo = linear && opts.target == TargetKind::Rgba8;
-        self.prepare_targets(w, h, srgb_fbo, opts.target)?;
-        let bg = if linear {
-            opts.background
-                .map(|c| crate::profile::srgb_decode(c as f64) as f32)
-        } else {
-            opts.background
-        };
         let settings = DrawSettings {
             sh_degree: opts.sh_degree,
             depth_test: false,
-            color_space: Some(space),
+            color_space: Some(opts.color_space.unwrap_or(self.renderer.color_space())),
             ..DrawSettings::default()
         };
-        let gl = self.ctx.gl();
-        let target = self.target.as_ref().expect("prepared above");
-        // Where GL_FRAMEBUFFER_SRGB can be switched (desktop GL, ES with
-        // EXT_sRGB_write_control) the sRGB target encodes only with it on: the clear needs it
-        // as the draw does (which sets it itself, from `color_space`, and leaves it so).
-        let srgb_switch = !gl.version().is_embedded
-            || gl
-                .supported_extensions()
-                .contains("GL_EXT_sRGB_write_control");
-        target.bind(gl)?;
-        // SAFETY: a capability switch and a clear of our own framebuffer, bound just above.
-        unsafe {
-            if srgb_switch && srgb_fbo {
-                gl.enable(glow::FRAMEBUFFER_SRGB);
-            }
-            gl.clear_color(bg[0], bg[1], bg[2], 0.0);
-            gl.clear(glow::COLOR_BUFFER_BIT);
-        }
-        let (renderer, offscreen) = (&mut self.renderer, &mut self.offscreen);
-        let drawn = (|| {
-            renderer.set_order(gl, order)?;
-            match opts.target {
-                TargetKind::Rgba8 => renderer.draw_current_with(gl, camera, &settings),
-                TargetKind::Rgba16fResolve => {
-                    let offscreen = offscreen.as_mut().expect("prepared above");
-                    offscreen.begin(gl, [bg[0], bg[1], bg[2], 0.0])?;
-                    renderer.draw_current_with(gl, camera, &settings)?;
-                    offscreen.resolve(gl, linear)
-                }
-            }
-        })();
-        let image = drawn
-            .and_then(|()| crate::gl::check_error(gl, "rendering"))
-            .and_then(|()| target.read_image(gl));
-        // SAFETY: unbinding our framebuffer.
-        unsafe { gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
-        Ok(image?)
-    }
-
-    /// (Re)creates the 8-bit target (sRGB or not) and, for `Rgba16fResolve`, the float target,
-    /// when the size or format changed.
-    fn prepare_targets(
-        &mut self,
-        w: u32,
-        h: u32,
-        srgb: bool,
-        kind: TargetKind,
-    ) -> Result<(), GlError> {
-        let gl = self.ctx.gl();
-        let format = if srgb {
-            ColorFormat::Srgb8Alpha8
-        } else {
-            ColorFormat::Rgba8
+        let blend = match opts.target {
+            TargetKind::Rgba8 => Blend::Rgba8,
+            TargetKind::Rgba16fResolve => Blend::Rgba16f,
         };
-        if self
-            .target
-            .as_ref()
-            .is_none_or(|t| (t.size(), t.format()) != ((w, h), format))
-        {
-            if let Some(mut t) = self.target.take() {
-                t.destroy(gl);
-            }
-            self.target = Some(ReadbackTarget::new(gl, w, h, format, None)?);
-        }
-        if kind == TargetKind::Rgba16fResolve
-            && self.offscreen.as_ref().is_none_or(|t| t.size() != (w, h))
-        {
-            if let Some(mut t) = self.offscreen.take() {
-                t.destroy(gl);
-            }
-            self.offscreen = Some(OffscreenTarget::new(gl, w, h)?);
-        }
-        Ok(())
+        let gl = self.ctx.gl();
+        self.renderer.set_order(gl, order)?;
+        let image = self.targets.draw(
+            gl,
+            &self.renderer,
+            camera,
+            &settings,
+            opts.background,
+            blend,
+            Output::Image,
+            "rendering",
+        )?;
+        Ok(image.expect("Output::Image returns the image"))
     }
 
     /// Blocks until the GL has finished all commands (for timing).
@@ -269,17 +201,11 @@ impl Drop for HeadlessRenderer {
         if self.ctx.make_current().is_err() {
             // The objects go with the context (destroyed right after this).
             self.renderer.abandon();
-            self.target.iter_mut().for_each(ReadbackTarget::abandon);
-            self.offscreen.iter_mut().for_each(OffscreenTarget::abandon);
+            self.targets.abandon();
             return;
         }
         let gl = self.ctx.gl();
         self.renderer.destroy(gl);
-        if let Some(t) = &mut self.target {
-            t.destroy(gl);
-        }
-        if let Some(t) = &mut self.offscreen {
-            t.destroy(gl);
-        }
+        self.targets.destroy(gl);
     }
 }
