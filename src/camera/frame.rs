@@ -64,7 +64,7 @@ impl UpAxis {
         let why = match up {
             UpAxis::Y => "glTF: +Y up by the glTF specification",
             UpAxis::Z => "stands on z = 0 and is clearly taller along +Z than wide",
-            UpAxis::NegY => "3DGS training output in COLMAP axes (PLY and the packed formats)",
+            UpAxis::NegY => "PLY and the packed formats: 3DGS training output in COLMAP axes",
         };
         (up, why)
     }

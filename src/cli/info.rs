@@ -59,6 +59,20 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         println!("{info:#}");
         return ExitCode::SUCCESS;
     }
+    print_text(&a, &loaded, &info, &opts.limits);
+    ExitCode::SUCCESS
+}
+
+/// The text output of `info` (`info` holds the JSON values it shares).
+fn print_text(
+    a: &super::FileArgs,
+    loaded: &splatgl::load::Scene,
+    info: &serde_json::Value,
+    limits: &splatgl::load::Limits,
+) {
+    let (c, r) = (&loaded.cloud, &loaded.report);
+    let b = c.bounds();
+    let (up, up_rule) = splatgl::camera::UpAxis::for_cloud_explained(Some(r.format), c);
     println!("file:           {}", a.file.display());
     println!("format:         {}", r.format.name());
     println!("splats:         {}", c.len());
@@ -81,11 +95,11 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "memory:         {:.1} MiB",
         c.memory_bytes() as f64 / 1048576.0
     );
-    if let Some(d) = details {
+    if let Some(d) = &r.details {
         print_details(d);
     }
     if a.verbose {
-        super::print_limits(&opts.limits);
+        super::print_limits(limits);
     }
     if r.non_finite_opacities > 0 {
         println!(
@@ -101,7 +115,6 @@ pub fn run(a: super::FileArgs) -> ExitCode {
             println!("note: {n}");
         }
     }
-    ExitCode::SUCCESS
 }
 
 /// The container lines of the text output.

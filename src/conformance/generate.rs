@@ -234,11 +234,20 @@ fn add_cameras(doc: &mut crate::write::scene::SceneDoc, spec: &AssetSpec) {
     }
 }
 
-fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
-    let design = |message: String| GenerateError::Design {
+fn design_error(spec: &AssetSpec, message: String) -> GenerateError {
+    GenerateError::Design {
         asset: spec.name.to_owned(),
         message,
-    };
+    }
+}
+
+/// Writes the asset's file (with its camera nodes), checks `rc_valid` against `splatgl
+/// validate`, and loads it back as a renderer would; returns the file's name and the scene.
+fn write_asset_file(
+    dir: &Path,
+    spec: &AssetSpec,
+) -> Result<(String, crate::load::Scene), GenerateError> {
+    let design = |m| design_error(spec, m);
     let mut doc = spec.doc.clone();
     add_cameras(&mut doc, spec);
     let ext = if spec.json { "gltf" } else { "glb" };
@@ -264,91 +273,137 @@ fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
     if scene.cameras.len() != spec.cameras.len() {
         return Err(design(format!("{} cameras loaded", scene.cameras.len())));
     }
-    let cloud = &scene.cloud;
+    Ok((file, scene))
+}
+
+/// Which errata the camera's tolerance catches (those the asset admits are skipped), and
+/// that it detects its variants; an error when a verdict lands within the margin.
+fn catches_of(
+    spec: &AssetSpec,
+    spec_cam: &CameraSpec,
+    (cloud, cam): (&crate::SplatCloud, &Camera),
+    (reference, bound, tolerance): (&Image, &[f64], &Tolerance),
+) -> Result<Vec<Erratum>, GenerateError> {
+    let admitted = admitted_errata(spec);
+    let mut caught = Vec::new();
+    for e in Erratum::ALL.into_iter().filter(|e| !admitted.contains(e)) {
+        let img = model::render(cloud, cam, &[e]).image;
+        match verdict(&img, reference, bound, tolerance) {
+            Some(true) => caught.push(e),
+            Some(false) => {}
+            None => {
+                return Err(design_error(
+                    spec,
+                    format!(
+                        "camera {}: erratum {} lands within the margin of the tolerance ({})",
+                        spec_cam.name,
+                        e.letter(),
+                        margin_text(&img, reference, bound, tolerance)
+                    ),
+                ));
+            }
+        }
+    }
+    for &v in spec.detects {
+        let img = model::render_with(cloud, cam, &[], &[v]).image;
+        if verdict(&img, reference, bound, tolerance) != Some(true) {
+            return Err(design_error(
+                spec,
+                format!(
+                    "camera {}: designed to detect {} but its model does not fail clearly ({})",
+                    spec_cam.name,
+                    v.name(),
+                    margin_text(&img, reference, bound, tolerance)
+                ),
+            ));
+        }
+    }
+    Ok(caught)
+}
+
+/// One camera: writes its reference (PNG, PFM) and bound, derives its tolerance and what it
+/// catches; returns the manifest entry, its `cameras.json` entry and the errata caught.
+fn camera_entry(
+    dir: &Path,
+    spec: &AssetSpec,
+    k: usize,
+    spec_cam: &CameraSpec,
+    g: &crate::camera::GltfPerspective,
+    cloud: &crate::SplatCloud,
+) -> Result<(CameraEntry, serde_json::Value, Vec<Erratum>), GenerateError> {
+    let design = |m| design_error(spec, m);
+    let cam = Camera::from_gltf(g, WIDTH, HEIGHT).map_err(|e| design(e.to_string()))?;
     let space = cloud.meta.color_space.effective();
+    let opts = crate::reference::RenderOptions::default();
+    let (reference, _) = crate::reference::render_display(cloud, &cam, &opts, space);
+    let image = format!("{}/{}", spec.name, spec_cam.name);
+    let (png, pfm) = (
+        format!("reference/{image}.png"),
+        format!("reference/{image}.pfm"),
+    );
+    let png_bytes = reference.encode_png(PngDepth::Eight, false);
+    write(
+        &dir.join(&png),
+        &png_bytes.map_err(|e| design(e.to_string()))?,
+    )?;
+    write(&dir.join(&pfm), &reference.encode_pfm())?;
+    let mut exact = model::render(cloud, &cam, &[]);
+    admit(&mut exact, spec, cloud, &cam);
+    let tolerance = tolerance(&exact);
+    let bound_pfm = format!("reference/{image}.bound.pfm");
+    let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
+    for (p, b) in bound_img.pixels.iter_mut().zip(&exact.bound) {
+        p[3] = *b as f32;
+    }
+    write(&dir.join(&bound_pfm), &bound_img.encode_pfm_alpha())?;
+    // The bound as the runner reads it back (f32).
+    let bound: Vec<f64> = bound_img.pixels.iter().map(|p| p[3] as f64).collect();
+    let caught = catches_of(
+        spec,
+        spec_cam,
+        (cloud, &cam),
+        (&reference, &bound, &tolerance),
+    )?;
+    let c2w = DMat3::from_mat4(cam.world_to_camera.as_dmat4()).transpose();
+    let json_cam = json!({
+        "id": k, "img_name": image, "width": WIDTH, "height": HEIGHT,
+        "position": cam.eye().as_dvec3().to_array(),
+        "rotation": [c2w.row(0).to_array(), c2w.row(1).to_array(), c2w.row(2).to_array()],
+        "fx": cam.fx, "fy": cam.fy, "cx": cam.cx, "cy": cam.cy,
+    });
+    let entry = CameraEntry {
+        name: spec_cam.name.to_owned(),
+        gltf_camera: k,
+        width: WIDTH,
+        height: HEIGHT,
+        image,
+        reference_png: png,
+        reference_pfm: pfm,
+        bound_pfm,
+        tolerance,
+    };
+    Ok((entry, json_cam, caught))
+}
+
+fn asset(dir: &Path, spec: &AssetSpec) -> Result<AssetEntry, GenerateError> {
+    let (file, scene) = write_asset_file(dir, spec)?;
     let mut cameras = Vec::new();
     let mut json_cams = Vec::new();
     let mut catches = std::collections::BTreeSet::new();
     for (k, (spec_cam, g)) in spec.cameras.iter().zip(&scene.cameras).enumerate() {
-        let cam = Camera::from_gltf(g, WIDTH, HEIGHT).map_err(|e| design(e.to_string()))?;
-        let opts = crate::reference::RenderOptions::default();
-        let (reference, _) = crate::reference::render_display(cloud, &cam, &opts, space);
-        let image = format!("{}/{}", spec.name, spec_cam.name);
-        let (png, pfm) = (
-            format!("reference/{image}.png"),
-            format!("reference/{image}.pfm"),
-        );
-        let png_bytes = reference.encode_png(PngDepth::Eight, false);
-        write(
-            &dir.join(&png),
-            &png_bytes.map_err(|e| design(e.to_string()))?,
-        )?;
-        write(&dir.join(&pfm), &reference.encode_pfm())?;
-        let mut exact = model::render(cloud, &cam, &[]);
-        let admitted = admitted_errata(spec);
-        admit(&mut exact, spec, cloud, &cam);
-        let tolerance = tolerance(&exact);
-        let bound_pfm = format!("reference/{image}.bound.pfm");
-        let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
-        for (p, b) in bound_img.pixels.iter_mut().zip(&exact.bound) {
-            p[3] = *b as f32;
-        }
-        write(&dir.join(&bound_pfm), &bound_img.encode_pfm_alpha())?;
-        // The bound as the runner reads it back (f32).
-        let bound: Vec<f64> = bound_img.pixels.iter().map(|p| p[3] as f64).collect();
-        for e in Erratum::ALL {
-            if admitted.contains(&e) {
-                continue; // an RC-silent choice: admitted by the bound, checked by its own asset
-            }
-            let img = model::render(cloud, &cam, &[e]).image;
-            match verdict(&img, &reference, &bound, &tolerance) {
-                Some(true) => _ = catches.insert(e),
-                Some(false) => {}
-                None => {
-                    return Err(design(format!(
-                        "camera {}: erratum {} lands within the margin of the tolerance ({})",
-                        spec_cam.name,
-                        e.letter(),
-                        margin_text(&img, &reference, &bound, &tolerance)
-                    )));
-                }
-            }
-        }
-        for &v in spec.detects {
-            let img = model::render_with(cloud, &cam, &[], &[v]).image;
-            if verdict(&img, &reference, &bound, &tolerance) != Some(true) {
-                return Err(design(format!(
-                    "camera {}: designed to detect {} but its model does not fail clearly ({})",
-                    spec_cam.name,
-                    v.name(),
-                    margin_text(&img, &reference, &bound, &tolerance)
-                )));
-            }
-        }
-        let c2w = DMat3::from_mat4(cam.world_to_camera.as_dmat4()).transpose();
-        json_cams.push(json!({
-            "id": k, "img_name": image, "width": WIDTH, "height": HEIGHT,
-            "position": cam.eye().as_dvec3().to_array(),
-            "rotation": [c2w.row(0).to_array(), c2w.row(1).to_array(), c2w.row(2).to_array()],
-            "fx": cam.fx, "fy": cam.fy, "cx": cam.cx, "cy": cam.cy,
-        }));
-        cameras.push(CameraEntry {
-            name: spec_cam.name.to_owned(),
-            gltf_camera: k,
-            width: WIDTH,
-            height: HEIGHT,
-            image,
-            reference_png: png,
-            reference_pfm: pfm,
-            bound_pfm,
-            tolerance,
-        });
+        let (entry, json_cam, caught) = camera_entry(dir, spec, k, spec_cam, g, &scene.cloud)?;
+        cameras.push(entry);
+        json_cams.push(json_cam);
+        catches.extend(caught);
     }
     if let Some(e) = spec.designed_for.iter().find(|e| !catches.contains(e)) {
-        return Err(design(format!(
-            "designed to catch erratum {} but its model passes",
-            e.letter()
-        )));
+        return Err(design_error(
+            spec,
+            format!(
+                "designed to catch erratum {} but its model passes",
+                e.letter()
+            ),
+        ));
     }
     let cameras_json = format!("assets/{}.cameras.json", spec.name);
     let text = serde_json::to_vec_pretty(&json_cams).unwrap_or_default();

@@ -260,112 +260,145 @@ fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool, v: &[Variant]) -
     (c, f16_err)
 }
 
+/// What [`project`] needs of the camera and the deviations, once per render.
+struct View<'a> {
+    cam: &'a Camera,
+    errata: &'a [Erratum],
+    vars: &'a [Variant],
+    w2c: glam::DMat4,
+    /// The world → camera rotation as the (possibly erratum-b) shader uses it.
+    w: DMat3,
+    eye: DVec3,
+    /// The J clamp limits on x/z, y/z.
+    lim: [f64; 2],
+}
+
+impl View<'_> {
+    fn on(&self, e: Erratum) -> bool {
+        self.errata.contains(&e)
+    }
+    fn var(&self, v: Variant) -> bool {
+        self.vars.contains(&v)
+    }
+}
+
 fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], vars: &[Variant]) -> Vec<Layer> {
-    let on = |e| x.contains(&e);
-    let var = |w| vars.contains(&w);
     let w2c = cam.world_to_camera.as_dmat4();
     let w_cv = DMat3::from_mat4(w2c);
     let flip = DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0));
-    // (b) the shader's W = transpose(mat3(view)) is, in OpenCV axes, D·Wᵀ·D.
-    let w = if on(Erratum::B) {
-        flip * w_cv.transpose() * flip
-    } else {
-        w_cv
-    };
-    let eye = w2c.inverse().w_axis.truncate();
-    let (fx, fy, cx, cy) = (cam.fx as f64, cam.fy as f64, cam.cx as f64, cam.cy as f64);
     let tan = cam.tan_half_fov().as_dvec2();
-    let lim = if on(Erratum::K) {
-        [f64::INFINITY; 2]
-    } else {
-        [JACOBIAN_CLAMP * tan.x, JACOBIAN_CLAMP * tan.y]
+    let view = View {
+        cam,
+        errata: x,
+        vars,
+        w2c,
+        // (b) the shader's W = transpose(mat3(view)) is, in OpenCV axes, D·Wᵀ·D.
+        w: if x.contains(&Erratum::B) {
+            flip * w_cv.transpose() * flip
+        } else {
+            w_cv
+        },
+        eye: w2c.inverse().w_axis.truncate(),
+        lim: if x.contains(&Erratum::K) {
+            [f64::INFINITY; 2]
+        } else {
+            [JACOBIAN_CLAMP * tan.x, JACOBIAN_CLAMP * tan.y]
+        },
     };
-    let cull = (NEAR_CULL).max(cam.near as f64);
-    let mode = if var(Variant::ViewDepthOrder) {
+    let mode = if view.var(Variant::ViewDepthOrder) {
         SortMode::ViewDepth
     } else {
         SortMode::Distance
     };
     let mut order = back_to_front(&cloud.positions, cam, mode);
-    if on(Erratum::G) {
+    if view.on(Erratum::G) {
         order.reverse(); // the appendix's front-to-back
     }
-    let mut out = Vec::new();
-    for i in order.into_iter().map(|i| i as usize) {
-        if !cloud.is_drawable(i) || (cloud.opacities[i].min(ALPHA_MAX)) < ALPHA_MIN {
-            continue;
-        }
-        let mean = DVec3::from_array(cloud.positions[i].map(f64::from));
-        let t = w2c.transform_point3(mean);
-        if t.z <= cull {
-            continue;
-        }
-        let mut q = cloud.rotations[i];
-        if var(Variant::QuatWxyz) {
-            q = [q[1], q[2], q[3], q[0]]; // the stored x taken as w
-        }
-        if on(Erratum::A) {
-            let c = DQuat::from_array(q.map(f64::from)).conjugate(); // Rᵀ = R(q*)
-            q = [c.x as f32, c.y as f32, c.z as f32, c.w as f32];
-        }
-        let scale = if var(Variant::LogScale) {
-            cloud.scales[i].map(f32::exp)
-        } else {
-            cloud.scales[i]
-        };
-        let c = c_matrix(scale, q);
-        let txtz = (t.x / t.z).clamp(-lim[0], lim[0]);
-        let tytz = (t.y / t.z).clamp(-lim[1], lim[1]);
-        let j0 = DVec3::new(fx / t.z, 0.0, -fx * txtz / t.z);
-        let j1 = DVec3::new(0.0, fy / t.z, -fy * tytz / t.z);
-        let m = c.transpose() * w.transpose();
-        let (p0, p1) = (m * j0, m * j1);
-        let d = if on(Erratum::I) { 0.0 } else { DILATION_PX2 };
-        let (a, b, cc) = (p0.dot(p0) + d, p0.dot(p1), p1.dot(p1) + d);
-        let det = p0.cross(p1).length_squared() + d * (p0.dot(p0) + p1.dot(p1)) + d * d;
-        if !(det > 0.0 && det.is_finite()) {
-            continue;
-        }
-        let (u, v) = (fx * t.x / t.z + cx, fy * t.y / t.z + cy);
-        let dir = (mean - eye).normalize().to_array();
-        let (color, f16_err) = colour(cloud, i, dir, on(Erratum::E), vars);
-        let mut opacity = cloud.opacities[i] as f64;
-        if var(Variant::AaCompensation) {
-            let det0 = p0.cross(p1).length_squared();
-            opacity *= (det0 / det).max(0.0).sqrt();
-        }
-        let box_axes = var(Variant::BoxCut).then(|| box_half_axes(a, b, cc));
-        let (rx, ry) = (3.0 * a.sqrt(), 3.0 * cc.sqrt());
-        let (centre, rect) = if on(Erratum::D) {
-            // Quad ± radius/focal in NDC around the mean; centre (ndc/2 + 1/2)·w/P·2.
-            let mid = 0.5 * (a + cc);
-            let r = (9.0 * (mid + (mid * mid - det).max(0.1).sqrt()))
-                .sqrt()
-                .ceil();
-            let (hx, hy) = (
-                r * cam.width as f64 / (2.0 * fx),
-                r * cam.height as f64 / (2.0 * fy),
-            );
-            let h = cam.height as f64;
-            let centre = [u * t.z / fx, h - (h - v) * t.z / fy];
-            (centre, [u - hx, u + hx, v - hy, v + hy])
-        } else if let Some([e1, e2]) = box_axes {
-            let (hx, hy) = (e1[0].abs() + e2[0].abs(), e1[1].abs() + e2[1].abs());
-            ([u, v], [u - hx, u + hx, v - hy, v + hy])
-        } else {
-            ([u, v], [u - rx, u + rx, v - ry, v + ry])
-        };
-        out.push(Layer {
-            centre,
-            conic: [cc / det, -b / det, a / det],
-            opacity,
-            color,
-            f16_err,
-            rect,
-            box_axes,
-        });
+    order
+        .into_iter()
+        .filter_map(|i| project_one(cloud, i as usize, &view))
+        .collect()
+}
+
+/// Splat `i` projected for `view` (`None`: not drawn — culled, or Σ' degenerate).
+fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
+    let cam = view.cam;
+    if !cloud.is_drawable(i) || (cloud.opacities[i].min(ALPHA_MAX)) < ALPHA_MIN {
+        return None;
     }
-    out
+    let mean = DVec3::from_array(cloud.positions[i].map(f64::from));
+    let t = view.w2c.transform_point3(mean);
+    if t.z <= (NEAR_CULL).max(cam.near as f64) {
+        return None;
+    }
+    let mut q = cloud.rotations[i];
+    if view.var(Variant::QuatWxyz) {
+        q = [q[1], q[2], q[3], q[0]]; // the stored x taken as w
+    }
+    if view.on(Erratum::A) {
+        let c = DQuat::from_array(q.map(f64::from)).conjugate(); // Rᵀ = R(q*)
+        q = [c.x as f32, c.y as f32, c.z as f32, c.w as f32];
+    }
+    let scale = if view.var(Variant::LogScale) {
+        cloud.scales[i].map(f32::exp)
+    } else {
+        cloud.scales[i]
+    };
+    let (fx, fy, cx, cy) = (cam.fx as f64, cam.fy as f64, cam.cx as f64, cam.cy as f64);
+    let txtz = (t.x / t.z).clamp(-view.lim[0], view.lim[0]);
+    let tytz = (t.y / t.z).clamp(-view.lim[1], view.lim[1]);
+    let j0 = DVec3::new(fx / t.z, 0.0, -fx * txtz / t.z);
+    let j1 = DVec3::new(0.0, fy / t.z, -fy * tytz / t.z);
+    let m = c_matrix(scale, q).transpose() * view.w.transpose();
+    let (p0, p1) = (m * j0, m * j1);
+    let d = if view.on(Erratum::I) {
+        0.0
+    } else {
+        DILATION_PX2
+    };
+    let (a, b, cc) = (p0.dot(p0) + d, p0.dot(p1), p1.dot(p1) + d);
+    let det = p0.cross(p1).length_squared() + d * (p0.dot(p0) + p1.dot(p1)) + d * d;
+    if !(det > 0.0 && det.is_finite()) {
+        return None;
+    }
+    let (u, v) = (fx * t.x / t.z + cx, fy * t.y / t.z + cy);
+    let dir = (mean - view.eye).normalize().to_array();
+    let (color, f16_err) = colour(cloud, i, dir, view.on(Erratum::E), view.vars);
+    let mut opacity = cloud.opacities[i] as f64;
+    if view.var(Variant::AaCompensation) {
+        let det0 = p0.cross(p1).length_squared();
+        opacity *= (det0 / det).max(0.0).sqrt();
+    }
+    let box_axes = view.var(Variant::BoxCut).then(|| box_half_axes(a, b, cc));
+    let (rx, ry) = (3.0 * a.sqrt(), 3.0 * cc.sqrt());
+    let (centre, rect) = if view.on(Erratum::D) {
+        // Quad ± radius/focal in NDC around the mean; centre (ndc/2 + 1/2)·w/P·2.
+        let mid = 0.5 * (a + cc);
+        let r = (9.0 * (mid + (mid * mid - det).max(0.1).sqrt()))
+            .sqrt()
+            .ceil();
+        let (hx, hy) = (
+            r * cam.width as f64 / (2.0 * fx),
+            r * cam.height as f64 / (2.0 * fy),
+        );
+        let h = cam.height as f64;
+        let centre = [u * t.z / fx, h - (h - v) * t.z / fy];
+        (centre, [u - hx, u + hx, v - hy, v + hy])
+    } else if let Some([e1, e2]) = box_axes {
+        let (hx, hy) = (e1[0].abs() + e2[0].abs(), e1[1].abs() + e2[1].abs());
+        ([u, v], [u - hx, u + hx, v - hy, v + hy])
+    } else {
+        ([u, v], [u - rx, u + rx, v - ry, v + ry])
+    };
+    Some(Layer {
+        centre,
+        conic: [cc / det, -b / det, a / det],
+        opacity,
+        color,
+        f16_err,
+        rect,
+        box_axes,
+    })
 }
 
 /// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
@@ -400,97 +433,25 @@ pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
 pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant]) -> ModelImage {
     let layers = project(cloud, cam, x, v);
     let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display;
-    let (f, k, g) = (
-        x.contains(&Erratum::F),
-        x.contains(&Erratum::K),
-        x.contains(&Erratum::G),
-    );
-    let cut = if f { 8.0 } else { CUTOFF_M2 as f64 };
+    let blend = Blending {
+        cut: if x.contains(&Erratum::F) {
+            8.0
+        } else {
+            CUTOFF_M2 as f64
+        },
+        no_cap: x.contains(&Erratum::K),
+        alpha_squared: x.contains(&Erratum::G),
+    };
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut image = Image::filled(cam.width, cam.height, [0.0, 0.0, 0.0, 1.0]);
     let mut bound = vec![0.0; w * h];
     let mut worst = Terms::default();
-    let q = 0.5 / 255.0;
     for py in 0..h {
         for px in 0..w {
-            let (xc, yc) = (px as f64 + 0.5, py as f64 + 0.5);
-            let (mut c, mut a) = ([0.0f64; 3], 0.0f64);
-            let mut t = Terms {
-                output: q,
-                ..Default::default()
-            };
-            let mut layers_here = 0usize;
-            for l in &layers {
-                let [x0, x1, y0, y1] = l.rect;
-                if xc < x0 || xc > x1 || yc < y0 || yc > y1 {
-                    continue;
-                }
-                let (dx, dy) = (xc - l.centre[0], yc - l.centre[1]);
-                let m2 = l.conic[0] * dx * dx + 2.0 * l.conic[1] * dx * dy + l.conic[2] * dy * dy;
-                let raw = l.opacity * (-0.5 * m2).exp();
-                if (m2 - cut).abs() <= EDGE_BAND * cut {
-                    t.cutoff += raw.min(ALPHA_MAX as f64);
-                }
-                let inside = match l.box_axes {
-                    // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
-                    Some(ax) => ax.iter().all(|h| {
-                        let n2 = h[0] * h[0] + h[1] * h[1];
-                        (dx * h[0] + dy * h[1]).abs() <= n2 + 1e-12
-                    }),
-                    None => (0.0..=cut).contains(&m2),
-                };
-                if !inside {
-                    continue;
-                }
-                let alpha = if k { raw } else { raw.min(ALPHA_MAX as f64) };
-                if raw < ALPHA_MIN as f64 * (1.0 + 10.0 * EDGE_BAND) {
-                    t.threshold += raw;
-                }
-                if raw > ALPHA_MAX as f64 * (1.0 - EDGE_BAND) {
-                    t.cap += (raw.min(1.0) - ALPHA_MAX as f64).max(0.0);
-                }
-                if alpha < ALPHA_MIN as f64 {
-                    continue;
-                }
-                layers_here += 1;
-                t.sh_f16 += alpha * l.f16_err;
-                t.overbright += l
-                    .color
-                    .iter()
-                    .map(|v| (v - 1.0).max(0.0))
-                    .fold(0.0, f64::max);
-                let wgt = if g { alpha * alpha } else { alpha };
-                for (v, lc) in c.iter_mut().zip(l.color) {
-                    *v = lc * wgt + *v * (1.0 - alpha);
-                }
-                a = wgt + a * (1.0 - alpha);
-            }
-            // UNORM8 blending rounds the fragment output (c·α, α) to 8 bits and the result
-            // again: two half-steps per blended splat.
-            t.blend = 2.0 * q * layers_here as f64;
-            t.float = 1e-5 * (layers_here + 1) as f64;
+            let (c, a, mut t) = shade(&layers, (px as f64 + 0.5, py as f64 + 0.5), &blend);
             let disp = c.map(|v| if linear { srgb_encode(v) } else { v }.clamp(0.0, 1.0));
             if linear {
-                // α-convention terms act on linear values: map the interval through the curve.
-                let lin = t.cutoff + t.threshold + t.cap + t.sh_f16 + t.overbright;
-                let span = c
-                    .iter()
-                    .map(|&v| {
-                        let hi = srgb_encode(v + lin) - srgb_encode(v);
-                        let lo = srgb_encode(v) - srgb_encode((v - lin).max(0.0));
-                        hi.max(lo)
-                    })
-                    .fold(0.0, f64::max);
-                let scale = if lin > 0.0 { span / lin } else { 0.0 };
-                for term in [
-                    &mut t.cutoff,
-                    &mut t.threshold,
-                    &mut t.cap,
-                    &mut t.sh_f16,
-                    &mut t.overbright,
-                ] {
-                    *term *= scale;
-                }
+                through_srgb_curve(&mut t, c);
             }
             let i = py * w + px;
             image.pixels[i] = [disp[0] as f32, disp[1] as f32, disp[2] as f32, a as f32];
@@ -503,5 +464,109 @@ pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant
         image,
         bound,
         worst,
+    }
+}
+
+/// How the layers are blended: the cut-off (Mahalanobis²), and the errata k (no α cap) and g
+/// (α² weighting).
+struct Blending {
+    cut: f64,
+    no_cap: bool,
+    alpha_squared: bool,
+}
+
+/// One pixel centre: the blended linear colour, the alpha and the error terms, walking the
+/// layers in blending order.
+fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64, Terms) {
+    let q = 0.5 / 255.0;
+    let cut = b.cut;
+    let (mut c, mut a) = ([0.0f64; 3], 0.0f64);
+    let mut t = Terms {
+        output: q,
+        ..Default::default()
+    };
+    let mut layers_here = 0usize;
+    for l in layers {
+        let [x0, x1, y0, y1] = l.rect;
+        if xc < x0 || xc > x1 || yc < y0 || yc > y1 {
+            continue;
+        }
+        let (dx, dy) = (xc - l.centre[0], yc - l.centre[1]);
+        let m2 = l.conic[0] * dx * dx + 2.0 * l.conic[1] * dx * dy + l.conic[2] * dy * dy;
+        let raw = l.opacity * (-0.5 * m2).exp();
+        if (m2 - cut).abs() <= EDGE_BAND * cut {
+            t.cutoff += raw.min(ALPHA_MAX as f64);
+        }
+        let inside = match l.box_axes {
+            // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
+            Some(ax) => ax.iter().all(|h| {
+                let n2 = h[0] * h[0] + h[1] * h[1];
+                (dx * h[0] + dy * h[1]).abs() <= n2 + 1e-12
+            }),
+            None => (0.0..=cut).contains(&m2),
+        };
+        if !inside {
+            continue;
+        }
+        let alpha = if b.no_cap {
+            raw
+        } else {
+            raw.min(ALPHA_MAX as f64)
+        };
+        if raw < ALPHA_MIN as f64 * (1.0 + 10.0 * EDGE_BAND) {
+            t.threshold += raw;
+        }
+        if raw > ALPHA_MAX as f64 * (1.0 - EDGE_BAND) {
+            t.cap += (raw.min(1.0) - ALPHA_MAX as f64).max(0.0);
+        }
+        if alpha < ALPHA_MIN as f64 {
+            continue;
+        }
+        layers_here += 1;
+        t.sh_f16 += alpha * l.f16_err;
+        t.overbright += l
+            .color
+            .iter()
+            .map(|v| (v - 1.0).max(0.0))
+            .fold(0.0, f64::max);
+        let wgt = if b.alpha_squared {
+            alpha * alpha
+        } else {
+            alpha
+        };
+        for (v, lc) in c.iter_mut().zip(l.color) {
+            *v = lc * wgt + *v * (1.0 - alpha);
+        }
+        a = wgt + a * (1.0 - alpha);
+    }
+    // UNORM8 blending rounds the fragment output (c·α, α) to 8 bits and the result again:
+    // two half-steps per blended splat.
+    t.blend = 2.0 * q * layers_here as f64;
+    t.float = 1e-5 * (layers_here + 1) as f64;
+    (c, a, t)
+}
+
+/// For `lin_rec709_display`: the α-convention terms act on linear values, so their interval
+/// around the pixel's linear colour `c` is mapped through the sRGB curve (the rounding terms
+/// are already in encoded units).
+fn through_srgb_curve(t: &mut Terms, c: [f64; 3]) {
+    let lin = t.cutoff + t.threshold + t.cap + t.sh_f16 + t.overbright;
+    let span = c
+        .iter()
+        .map(|&v| {
+            let hi = srgb_encode(v + lin) - srgb_encode(v);
+            let lo = srgb_encode(v) - srgb_encode((v - lin).max(0.0));
+            hi.max(lo)
+        })
+        .fold(0.0, f64::max);
+    let scale = if lin > 0.0 { span / lin } else { 0.0 };
+    for term in [
+        &mut t.cutoff,
+        &mut t.threshold,
+        &mut t.cap,
+        &mut t.sh_f16,
+        &mut t.overbright,
+    ] {
+        *term *= scale;
     }
 }

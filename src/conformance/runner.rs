@@ -29,6 +29,8 @@ pub struct CameraResult {
     pub expected: Image,
     /// The image compared (`None` when missing).
     pub actual: Option<Image>,
+    /// No image was given for this camera.
+    pub missing: bool,
 }
 
 /// The outcome of one asset: passes when every camera passes.
@@ -119,82 +121,12 @@ pub fn run(
     let mut results = Vec::new();
     for (ai, a) in m.assets.iter().enumerate() {
         let mut cams = Vec::new();
-        let mut missing = 0;
         let mut loaded = None;
         for (ci, c) in a.cameras.iter().enumerate() {
-            let want =
-                Image::read(suite_path(dir, &c.reference_pfm)?).map_err(|e| e.to_string())?;
-            let want = clamped(&want);
-            let bound: Vec<f64> = Image::read(suite_path(dir, &c.bound_pfm)?)
-                .map_err(|e| e.to_string())?
-                .pixels
-                .iter()
-                .map(|p| p[0] as f64)
-                .collect();
-            if bound.len() != want.pixels.len() {
-                return Err(format!("{}: wrong size", c.bound_pfm));
-            }
-            let mut r = CameraResult {
-                camera: c.clone(),
-                comparison: None,
-                pass: false,
-                cause: None,
-                explained_by: Vec::new(),
-                against_reference: None,
-                expected: want.clone(),
-                actual: None,
-            };
-            match get(c) {
-                None => {
-                    missing += 1;
-                    r.cause = Some(format!("no image {}.png or {}.pfm", c.image, c.image));
-                }
-                Some(Err(e)) => r.cause = Some(format!("unreadable image: {e}")),
-                Some(Ok(img)) if (img.width, img.height) != (c.width, c.height) => {
-                    r.cause = Some(format!(
-                        "image is {}x{}, expected {}x{}",
-                        img.width, img.height, c.width, c.height
-                    ));
-                    r.actual = Some(clamped(&img));
-                }
-                Some(Ok(img)) => {
-                    let img = clamped(&img);
-                    let (_, ratio) = measure(&img, &want, &bound);
-                    let cmp = compare(&img, &want, 1.0 / 255.0).map_err(|e| e.to_string())?;
-                    let t = &c.tolerance;
-                    r.pass =
-                        ratio <= 1.0 && cmp.max_abs as f64 <= t.max_abs && cmp.psnr >= t.min_psnr;
-                    r.against_reference = Some((cmp.psnr, cmp.max_abs as f64));
-                    r.comparison = Some(cmp);
-                    if !r.pass {
-                        if loaded.is_none() {
-                            loaded = render::load_asset(dir, m, ai).ok();
-                        }
-                        if let Some(l) = &loaded {
-                            if let Some(d) = allowed_choice(l, ci, c, &img, &bound) {
-                                r.pass = true;
-                                r.cause = Some(format!(
-                                    "passes as a renderer that {} (the RC allows it: {})",
-                                    d.describe().to_lowercase(),
-                                    d.rc_section()
-                                ));
-                            } else {
-                                r.explained_by =
-                                    diagnosis::explain(&l.0.cloud, &l.1[ci], c, &img, &bound);
-                            }
-                        }
-                        if !r.pass {
-                            r.cause = Some(format!(
-                                "{} pixels over their bound (worst {ratio:.2}×); ",
-                                over_bound(&img, &want, &bound)
-                            ));
-                        }
-                    }
-                    r.actual = Some(img);
-                }
-            }
-            cams.push(r);
+            let got = get(c);
+            cams.push(camera_result(dir, m, (ai, ci), got, &mut loaded)?);
         }
+        let missing = cams.iter().filter(|c| c.missing).count();
         results.push(AssetResult {
             asset: a.clone(),
             skipped: a.optional && missing == a.cameras.len(),
@@ -203,6 +135,98 @@ pub fn run(
     }
     name_causes(&mut results);
     Ok(results)
+}
+
+/// The reference and the per-pixel bound of camera `c`.
+fn reference_and_bound(dir: &Path, c: &CameraEntry) -> Result<(Image, Vec<f64>), String> {
+    let want = Image::read(suite_path(dir, &c.reference_pfm)?).map_err(|e| e.to_string())?;
+    let want = clamped(&want);
+    let bound: Vec<f64> = Image::read(suite_path(dir, &c.bound_pfm)?)
+        .map_err(|e| e.to_string())?
+        .pixels
+        .iter()
+        .map(|p| p[0] as f64)
+        .collect();
+    if bound.len() != want.pixels.len() {
+        return Err(format!("{}: wrong size", c.bound_pfm));
+    }
+    Ok((want, bound))
+}
+
+/// Camera `ci` of asset `ai` with the image `got`: compared with the reference; when it fails,
+/// checked against the RC-allowed SH caps and explained with the models (the asset is loaded
+/// into `loaded` the first time it is needed).
+fn camera_result(
+    dir: &Path,
+    m: &Manifest,
+    (ai, ci): (usize, usize),
+    got: Option<Result<Image, String>>,
+    loaded: &mut Option<(crate::load::Scene, Vec<crate::camera::Camera>)>,
+) -> Result<CameraResult, String> {
+    let c = &m.assets[ai].cameras[ci];
+    let (want, bound) = reference_and_bound(dir, c)?;
+    let mut r = CameraResult {
+        camera: c.clone(),
+        comparison: None,
+        pass: false,
+        cause: None,
+        explained_by: Vec::new(),
+        against_reference: None,
+        expected: want.clone(),
+        actual: None,
+        missing: false,
+    };
+    let img = match got {
+        None => {
+            r.missing = true;
+            r.cause = Some(format!("no image {}.png or {}.pfm", c.image, c.image));
+            return Ok(r);
+        }
+        Some(Err(e)) => {
+            r.cause = Some(format!("unreadable image: {e}"));
+            return Ok(r);
+        }
+        Some(Ok(img)) => clamped(&img),
+    };
+    if (img.width, img.height) != (c.width, c.height) {
+        r.cause = Some(format!(
+            "image is {}x{}, expected {}x{}",
+            img.width, img.height, c.width, c.height
+        ));
+        r.actual = Some(img);
+        return Ok(r);
+    }
+    let (_, ratio) = measure(&img, &want, &bound);
+    let cmp = compare(&img, &want, 1.0 / 255.0).map_err(|e| e.to_string())?;
+    let t = &c.tolerance;
+    r.pass = ratio <= 1.0 && cmp.max_abs as f64 <= t.max_abs && cmp.psnr >= t.min_psnr;
+    r.against_reference = Some((cmp.psnr, cmp.max_abs as f64));
+    r.comparison = Some(cmp);
+    if !r.pass {
+        if loaded.is_none() {
+            *loaded = render::load_asset(dir, m, ai).ok();
+        }
+        if let Some(l) = loaded.as_ref() {
+            if let Some(d) = allowed_choice(l, ci, c, &img, &bound) {
+                r.pass = true;
+                r.cause = Some(format!(
+                    "passes as a renderer that {} (the RC allows it: {})",
+                    d.describe().to_lowercase(),
+                    d.rc_section()
+                ));
+            } else {
+                r.explained_by = diagnosis::explain(&l.0.cloud, &l.1[ci], c, &img, &bound);
+            }
+        }
+        if !r.pass {
+            r.cause = Some(format!(
+                "{} pixels over their bound (worst {ratio:.2}×); ",
+                over_bound(&img, &want, &bound)
+            ));
+        }
+    }
+    r.actual = Some(img);
+    Ok(r)
 }
 
 /// The failing cameras that had an image to explain.
