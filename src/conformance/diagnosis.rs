@@ -91,7 +91,7 @@ impl Deviation {
 /// One candidate that explains a camera, with its evidence.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Explanation {
-    /// The deviations switched on (one or two).
+    /// The deviations switched on (one to three).
     pub deviations: Vec<Deviation>,
     /// PSNR of the image against the model with them.
     pub psnr: f64,
@@ -142,11 +142,27 @@ pub fn flipped(img: &Image, vertical: bool) -> Image {
     out
 }
 
-/// At most this many of the single deviations that bring the image closest are paired.
-const PAIRED: usize = 4;
+/// At most this many of the single deviations that bring the image closest are combined
+/// (in pairs, then triples: 10 + 10 model renders at most).
+const PAIRED: usize = 5;
 
-/// The candidates (single deviations, then pairs of the closest singles) that explain a
-/// failing camera: `actual` passes `camera`'s tolerance against the model with them.
+/// The `k`-element subsets of `items`, in order.
+fn combinations(items: &[Deviation], k: usize) -> Vec<Vec<Deviation>> {
+    if k == 0 {
+        return vec![Vec::new()];
+    }
+    let mut out = Vec::new();
+    for (i, d) in items.iter().enumerate() {
+        for mut rest in combinations(&items[i + 1..], k - 1) {
+            rest.insert(0, *d);
+            out.push(rest);
+        }
+    }
+    out
+}
+
+/// The candidates (single deviations, then pairs and triples of the closest singles) that
+/// explain a failing camera: `actual` passes `camera`'s tolerance against the model with them.
 pub fn explain(
     cloud: &SplatCloud,
     cam: &Camera,
@@ -181,15 +197,19 @@ pub fn explain(
     }
     singles.sort_by(|a, b| b.0.total_cmp(&a.0));
     let best: Vec<Deviation> = singles.iter().take(PAIRED).map(|(_, d)| *d).collect();
-    for (i, a) in best.iter().enumerate() {
-        for b in &best[i + 1..] {
-            if let Some((true, psnr, max_abs)) = score(&[*a, *b]) {
+    // Pairs, then (only when no pair explains it) triples of the closest singles.
+    for size in [2, 3] {
+        for set in combinations(&best, size) {
+            if let Some((true, psnr, max_abs)) = score(&set) {
                 out.push(Explanation {
-                    deviations: vec![*a, *b],
+                    deviations: set,
                     psnr,
                     max_abs,
                 });
             }
+        }
+        if !out.is_empty() {
+            break;
         }
     }
     out

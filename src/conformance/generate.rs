@@ -154,13 +154,18 @@ type TermField = fn(&mut model::Terms) -> &mut f64;
 /// - the shape of the cut-off (erratum f's 2.83σ, a 3.33σ bounding box): an RC rule,
 ///   detected by `cutoff_three_sigma` alone;
 /// - the order by view depth instead of camera distance: an RC rule, detected by the sorting
-///   assets.
-const ISOLATED: [(Admitted, TermField); 4] = [
+///   assets;
+/// - 8-bit storage of the DC colour and the opacity (rounded down): a precision the RC does
+///   not specify, admitted everywhere (no asset detects it).
+const ISOLATED: [(Admitted, TermField); 5] = [
     (Admitted::Erratum(Erratum::I), |t| &mut t.dilation),
     (Admitted::Erratum(Erratum::F), |t| &mut t.cutoff_shape),
     (Admitted::Variant(Variant::BoxCut), |t| &mut t.cutoff_shape),
     (Admitted::Variant(Variant::ViewDepthOrder), |t| {
         &mut t.sort_order
+    }),
+    (Admitted::Variant(Variant::Colour8Bit), |t| {
+        &mut t.colour_8bit
     }),
 ];
 

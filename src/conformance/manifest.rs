@@ -108,6 +108,7 @@ fn terms_json(t: &Terms) -> Value {
         "alpha_threshold": t.threshold, "alpha_cap": t.cap, "sh_f16": t.sh_f16,
         "overbright": t.overbright, "float": t.float, "dilation": t.dilation,
         "cutoff_shape": t.cutoff_shape, "sort_order": t.sort_order,
+        "colour_8bit": t.colour_8bit,
     })
 }
 
@@ -126,6 +127,7 @@ fn terms_from_json(v: &Value) -> Terms {
         dilation: f("dilation"),
         cutoff_shape: f("cutoff_shape"),
         sort_order: f("sort_order"),
+        colour_8bit: f("colour_8bit"),
     }
 }
 

@@ -43,11 +43,18 @@ pub enum Variant {
     LogScale,
     /// Colour as `sigmoid(Σ SH·Y)` instead of `Σ SH·Y + 0.5`.
     SigmoidColour,
+    /// The DC colour (`SH_C0·DC + 0.5`) and the opacity stored in 8 bits, rounded down
+    /// (GaussianSplats3D's splat buffers).
+    Colour8Bit,
+    /// Σ' rebuilt from eigenvalues `mid ± √max(0.1, mid² − det)`, and dropped when the smaller
+    /// is ≤ 0 (GaussianSplats3D's vertex shader): near-round footprints come out slightly
+    /// anisotropic, sub-pixel splats vanish.
+    EigenvalueFloor,
 }
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 9] = [
+    pub const ALL: [Variant; 11] = [
         Variant::BoxCut,
         Variant::ViewDepthOrder,
         Variant::AaCompensation,
@@ -57,6 +64,8 @@ impl Variant {
         Variant::QuatWxyz,
         Variant::LogScale,
         Variant::SigmoidColour,
+        Variant::Colour8Bit,
+        Variant::EigenvalueFloor,
     ];
     /// A short identifier (the diagnosis's `rule`).
     pub fn name(self) -> &'static str {
@@ -70,6 +79,8 @@ impl Variant {
             Variant::QuatWxyz => "quaternion_read_as_wxyz",
             Variant::LogScale => "scale_read_as_log",
             Variant::SigmoidColour => "sigmoid_colour",
+            Variant::Colour8Bit => "colour_and_opacity_8bit",
+            Variant::EigenvalueFloor => "eigenvalue_floor",
         }
     }
     /// What a renderer with this variant does, for reports.
@@ -88,6 +99,12 @@ impl Variant {
             Variant::QuatWxyz => "ROTATION read as (w, x, y, z) instead of (x, y, z, w)",
             Variant::LogScale => "SCALE read as ln(scale) (the review draft) instead of linear",
             Variant::SigmoidColour => "colour = sigmoid(Σ SH·Y) instead of Σ SH·Y + 0.5",
+            Variant::Colour8Bit => {
+                "DC colour and opacity stored in 8 bits, rounded down (lossy storage)"
+            }
+            Variant::EigenvalueFloor => {
+                "Σ' rebuilt from eigenvalues mid ± √max(0.1, mid² − det) (near-round footprints anisotropic, sub-pixel splats dropped)"
+            }
         }
     }
     /// The RC section whose rule the variant departs from.
@@ -102,6 +119,10 @@ impl Variant {
             Variant::QuatWxyz => "RC Attributes (ROTATION: xyzw, the usual glTF order)",
             Variant::LogScale => "RC Attributes (SCALE: linear)",
             Variant::SigmoidColour => "RC Lighting (colour = Σ SH·Y + 0.5)",
+            Variant::Colour8Bit => {
+                "RC Attributes (float SH, OPACITY); the RC does not specify a renderer's precision"
+            }
+            Variant::EigenvalueFloor => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
         }
     }
     /// Whether the RC allows it: an image that matches it passes.
@@ -110,6 +131,11 @@ impl Variant {
             self,
             Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2
         )
+    }
+    /// Whether it is only a precision the RC does not specify (8-bit storage): every asset's
+    /// bound admits it, so an image with it passes.
+    pub fn precision_only(self) -> bool {
+        self == Variant::Colour8Bit
     }
     /// The highest SH degree evaluated (3: all).
     fn sh_cap(v: &[Variant]) -> usize {
@@ -167,8 +193,10 @@ pub struct Terms {
     pub dilation: f64,
     /// …with another cut-off shape (2.83σ, a 3.33σ bounding box),
     pub cutoff_shape: f64,
-    /// …and with splats ordered by view depth.
+    /// …with splats ordered by view depth,
     pub sort_order: f64,
+    /// …and with the DC colour and the opacity stored in 8 bits (rounded down).
+    pub colour_8bit: f64,
 }
 
 impl Terms {
@@ -185,6 +213,7 @@ impl Terms {
             + self.dilation
             + self.cutoff_shape
             + self.sort_order
+            + self.colour_8bit
     }
     pub(crate) fn max(self, o: Terms) -> Terms {
         Terms {
@@ -199,6 +228,7 @@ impl Terms {
             dilation: self.dilation.max(o.dilation),
             cutoff_shape: self.cutoff_shape.max(o.cutoff_shape),
             sort_order: self.sort_order.max(o.sort_order),
+            colour_8bit: self.colour_8bit.max(o.colour_8bit),
         }
     }
 }
@@ -242,7 +272,16 @@ fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool, v: &[Variant]) -
     };
     let mut sum = [0.0f64; 3];
     let mut f16 = 0.0f64;
+    let eight = v.contains(&Variant::Colour8Bit) && !e;
     for (k, c) in coeffs.iter().enumerate() {
+        if k == 0 && eight {
+            // floor(255·clamp(SH_C0·DC + 0.5)) / 255, less the bias added back below.
+            for ch in 0..3 {
+                let dc = (y[0] * c[ch] as f64 + crate::profile::SH_DC_BIAS).clamp(0.0, 1.0);
+                sum[ch] += (dc * 255.0).floor() / 255.0 - crate::profile::SH_DC_BIAS;
+            }
+            continue;
+        }
         for ch in 0..3 {
             sum[ch] += y[k] * c[ch] as f64;
         }
@@ -356,15 +395,21 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
     } else {
         DILATION_PX2
     };
-    let (a, b, cc) = (p0.dot(p0) + d, p0.dot(p1), p1.dot(p1) + d);
-    let det = p0.cross(p1).length_squared() + d * (p0.dot(p0) + p1.dot(p1)) + d * d;
+    let (mut a, mut b, mut cc) = (p0.dot(p0) + d, p0.dot(p1), p1.dot(p1) + d);
+    let mut det = p0.cross(p1).length_squared() + d * (p0.dot(p0) + p1.dot(p1)) + d * d;
     if !(det > 0.0 && det.is_finite()) {
         return None;
+    }
+    if view.var(Variant::EigenvalueFloor) {
+        [a, b, cc, det] = eigenvalue_floor(a, b, cc, det)?;
     }
     let (u, v) = (fx * t.x / t.z + cx, fy * t.y / t.z + cy);
     let dir = (mean - view.eye).normalize().to_array();
     let (color, f16_err) = colour(cloud, i, dir, view.on(Erratum::E), view.vars);
     let mut opacity = cloud.opacities[i] as f64;
+    if view.var(Variant::Colour8Bit) {
+        opacity = (opacity * 255.0).floor() / 255.0;
+    }
     if view.var(Variant::AaCompensation) {
         let det0 = p0.cross(p1).length_squared();
         opacity *= (det0 / det).max(0.0).sqrt();
@@ -399,6 +444,34 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
         rect,
         box_axes,
     })
+}
+
+/// [`Variant::EigenvalueFloor`]: Σ' = [[a, b], [b, c]] rebuilt from the floored eigenvalues
+/// and the eigenvector `normalize(b, λ₁ − a)` (axis-aligned when that is degenerate); `None`
+/// when the smaller eigenvalue is ≤ 0. Returns `[a, b, c, det]`.
+fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64; 4]> {
+    let mid = 0.5 * (a + c);
+    let r = (mid * mid - det).max(0.1).sqrt();
+    let (l1, l2) = (mid + r, mid - r);
+    if l2 <= 0.0 {
+        return None;
+    }
+    let (x, y) = (b, l1 - a);
+    let n = (x * x + y * y).sqrt();
+    let e1 = if n > 1e-12 {
+        [x / n, y / n]
+    } else if a >= c {
+        [1.0, 0.0]
+    } else {
+        [0.0, 1.0]
+    };
+    let e2 = [-e1[1], e1[0]];
+    Some([
+        l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
+        l1 * e1[0] * e1[1] + l2 * e2[0] * e2[1],
+        l1 * e1[1] * e1[1] + l2 * e2[1] * e2[1],
+        l1 * l2,
+    ])
 }
 
 /// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors

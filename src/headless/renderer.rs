@@ -19,7 +19,7 @@ pub enum TargetKind {
     /// `SRGB8_ALPHA8` for `lin_rec709_display` (GL decodes, blends linear, re-encodes).
     #[default]
     Rgba8,
-    /// Blend in an `RGBA16F` [`OffscreenTarget`], then resolve (sRGB-encoding linear clouds)
+    /// Blend in an `RGBA16F` [`OffscreenTarget`](crate::gl::OffscreenTarget), then resolve (sRGB-encoding linear clouds)
     /// into an `RGBA8` framebuffer.
     Rgba16fResolve,
 }
