@@ -456,15 +456,7 @@ fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64; 4]> {
     if l2 <= 0.0 {
         return None;
     }
-    let (x, y) = (b, l1 - a);
-    let n = (x * x + y * y).sqrt();
-    let e1 = if n > 1e-12 {
-        [x / n, y / n]
-    } else if a >= c {
-        [1.0, 0.0]
-    } else {
-        [0.0, 1.0]
-    };
+    let e1 = major_axis(a, b, c, l1);
     let e2 = [-e1[1], e1[0]];
     Some([
         l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
@@ -474,12 +466,10 @@ fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64; 4]> {
     ])
 }
 
-/// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
-/// scaled by 3.33·√λ.
-fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
-    let (mid, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
-    let (l1, l2) = (mid + half, (mid - half).max(0.0));
-    let e1 = if b.abs() > 1e-12 * (a.abs() + c.abs()) {
+/// The unit eigenvector of [[a, b], [b, c]] for its larger eigenvalue `l1`: `(b, l1 − a)`
+/// normalised, or the axis of the larger diagonal entry when `b` is 0 (to rounding).
+fn major_axis(a: f64, b: f64, c: f64, l1: f64) -> [f64; 2] {
+    if b.abs() > 1e-12 * (a.abs() + c.abs()) {
         let (x, y) = (b, l1 - a);
         let n = (x * x + y * y).sqrt();
         [x / n, y / n]
@@ -487,7 +477,15 @@ fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
         [1.0, 0.0]
     } else {
         [0.0, 1.0]
-    };
+    }
+}
+
+/// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
+/// scaled by 3.33·√λ.
+fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
+    let (mid, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
+    let (l1, l2) = (mid + half, (mid - half).max(0.0));
+    let e1 = major_axis(a, b, c, l1);
     let e2 = [-e1[1], e1[0]];
     let k = 3.33;
     [
