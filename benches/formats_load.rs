@@ -134,7 +134,7 @@ fn decompress(spz: &[u8]) -> Vec<u8> {
 }
 
 fn bench(c: &mut Criterion) {
-    let cloud = splatgl::scene::random_cloud(N, 3, 5.0, 1);
+    let cloud = splatgl::synthetic::random_cloud(N, 3, 5.0, 1);
     let files = [
         ("spz_v2", to_spz(&cloud, SpzVersion::V2).expect("SPZ v2")),
         ("spz_v4", to_spz(&cloud, SpzVersion::V4).expect("SPZ v4")),

@@ -3,7 +3,7 @@
 //!
 //! Scenes (`SPLATGL_BENCH_SCENES`, default `biker,1m,4m`): `biker` = the real 152,746-splat
 //! `playcanvas_biker.compressed.ply` (framed as the CLI frames PLY scenes), `1m` = a generated
-//! 1M-splat SH-3 cloud, `4m` = a generated 4M-splat SH-0 cloud (`scene::random_cloud` in
+//! 1M-splat SH-3 cloud, `4m` = a generated 4M-splat SH-0 cloud (`synthetic::random_cloud` in
 //! [-1, 1]³, scales × 0.2·(10⁵/n)^(1/3)·`SPLATGL_BENCH_SCALE`, seen from 3.2 units with a
 //! 50° vertical field of view). Views: `full` (everything in view) and `half` (the camera
 //! turned, by bisection on the CPU cull, until about half the splats are in view).
@@ -45,7 +45,7 @@ use splatgl::gl::{
     frustum_for_camera,
 };
 use splatgl::headless::{GlApi, HeadlessContext};
-use splatgl::{SplatCloud, scene};
+use splatgl::{SplatCloud, synthetic};
 
 /// CPU time of the whole process (all threads, so llvmpipe's threads count).
 fn cpu_time() -> Duration {
@@ -299,7 +299,7 @@ fn half_view(cam: &Camera, cloud: &SplatCloud, bounds: &CullBounds) -> Camera {
 fn scene(name: &str, w: u32, h: u32, scale: f32) -> Option<(SplatCloud, Camera, Vec3)> {
     let fov = 50f32.to_radians();
     let generated = |n: usize, degree: u8| {
-        let mut cloud = scene::random_cloud(n, degree, 1.0, 1234);
+        let mut cloud = synthetic::random_cloud(n, degree, 1.0, 1234);
         let k = scale * 0.2 * (1e5 / n as f32).cbrt();
         for s in &mut cloud.scales {
             *s = s.map(|v| v * k);

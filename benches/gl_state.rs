@@ -23,7 +23,7 @@ use glow::HasContext;
 use splatgl::camera::Camera;
 use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer, sort_back_to_front};
 use splatgl::headless::{GlApi, HeadlessContext};
-use splatgl::scene;
+use splatgl::synthetic;
 
 fn main() {
     let smoke = !std::env::args().any(|a| a == "--bench");
@@ -46,7 +46,7 @@ fn run(ctx: &HeadlessContext, draws: usize) {
     let gl = ctx.gl();
     let mut frame = ReadbackTarget::new(gl, 64, 64, ColorFormat::Rgba8, None).unwrap();
     frame.bind(gl).unwrap();
-    let cloud = scene::random_cloud(1000, 1, 0.8, 5);
+    let cloud = synthetic::random_cloud(1000, 1, 0.8, 5);
     let cam = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9, 64, 64);
     let mut order = Vec::new();
     sort_back_to_front(&cloud.positions, cam.eye(), &mut order);

@@ -69,7 +69,7 @@ fn bench_file() -> PathBuf {
 }
 
 fn generate(p: &Path) {
-    let cloud = splatgl::scene::random_cloud(N, 3, 10.0, 7);
+    let cloud = splatgl::synthetic::random_cloud(N, 3, 10.0, 7);
     let bytes = splatgl::write::to_inria_ply_with_normals(&cloud);
     splatgl::write::write_bytes_atomic(p, &[], &bytes).expect("bench file");
 }

@@ -6,7 +6,7 @@ use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use glam::Vec3;
 use splatgl::camera::Camera;
 use splatgl::reference::{RenderOptions, render_with_stats};
-use splatgl::scene::random_cloud;
+use splatgl::synthetic::random_cloud;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {

@@ -17,7 +17,7 @@ use splatgl::camera::Camera;
 use splatgl::cull::{CullBounds, Frustum, visible_into};
 use splatgl::sort::{Precision, SortRequest, Sorter, far_first_key, squared_distance};
 
-use splatgl::scene::Rng;
+use splatgl::synthetic::Rng;
 
 /// A scene and the eye to sort it for.
 struct Scene {

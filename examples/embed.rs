@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let cloud = match args.next() {
         Some(p) => splatgl::load::load_path(&p, &Default::default())?.cloud,
-        None => splatgl::scene::default_scene(),
+        None => splatgl::synthetic::default_scene(),
     };
     let prefix = args.next().unwrap_or_else(|| "embed".into());
     let ctx = HeadlessContext::new()?;

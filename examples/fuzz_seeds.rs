@@ -8,7 +8,7 @@
 //! 0–3, `.splat`, `.ksplat` of levels 0–2, SOG bundles and a bare meta.json — plus the real
 //! files under 64 KiB.
 use splatgl::SplatCloud;
-use splatgl::scene::random_cloud;
+use splatgl::synthetic::random_cloud;
 use splatgl::write::{Comp, GltfWriteOptions, to_glb, to_gltf, to_inria_ply};
 use splatgl::write::{SpzVersion, SpzWriteOptions, to_glb_spz, to_splat, to_spz_with};
 use std::path::Path;

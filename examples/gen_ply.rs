@@ -14,7 +14,7 @@ fn main() {
         .next()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1_000_000);
-    let cloud = splatgl::scene::random_cloud(n, 3, 10.0, 7);
+    let cloud = splatgl::synthetic::random_cloud(n, 3, 10.0, 7);
     let path = std::path::Path::new(&out);
     let result = if normals {
         let bytes = splatgl::write::to_inria_ply_with_normals(&cloud);

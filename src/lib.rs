@@ -32,10 +32,10 @@ pub mod profile;
 pub mod reference;
 // Synthetic scenes (the CLI's default scene, seeded random clouds for tests, benches and
 // examples): public for those targets, not part of the documented API.
-#[doc(hidden)]
-pub mod scene;
 pub mod sh;
 pub mod sort;
+#[doc(hidden)]
+pub mod synthetic;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod write;

@@ -269,6 +269,6 @@ fn auto_up_axis_takes_z_for_content_standing_on_z_zero() {
         UpAxis::NegY
     );
     // Not taller along z than wide: −Y.
-    let wide = splatgl::scene::random_cloud(200, 0, 1.0, 5);
+    let wide = splatgl::synthetic::random_cloud(200, 0, 1.0, 5);
     assert_eq!(UpAxis::for_cloud(Some(Format::Ply), &wide), UpAxis::NegY);
 }

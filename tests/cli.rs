@@ -145,7 +145,7 @@ fn info_reports_the_container_and_validate_accepts_spz_compression() {
 /// to sRGB once at the end, over a background given in display values.
 #[test]
 fn backends_agree_on_linear_colour_space() {
-    let mut cloud = splatgl::scene::default_scene();
+    let mut cloud = splatgl::synthetic::default_scene();
     cloud.meta.color_space =
         splatgl::cloud::Known::Known(splatgl::cloud::ColorSpace::LinRec709Display);
     let scene = tmp(
@@ -340,7 +340,7 @@ fn errors_are_reported_not_panics() {
 /// `--print-camera-json` writes a cameras.json that does too.
 #[test]
 fn printed_camera_renders_the_same_image() {
-    let cloud = splatgl::scene::random_cloud(300, 1, 1.0, 11);
+    let cloud = splatgl::synthetic::random_cloud(300, 1, 1.0, 11);
     let ply = tmp("printed.ply", &splatgl::write::to_inria_ply(&cloud));
     let dir = ply.parent().unwrap().to_owned();
     let out = |n: &str| dir.join(n).to_str().unwrap().to_owned();
@@ -379,7 +379,7 @@ fn printed_camera_renders_the_same_image() {
 /// framing does), or the `--up` given.
 #[test]
 fn look_at_default_up_is_the_up_axis() {
-    let cloud = splatgl::scene::random_cloud(200, 0, 1.0, 12);
+    let cloud = splatgl::synthetic::random_cloud(200, 0, 1.0, 12);
     let ply = tmp("up.ply", &splatgl::write::to_inria_ply(&cloud));
     let dir = ply.parent().unwrap().to_owned();
     let render = |extra: &[&str], name: &str| {

@@ -22,7 +22,7 @@ fn dir(name: &str) -> PathBuf {
 
 fn ply(d: &Path) -> String {
     let p = d.join("s.ply");
-    let cloud = splatgl::scene::random_cloud(120, 0, 1.0, 21);
+    let cloud = splatgl::synthetic::random_cloud(120, 0, 1.0, 21);
     std::fs::write(&p, splatgl::write::to_inria_ply(&cloud)).unwrap();
     p.to_str().unwrap().to_owned()
 }
@@ -100,7 +100,7 @@ fn view_all_renders_every_view_of_a_cameras_json() {
 fn gltf_camera_all_renders_every_camera_node() {
     use base64::Engine;
     let d = dir("gltf");
-    let cloud = splatgl::scene::random_cloud(100, 0, 1.0, 22);
+    let cloud = splatgl::synthetic::random_cloud(100, 0, 1.0, 22);
     let (mut doc, bin) = splatgl::write::build(&cloud, &Default::default());
     let nodes = doc["nodes"].as_array_mut().unwrap();
     let first = nodes.len();

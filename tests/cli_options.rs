@@ -21,7 +21,7 @@ fn dir(name: &str) -> PathBuf {
 /// A small PLY scene in `d`.
 fn ply(d: &std::path::Path) -> String {
     let p = d.join("s.ply");
-    let cloud = splatgl::scene::random_cloud(50, 0, 1.0, 3);
+    let cloud = splatgl::synthetic::random_cloud(50, 0, 1.0, 3);
     std::fs::write(&p, splatgl::write::to_inria_ply(&cloud)).unwrap();
     p.to_str().unwrap().to_owned()
 }

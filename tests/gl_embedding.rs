@@ -47,8 +47,8 @@ fn raise_host_error(gl: &glow::Context, code: u32) {
 
 /// Every call of the renderer and the scene, in `settings`' mode.
 fn every_call(gl: &glow::Context, settings: DrawSettings) {
-    let cloud = scene::random_cloud(40, 3, 0.8, 7);
-    let other = scene::random_cloud(30, 1, 0.6, 8);
+    let cloud = synthetic::random_cloud(40, 3, 0.8, 7);
+    let other = synthetic::random_cloud(30, 1, 0.6, 8);
     let cam = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 50, 60);
     let order: Vec<u32> = (0..40).rev().collect();
     let mut r = SplatRenderer::new(gl).unwrap();
@@ -266,7 +266,7 @@ fn hostile_inherited_state_does_not_change_the_splats() {
     };
     let gl = ctx.gl();
     let lgl = host::legacy_gl::LegacyGl::load(|n| ctx.get_proc_address(n)).unwrap();
-    let cloud = scene::random_cloud(300, 2, 0.8, 21);
+    let cloud = synthetic::random_cloud(300, 2, 0.8, 21);
     let cam = look_at_fov_deg(Vec3::new(0.3, 0.2, 3.0), Vec3::ZERO, 50.0, 64, 64);
     // An sRGB target: a host's GL_FRAMEBUFFER_SRGB would re-encode srgb_rec709 colours.
     let target = ReadbackTarget::new(gl, 64, 64, ColorFormat::Srgb8Alpha8, None).unwrap();
@@ -522,7 +522,7 @@ fn draw_with_a_cameras_matrices_equals_draw_with_the_camera() {
         return;
     };
     let gl = ctx.gl();
-    let cloud = scene::random_cloud(400, 3, 0.8, 5);
+    let cloud = synthetic::random_cloud(400, 3, 0.8, 5);
     let mut r = SplatRenderer::new(gl).unwrap();
     r.upload(gl, &cloud).unwrap();
     r.settings_mut().depth_test = false;
@@ -601,8 +601,8 @@ fn interleaved_clouds_render_like_the_merged_cloud_through_the_reference() {
     let gl = ctx.gl();
     // Two clouds in the same volume (their splats interleave in depth), SH degree 3, placed by
     // a similarity and by a non-uniform scale with rotation and translation.
-    let a = scene::random_cloud(700, 3, 0.7, 31);
-    let b = scene::random_cloud(700, 3, 0.7, 32);
+    let a = synthetic::random_cloud(700, 3, 0.7, 31);
+    let b = synthetic::random_cloud(700, 3, 0.7, 32);
     let ma = Mat4::from_translation(Vec3::new(-0.15, 0.05, 0.1))
         * Mat4::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.9)
         * Mat4::from_scale(Vec3::splat(1.1));
@@ -698,7 +698,7 @@ fn legacy_host_example_keeps_its_texture_arrays_and_vbo_frame_after_frame() {
     };
     let (w, h) = (96, 72);
     // Splats well above the ground, so the ground's lower rows stay free of them.
-    let mut cloud = scene::random_cloud(300, 1, 0.5, 41);
+    let mut cloud = synthetic::random_cloud(300, 1, 0.5, 41);
     for p in &mut cloud.positions {
         p[1] += 0.6;
     }

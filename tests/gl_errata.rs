@@ -100,7 +100,7 @@ fn erratum_d_focal_offset_and_centre() {
 
 #[test]
 fn erratum_e_appendix_sh() {
-    let mut cloud = scene::random_cloud(40, 3, 1.0, 13);
+    let mut cloud = synthetic::random_cloud(40, 3, 1.0, 13);
     for (k, c) in cloud.sh.iter_mut().enumerate() {
         if k % 16 != 0 {
             *c = c.map(|v| v * 2.0);
@@ -144,7 +144,7 @@ fn erratum_e_sign_flips_alone_change_colour() {
 
 #[test]
 fn erratum_g_src_alpha_blend_front_to_back() {
-    let cloud = scene::random_cloud(300, 0, 1.0, 17);
+    let cloud = synthetic::random_cloud(300, 0, 1.0, 17);
     let c = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO, 50.0, 64, 48);
     let errata = Errata {
         g_src_alpha_blend: true,

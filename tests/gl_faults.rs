@@ -142,7 +142,7 @@ fn missing_extension_is_named() {
     );
     // The headless renderer reports it instead of rendering nothing.
     let Some(mut r) = headless() else { return };
-    let cloud = scene::random_cloud(50, 0, 0.5, 1);
+    let cloud = synthetic::random_cloud(50, 0, 0.5, 1);
     r.upload(&cloud).unwrap();
     let cam = look_at_fov_deg(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 50.0, 16, 16);
     let opts = HeadlessOptions {
@@ -172,7 +172,7 @@ fn render_with_faults(
 fn clouds_beyond_one_texture_are_split_over_array_layers_with_identical_pixels() {
     // 2000 splats of SH degree 3 take 24000 SH texels: with GL_MAX_TEXTURE_SIZE lowered to 64
     // one texture holds 4096, so the cloud needs 6 layers.
-    let cloud = scene::random_cloud(2000, 3, 0.8, 77);
+    let cloud = synthetic::random_cloud(2000, 3, 0.8, 77);
     let cam = look_at_fov_deg(Vec3::new(0.2, 0.3, 2.8), Vec3::ZERO, 50.0, 64, 48);
     let Some(whole) = or_skip(
         render_with_faults(&cloud, &cam, Faults::default()),
@@ -215,7 +215,7 @@ fn clouds_beyond_one_texture_are_split_over_array_layers_with_identical_pixels()
 fn out_of_memory_on_upload_is_an_error_and_the_previous_cloud_stays() {
     let Some(mut r) = headless() else { return };
     let cam = look_at_fov_deg(Vec3::new(0.0, 0.2, 3.0), Vec3::ZERO, 50.0, 48, 48);
-    let first = scene::random_cloud(300, 1, 0.7, 3);
+    let first = synthetic::random_cloud(300, 1, 0.7, 3);
     r.upload(&first).unwrap();
     let before = r.render(&cam, &HeadlessOptions::default()).unwrap();
     // SAFETY: a plain integer query.
@@ -230,7 +230,8 @@ fn out_of_memory_on_upload_is_an_error_and_the_previous_cloud_stays() {
             oversize_layers: Some(layers),
             ..Faults::default()
         });
-        r.upload(&scene::random_cloud(10, 0, 0.5, 4)).unwrap_err()
+        r.upload(&synthetic::random_cloud(10, 0, 0.5, 4))
+            .unwrap_err()
     };
     assert!(
         matches!(
@@ -255,7 +256,7 @@ fn host_errors_are_kept_or_reported_never_swallowed() {
         return;
     };
     let gl = ctx.gl();
-    let cloud = scene::random_cloud(20, 0, 0.5, 9);
+    let cloud = synthetic::random_cloud(20, 0, 0.5, 9);
     let mut r = SplatRenderer::new(gl).unwrap();
     // SAFETY: invalid calls of the "host" that GL rejects without effect, and glGetError.
     unsafe {

@@ -55,7 +55,7 @@ fn single_splats_many_anisotropies_and_rotations() {
 #[test]
 fn sh_degrees_0_to_3_from_several_views() {
     let Some(mut r) = headless() else { return };
-    let mut cloud = scene::random_cloud(80, 3, 1.0, 7);
+    let mut cloud = synthetic::random_cloud(80, 3, 1.0, 7);
     // Stronger view dependence than random_cloud's ±0.3.
     for (k, c) in cloud.sh.iter_mut().enumerate() {
         if k % 16 != 0 {
@@ -102,7 +102,7 @@ fn sh_degrees_0_to_3_from_several_views() {
 #[test]
 fn dense_random_cloud_both_targets() {
     let Some(mut r) = headless() else { return };
-    let cloud = scene::random_cloud(4000, 1, 1.0, 42);
+    let cloud = synthetic::random_cloud(4000, 1, 1.0, 42);
     let c = look_at_fov_deg(Vec3::new(2.0, 1.0, 3.0), Vec3::ZERO, 50.0, 96, 72);
     for opts in both_targets() {
         check("dense", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
@@ -112,8 +112,8 @@ fn dense_random_cloud_both_targets() {
 #[test]
 fn default_scene_both_targets() {
     let Some(mut r) = headless() else { return };
-    let cloud = scene::default_scene();
-    let c = scene::default_camera(96, 72);
+    let cloud = synthetic::default_scene();
+    let c = synthetic::default_camera(96, 72);
     for mut opts in both_targets() {
         opts.background = [1.0, 1.0, 1.0];
         check("default scene", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
@@ -229,7 +229,7 @@ fn tiny_sub_pixel_splats() {
 #[test]
 fn lin_rec709_display_both_targets() {
     let Some(mut r) = headless() else { return };
-    let mut cloud = scene::random_cloud(1500, 2, 1.0, 9);
+    let mut cloud = synthetic::random_cloud(1500, 2, 1.0, 9);
     cloud.meta.color_space = splatgl::cloud::Known::Known(ColorSpace::LinRec709Display);
     let c = look_at_fov_deg(Vec3::new(-2.0, 1.5, 3.0), Vec3::ZERO, 50.0, 80, 64);
     for mut opts in both_targets() {
@@ -260,7 +260,7 @@ fn desktop_gl_330_core_matches_reference() {
     };
     eprintln!("{}", r.context().describe());
     assert!(!glow::HasContext::version(r.context().gl()).is_embedded);
-    let mut cloud = scene::random_cloud(1500, 3, 1.0, 31);
+    let mut cloud = synthetic::random_cloud(1500, 3, 1.0, 31);
     let c = look_at_fov_deg(Vec3::new(1.5, -1.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     for opts in both_targets() {
         check("desktop 330 core", &mut r, &cloud, &c, &opts, MAX_ERR_DENSE);
@@ -282,7 +282,7 @@ fn desktop_gl_330_core_matches_reference() {
 #[test]
 fn same_scene_twice_is_bit_identical() {
     let Some(mut r) = headless() else { return };
-    let cloud = scene::random_cloud(2000, 3, 1.0, 1);
+    let cloud = synthetic::random_cloud(2000, 3, 1.0, 1);
     let c = look_at_fov_deg(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, 50.0, 64, 48);
     for opts in both_targets() {
         r.upload(&cloud).unwrap();
@@ -302,7 +302,7 @@ fn same_scene_twice_is_bit_identical() {
 fn a_render_does_not_depend_on_the_colour_space_of_the_one_before() {
     // The draw switches GL_FRAMEBUFFER_SRGB per colour space and leaves it so: the next
     // render's clear of an sRGB target must not inherit it.
-    let cloud = scene::random_cloud(500, 1, 0.8, 2);
+    let cloud = synthetic::random_cloud(500, 1, 0.8, 2);
     let c = look_at_fov_deg(Vec3::new(0.5, 0.5, 3.0), Vec3::ZERO, 50.0, 48, 40);
     let bg = [0.3, 0.5, 0.7];
     let linear = HeadlessOptions {
@@ -331,7 +331,7 @@ fn a_render_does_not_depend_on_the_colour_space_of_the_one_before() {
 fn rgba16f_resolve_is_closer_to_the_reference_than_rgba8() {
     let Some(mut r) = headless() else { return };
     // Many low-opacity layers: where 8-bit blending loses most.
-    let mut cloud = scene::random_cloud(3000, 0, 0.6, 21);
+    let mut cloud = synthetic::random_cloud(3000, 0, 0.6, 21);
     for o in &mut cloud.opacities {
         *o *= 0.15;
     }
@@ -371,7 +371,7 @@ fn rgba16f_resolve_is_closer_to_the_reference_than_rgba8() {
 #[test]
 fn non_finite_splats_are_skipped_like_the_reference() {
     let Some(mut r) = headless() else { return };
-    let mut cloud = scene::random_cloud(200, 1, 1.0, 77);
+    let mut cloud = synthetic::random_cloud(200, 1, 1.0, 77);
     let n = cloud.len();
     cloud.positions[3] = [f32::NAN, 0.0, 0.0];
     cloud.positions[5] = [0.0, f32::INFINITY, 0.0];
@@ -411,7 +411,7 @@ fn empty_cloud_and_partial_orders() {
     let want = [0.2f32, 0.4, 0.6].map(|v| (v * 255.0).round() / 255.0);
     assert!(img.pixels.iter().all(|p| p[..3] == want && p[3] == 0.0));
     // An order longer than the cloud is an error, not a GPU read out of bounds.
-    let cloud = scene::random_cloud(10, 0, 1.0, 2);
+    let cloud = synthetic::random_cloud(10, 0, 1.0, 2);
     r.upload(&cloud).unwrap();
     let err = r.render_with_order(&c, &HeadlessOptions::default(), &[0; 11]);
     assert!(matches!(
@@ -452,8 +452,8 @@ fn empty_cloud_and_partial_orders() {
 #[test]
 fn one_shot_render_function_matches_the_renderer() {
     // `splatgl::headless::render` is what a CLI `--backend gl` calls.
-    let cloud = scene::default_scene();
-    let c = scene::default_camera(48, 36);
+    let cloud = synthetic::default_scene();
+    let c = synthetic::default_camera(48, 36);
     let opts = HeadlessOptions {
         background: [0.1, 0.1, 0.1],
         sh_degree: Some(3), // above the cloud's degree 1: clamped, like the reference
@@ -515,7 +515,7 @@ fn real_files_render_without_gl_errors() {
 #[test]
 fn splats_beyond_the_far_plane_are_drawn() {
     let Some(mut r) = headless() else { return };
-    let mut cloud = scene::random_cloud(60, 0, 1.0, 4);
+    let mut cloud = synthetic::random_cloud(60, 0, 1.0, 4);
     for p in &mut cloud.positions {
         p[2] -= 40.0;
     }

@@ -14,7 +14,7 @@ const LAYERS: &[&[&str]] = &[
     // The camera model (framing, cameras.json, glTF cameras).
     &["camera"],
     // Reading and writing files; images; the synthetic scenes.
-    &["load", "write", "image", "compare", "scene"],
+    &["load", "write", "image", "compare", "synthetic"],
     // Per-frame CPU stages; the converter.
     &["cull", "sort", "convert"],
     // The two renderers.

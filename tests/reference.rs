@@ -10,8 +10,8 @@ use splatgl::cloud::SplatCloud;
 use splatgl::covariance::{scale_rotation_from_covariance, transformed_covariance};
 use splatgl::image::Image;
 use splatgl::reference::{RenderOptions, SortMode, render};
-use splatgl::scene::random_cloud;
 use splatgl::sh::ShRotation;
+use splatgl::synthetic::random_cloud;
 
 const C0: f64 = 0.282_094_791_773_878_1; // RC §Lighting
 const C1: f64 = 0.488_602_511_902_919_9;
@@ -645,11 +645,11 @@ fn pixel_bits(img: &Image) -> Vec<u32> {
 /// opacity-aware boxes alone, and the default (opacity-aware boxes, culled before the sort);
 /// asserts the images are bit-identical and returns the tile entries of the first two.
 fn same_image_by_every_path(what: &str, cloud: &SplatCloud, cam: &Camera) -> (usize, usize) {
-    use splatgl::reference::{Extent, Path, render_with_path};
+    use splatgl::reference::{Path, PixelBox, render_with_path};
     let o = opts();
     let (full, full_stats) = render_with_path(cloud, cam, &o, Path::FULL);
     let extent_only = Path {
-        extent: Extent::OpacityAware,
+        extent: PixelBox::OpacityAware,
         cull: false,
     };
     let (boxed, boxed_stats) = render_with_path(cloud, cam, &o, extent_only);

@@ -53,7 +53,7 @@ static GLOBAL: Counting = Counting;
 
 // ---------------------------------------------------------------- helpers
 
-use splatgl::scene::Rng;
+use splatgl::synthetic::Rng;
 
 /// The documented draw order: NaN first, then larger keys first (−0 = +0).
 fn far_first(a: f32, b: f32) -> Ordering {

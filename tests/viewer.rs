@@ -429,7 +429,7 @@ fn failed_drop_keeps_the_previous_scene() {
     let Some(want) = reference(&cwd) else {
         return;
     };
-    let ply = splatgl::write::to_inria_ply(&splatgl::scene::default_scene());
+    let ply = splatgl::write::to_inria_ply(&splatgl::synthetic::default_scene());
     let truncated = cwd.join("truncated.ply");
     std::fs::write(&truncated, &ply[..ply.len() / 2]).unwrap();
     let x = x_server();

@@ -192,7 +192,7 @@ impl Val {
 /// The generated document before edits: (JSON, binary buffer).
 fn base(input: &Input) -> (Value, Vec<u8>) {
     let n = input.splats as usize % 9;
-    let cloud = splatgl::scene::random_cloud(n, input.degree % 4, 3.0, input.seed as u64);
+    let cloud = splatgl::synthetic::random_cloud(n, input.degree % 4, 3.0, input.seed as u64);
     let pick =
         |options: &[Comp], shift: u8| options[(input.types >> shift) as usize % options.len()];
     let o = GltfWriteOptions {

@@ -293,7 +293,7 @@ fn go(a: &Args) -> Result<(), String> {
             let s = load(p, a, progress)?;
             (s.cloud, Some(s.report.format), s.cameras)
         }
-        None => (splatgl::scene::default_scene(), None, Vec::new()),
+        None => (splatgl::synthetic::default_scene(), None, Vec::new()),
     };
     let file = a
         .scene

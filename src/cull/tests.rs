@@ -171,7 +171,7 @@ fn a_scaled_view_matrix_keeps_what_the_rigid_one_keeps() {
         c.tan_half_fov(),
         0.2,
     );
-    let mut rng = crate::scene::Rng::new(11);
+    let mut rng = crate::synthetic::Rng::new(11);
     let mut kept = 0;
     for _ in 0..20_000 {
         let p = [

@@ -21,7 +21,7 @@ mod raster;
 mod sort;
 
 #[doc(hidden)]
-pub use project::Extent;
+pub use project::PixelBox;
 use project::{Projected, ViewContext};
 pub use sort::{SortMode, back_to_front, sort_key};
 
@@ -91,7 +91,7 @@ pub fn render(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Imag
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Path {
     /// Pixel box per splat.
-    pub extent: Extent,
+    pub extent: PixelBox,
     /// Project and sort only the splats the camera's frustum may see ([`crate::cull`]).
     pub cull: bool,
 }
@@ -99,7 +99,7 @@ pub struct Path {
 impl Default for Path {
     fn default() -> Self {
         Path {
-            extent: Extent::OpacityAware,
+            extent: PixelBox::OpacityAware,
             cull: true,
         }
     }
@@ -108,7 +108,7 @@ impl Default for Path {
 impl Path {
     /// The rules before the opacity-aware extent and the cull: 3σ boxes, every splat.
     pub const FULL: Path = Path {
-        extent: Extent::Full,
+        extent: PixelBox::Full,
         cull: false,
     };
 }
@@ -195,7 +195,12 @@ pub fn render_with_path(
 #[doc(hidden)]
 pub fn footprints(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Vec<[f32; 6]> {
     let degree = opts.sh_degree.min(cloud.sh_degree);
-    let ctx = ViewContext::new(camera, opts.cull_depth(camera) as f64, degree, Extent::Full);
+    let ctx = ViewContext::new(
+        camera,
+        opts.cull_depth(camera) as f64,
+        degree,
+        PixelBox::Full,
+    );
     (0..cloud.len())
         .into_par_iter()
         .filter_map(|i| ctx.project(cloud, i))

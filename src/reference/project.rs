@@ -30,7 +30,7 @@ pub(crate) struct Projected {
     /// SH colour (negatives clamped to 0).
     pub(crate) color: [f32; 3],
     /// `[x0, x1, y0, y1]`: the pixels `x0..x1` × `y0..y1` (exclusive ends) whose centres lie in
-    /// the bounding box of the ellipse m² ≤ `m2_max` (with [`Extent::Full`]: of the 3σ
+    /// the bounding box of the ellipse m² ≤ `m2_max` (with [`PixelBox::Full`]: of the 3σ
     /// ellipse), clipped to the image; never empty.
     pub(crate) bbox: [u32; 4],
 }
@@ -40,7 +40,7 @@ pub(crate) struct Projected {
 /// the switch exists for the tests and benchmarks that show it.
 #[doc(hidden)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Extent {
+pub enum PixelBox {
     /// The box of the ellipse m² ≤ min(9, 2·ln(opacity/ALPHA_MIN) + margin), widened by a
     /// proven bound on the f32 rounding of the per-pixel m² (the default).
     #[default]
@@ -63,13 +63,13 @@ pub(crate) struct ViewContext {
     cull_z: f64,
     size: [u32; 2],
     sh_degree: u8,
-    extent: Extent,
+    extent: PixelBox,
 }
 
 impl ViewContext {
     /// Constants for `camera`; splats with view z ≤ `cull_z` are culled; SH up to `sh_degree`;
     /// pixel boxes by `extent`.
-    pub(crate) fn new(camera: &Camera, cull_z: f64, sh_degree: u8, extent: Extent) -> Self {
+    pub(crate) fn new(camera: &Camera, cull_z: f64, sh_degree: u8, extent: PixelBox) -> Self {
         let w2c = camera.world_to_camera.as_dmat4();
         let tan = camera.tan_half_fov().as_dvec2();
         ViewContext {
@@ -133,8 +133,8 @@ impl ViewContext {
         let m2_max = m2_max as f32;
         let conic = [(c / det) as f32, (-b / det) as f32, (a / det) as f32];
         let (ex, ey) = match self.extent {
-            Extent::Full => (3.0 * a.sqrt(), 3.0 * c.sqrt()),
-            Extent::OpacityAware => box_extents([a, b, c], det, conic, [u, v], m2_max),
+            PixelBox::Full => (3.0 * a.sqrt(), 3.0 * c.sqrt()),
+            PixelBox::OpacityAware => box_extents([a, b, c], det, conic, [u, v], m2_max),
         };
         let bbox = pixel_range(u, ex, self.size[0]).zip(pixel_range(v, ey, self.size[1]))?;
         let dir = (mean - self.eye).normalize().as_vec3().to_array();

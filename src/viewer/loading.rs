@@ -100,7 +100,12 @@ fn load(
     send: &impl Fn(LoadEvent),
 ) -> Result<Box<Loaded>, String> {
     let (cloud, format, cameras, warnings) = match &path {
-        None => (crate::scene::default_scene(), None, Vec::new(), Vec::new()),
+        None => (
+            crate::synthetic::default_scene(),
+            None,
+            Vec::new(),
+            Vec::new(),
+        ),
         Some(p) => {
             let bytes = read_with_progress(id, p, opts.limits.max_bytes, send)?;
             send(LoadEvent::Decoding { id });

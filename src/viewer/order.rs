@@ -148,7 +148,7 @@ impl Orders {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Rng;
+    use crate::synthetic::Rng;
 
     /// The documented bound: an order sorted for `e₀`, drawn from `e₁` with `2|e₁ − e₀| ≤ τ`
     /// ([`decide`] says `Stale`), has every inverted pair within `τ` of each other in distance

@@ -38,7 +38,7 @@ pub use splatgl::headless::{
 };
 pub use splatgl::image::Image;
 pub use splatgl::reference;
-pub use splatgl::scene::{self, Rng};
+pub use splatgl::synthetic::{self, Rng};
 
 /// Sparse scenes: (1 + 2) · 0.5/255 rounding + the 0.011 cut jump.
 pub const MAX_ERR_SPARSE: f32 = 1.5 / 255.0 + 0.0111;

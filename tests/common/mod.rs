@@ -1,4 +1,4 @@
-//! Shared test helpers: the seeded generator and random clouds (from `splatgl::scene`), the
+//! Shared test helpers: the seeded generator and random clouds (from `splatgl::synthetic`), the
 //! real-data folder, cameras and single-colour SH. The GL helpers (headless renderer, scores,
 //! error bounds) are in [`gl`]; test-side encoders of the packed formats in [`packed`]; running
 //! the binary in [`cli`].
@@ -8,7 +8,7 @@ use glam::Vec3;
 use splatgl::camera::Camera;
 use std::path::{Path, PathBuf};
 
-pub use splatgl::scene::{Rng, random_cloud};
+pub use splatgl::synthetic::{Rng, random_cloud};
 
 pub mod cli;
 #[cfg(feature = "gl")]
