@@ -29,11 +29,13 @@ use glam::{DMat3, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
 mod choose;
 mod frame;
 mod json;
+mod up;
 pub use choose::{LookAtSpec, SceneView, ViewOptions};
-pub use frame::{Extent, FIT_SIGMAS, FRAME_MARGIN, LookAt, UpAxis, Z_UP_BELOW, Z_UP_TALLER};
+pub use frame::{Extent, FIT_SIGMAS, FRAME_MARGIN, LookAt};
 pub use json::{
     CamerasJsonEntry, load_cameras_json, load_cameras_json_limited, parse_cameras_json,
 };
+pub use up::{UpAxis, Z_UP_BELOW, Z_UP_TALLER};
 
 /// Why a camera could not be built.
 #[derive(Debug, thiserror::Error)]

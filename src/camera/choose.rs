@@ -4,7 +4,7 @@
 use glam::Vec3;
 use std::path::PathBuf;
 
-use super::frame::UpAxis;
+use super::up::UpAxis;
 use super::{Camera, CameraError, CamerasJsonEntry, GltfPerspective, load_cameras_json_limited};
 use crate::cloud::SplatCloud;
 use crate::files::{Format, Limits};

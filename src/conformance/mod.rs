@@ -15,6 +15,7 @@ mod assets_pixel;
 mod assets_scene;
 pub mod diagnosis;
 mod generate;
+mod isolation;
 pub mod manifest;
 pub mod model;
 pub mod render;

@@ -20,137 +20,12 @@ use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2, JACOBIAN_CLA
 use crate::reference::{SortMode, back_to_front};
 use glam::{DMat3, DQuat, DVec3};
 
-/// Implementation variants beside the errata: choices and mistakes seen in real renderers,
-/// which the runner's diagnosis tests an image against ([`render_with`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Variant {
-    /// Splats cut by their oriented 3.33σ bounding box instead of the 3σ ellipse.
-    BoxCut,
-    /// Blending order by view depth (camera-space z; per tile or global, the same per pixel)
-    /// instead of camera distance.
-    ViewDepthOrder,
-    /// Opacity scaled by √(det Σ' / det(Σ' + 0.3 I)) (Mip-Splatting / gsplat antialiasing).
-    AaCompensation,
-    /// SH evaluated up to degree 0 only (the RC: "MAY ignore higher-degree coefficients").
-    ShDegree0,
-    /// SH evaluated up to degree 1 only (allowed likewise).
-    ShDegree1,
-    /// SH evaluated up to degree 2 only (allowed likewise).
-    ShDegree2,
-    /// ROTATION read as `(w, x, y, z)` instead of glTF's `(x, y, z, w)`.
-    QuatWxyz,
-    /// SCALE read as log-space (`exp(s)`, the review draft) instead of linear.
-    LogScale,
-    /// Colour as `sigmoid(Σ SH·Y)` instead of `Σ SH·Y + 0.5`.
-    SigmoidColour,
-    /// The DC colour (`SH_C0·DC + 0.5`) and the opacity stored in 8 bits, rounded down
-    /// (GaussianSplats3D's splat buffers).
-    Colour8Bit,
-    /// Σ' rebuilt from eigenvalues `mid ± √max(0.1, mid² − det)`, and dropped when the smaller
-    /// is ≤ 0 (GaussianSplats3D's vertex shader): near-round footprints come out slightly
-    /// anisotropic, sub-pixel splats vanish.
-    EigenvalueFloor,
-}
-
-impl Variant {
-    /// All of them.
-    pub const ALL: [Variant; 11] = [
-        Variant::BoxCut,
-        Variant::ViewDepthOrder,
-        Variant::AaCompensation,
-        Variant::ShDegree0,
-        Variant::ShDegree1,
-        Variant::ShDegree2,
-        Variant::QuatWxyz,
-        Variant::LogScale,
-        Variant::SigmoidColour,
-        Variant::Colour8Bit,
-        Variant::EigenvalueFloor,
-    ];
-    /// A short identifier (the diagnosis's `rule`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Variant::BoxCut => "bounding_box_cutoff",
-            Variant::ViewDepthOrder => "view_depth_order",
-            Variant::AaCompensation => "antialiasing_compensation",
-            Variant::ShDegree0 => "sh_ignored_above_degree_0",
-            Variant::ShDegree1 => "sh_ignored_above_degree_1",
-            Variant::ShDegree2 => "sh_ignored_above_degree_2",
-            Variant::QuatWxyz => "quaternion_read_as_wxyz",
-            Variant::LogScale => "scale_read_as_log",
-            Variant::SigmoidColour => "sigmoid_colour",
-            Variant::Colour8Bit => "colour_and_opacity_8bit",
-            Variant::EigenvalueFloor => "eigenvalue_floor",
-        }
-    }
-    /// What a renderer with this variant does, for reports.
-    pub fn describe(self) -> &'static str {
-        match self {
-            Variant::BoxCut => "splats cut by a 3.33σ bounding box instead of the 3σ ellipse",
-            Variant::ViewDepthOrder => {
-                "splats ordered by view depth (camera-space z) instead of distance to the camera"
-            }
-            Variant::AaCompensation => {
-                "opacity scaled by √(det Σ' / det(Σ' + 0.3 I)) (antialiased kernel)"
-            }
-            Variant::ShDegree0 => "SH coefficients above degree 0 ignored",
-            Variant::ShDegree1 => "SH coefficients above degree 1 ignored",
-            Variant::ShDegree2 => "SH coefficients above degree 2 ignored",
-            Variant::QuatWxyz => "ROTATION read as (w, x, y, z) instead of (x, y, z, w)",
-            Variant::LogScale => "SCALE read as ln(scale) (the review draft) instead of linear",
-            Variant::SigmoidColour => "colour = sigmoid(Σ SH·Y) instead of Σ SH·Y + 0.5",
-            Variant::Colour8Bit => {
-                "DC colour and opacity stored in 8 bits, rounded down (lossy storage)"
-            }
-            Variant::EigenvalueFloor => {
-                "Σ' rebuilt from eigenvalues mid ± √max(0.1, mid² − det) (near-round footprints anisotropic, sub-pixel splats dropped)"
-            }
-        }
-    }
-    /// The RC section whose rule the variant departs from.
-    pub fn rc_section(self) -> &'static str {
-        match self {
-            Variant::BoxCut => "RC Ellipse Kernel Rendering (3σ cut-off)",
-            Variant::ViewDepthOrder => "RC Sorting Method (cameraDistance)",
-            Variant::AaCompensation => "RC Ellipse Kernel Rendering (α = opacity · G(x))",
-            Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2 => {
-                "RC Splat Projection: \"Implementations MAY ignore higher-degree coefficients\""
-            }
-            Variant::QuatWxyz => "RC Attributes (ROTATION: xyzw, the usual glTF order)",
-            Variant::LogScale => "RC Attributes (SCALE: linear)",
-            Variant::SigmoidColour => "RC Lighting (colour = Σ SH·Y + 0.5)",
-            Variant::Colour8Bit => {
-                "RC Attributes (float SH, OPACITY); the RC does not specify a renderer's precision"
-            }
-            Variant::EigenvalueFloor => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
-        }
-    }
-    /// Whether the RC allows it: an image that matches it passes.
-    pub fn rc_allowed(self) -> bool {
-        matches!(
-            self,
-            Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2
-        )
-    }
-    /// Whether it is only a precision the RC does not specify (8-bit storage): every asset's
-    /// bound admits it, so an image with it passes.
-    pub fn precision_only(self) -> bool {
-        self == Variant::Colour8Bit
-    }
-    /// The highest SH degree evaluated (3: all).
-    fn sh_cap(v: &[Variant]) -> usize {
-        [
-            (Variant::ShDegree0, 0),
-            (Variant::ShDegree1, 1),
-            (Variant::ShDegree2, 2),
-        ]
-        .into_iter()
-        .filter(|(x, _)| v.contains(x))
-        .map(|(_, d)| d)
-        .min()
-        .unwrap_or(3)
-    }
-}
+mod footprint;
+mod terms;
+mod variant;
+use footprint::{box_half_axes, eigenvalue_floor};
+pub use terms::Terms;
+pub use variant::Variant;
 
 /// One projected splat.
 #[derive(Debug, Clone, Copy)]
@@ -167,70 +42,6 @@ struct Layer {
     rect: [f64; 4],
     /// [`Variant::BoxCut`]: the box's half axes (pixels), `None` for the ellipse cut.
     box_axes: Option<[[f64; 2]; 2]>,
-}
-
-/// Per-pixel error terms, each a worst case over the pixel (see `docs/conformance.md`).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Terms {
-    /// 8-bit output quantization, 0.5/255.
-    pub output: f64,
-    /// 8-bit framebuffer rounding, 2 × 0.5/255 per contributing splat (source and result).
-    pub blend: f64,
-    /// Pixel centres within rounding of a splat's 3σ cut (in for one renderer, out for another).
-    pub cutoff: f64,
-    /// Layers with α near or below 1/255 (skipped by 3DGS, drawn by others).
-    pub threshold: f64,
-    /// Layers whose α exceeds the 0.99 cap (capped by 3DGS, not by others).
-    pub cap: f64,
-    /// f16 storage of SH coefficients.
-    pub sh_f16: f64,
-    /// Colours above 1 clamped by a UNORM framebuffer between blends.
-    pub overbright: f64,
-    /// f32 arithmetic.
-    pub float: f64,
-    /// Deviations an asset admits because it does not test them (set by the generator, not by
-    /// [`render`]; isolation): the difference the model shows without the 0.3 px² dilation,
-    pub dilation: f64,
-    /// …with another cut-off shape (2.83σ, a 3.33σ bounding box),
-    pub cutoff_shape: f64,
-    /// …with splats ordered by view depth,
-    pub sort_order: f64,
-    /// …and with the DC colour and the opacity stored in 8 bits (rounded down).
-    pub colour_8bit: f64,
-}
-
-impl Terms {
-    /// The bound: the sum of the terms.
-    pub fn total(&self) -> f64 {
-        self.output
-            + self.blend
-            + self.cutoff
-            + self.threshold
-            + self.cap
-            + self.sh_f16
-            + self.overbright
-            + self.float
-            + self.dilation
-            + self.cutoff_shape
-            + self.sort_order
-            + self.colour_8bit
-    }
-    pub(crate) fn max(self, o: Terms) -> Terms {
-        Terms {
-            output: self.output.max(o.output),
-            blend: self.blend.max(o.blend),
-            cutoff: self.cutoff.max(o.cutoff),
-            threshold: self.threshold.max(o.threshold),
-            cap: self.cap.max(o.cap),
-            sh_f16: self.sh_f16.max(o.sh_f16),
-            overbright: self.overbright.max(o.overbright),
-            float: self.float.max(o.float),
-            dilation: self.dilation.max(o.dilation),
-            cutoff_shape: self.cutoff_shape.max(o.cutoff_shape),
-            sort_order: self.sort_order.max(o.sort_order),
-            colour_8bit: self.colour_8bit.max(o.colour_8bit),
-        }
-    }
 }
 
 /// A model render: the display image and, per pixel, the error bound.
@@ -444,54 +255,6 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
         rect,
         box_axes,
     })
-}
-
-/// [`Variant::EigenvalueFloor`]: Σ' = [[a, b], [b, c]] rebuilt from the floored eigenvalues
-/// and the eigenvector `normalize(b, λ₁ − a)` (axis-aligned when that is degenerate); `None`
-/// when the smaller eigenvalue is ≤ 0. Returns `[a, b, c, det]`.
-fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64; 4]> {
-    let mid = 0.5 * (a + c);
-    let r = (mid * mid - det).max(0.1).sqrt();
-    let (l1, l2) = (mid + r, mid - r);
-    if l2 <= 0.0 {
-        return None;
-    }
-    let e1 = major_axis(a, b, c, l1);
-    let e2 = [-e1[1], e1[0]];
-    Some([
-        l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
-        l1 * e1[0] * e1[1] + l2 * e2[0] * e2[1],
-        l1 * e1[1] * e1[1] + l2 * e2[1] * e2[1],
-        l1 * l2,
-    ])
-}
-
-/// The unit eigenvector of [[a, b], [b, c]] for its larger eigenvalue `l1`: `(b, l1 − a)`
-/// normalised, or the axis of the larger diagonal entry when `b` is 0 (to rounding).
-fn major_axis(a: f64, b: f64, c: f64, l1: f64) -> [f64; 2] {
-    if b.abs() > 1e-12 * (a.abs() + c.abs()) {
-        let (x, y) = (b, l1 - a);
-        let n = (x * x + y * y).sqrt();
-        [x / n, y / n]
-    } else if a >= c {
-        [1.0, 0.0]
-    } else {
-        [0.0, 1.0]
-    }
-}
-
-/// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
-/// scaled by 3.33·√λ.
-fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
-    let (mid, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
-    let (l1, l2) = (mid + half, (mid - half).max(0.0));
-    let e1 = major_axis(a, b, c, l1);
-    let e2 = [-e1[1], e1[0]];
-    let k = 3.33;
-    [
-        [k * l1.sqrt() * e1[0], k * l1.sqrt() * e1[1]],
-        [k * l2.sqrt() * e2[0], k * l2.sqrt() * e2[1]],
-    ]
 }
 
 /// Renders `cloud` (global space, as loaded) from `cam` over a black background with the

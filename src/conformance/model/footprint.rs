@@ -1,0 +1,50 @@
+//! Footprint geometry of two variants: GaussianSplats3D's eigenvalue floor and the 3.33σ
+//! bounding box (Σ' = [[a, b], [b, c]] in pixels²).
+
+/// [`Variant::EigenvalueFloor`]: Σ' = [[a, b], [b, c]] rebuilt from the floored eigenvalues
+/// and the eigenvector `normalize(b, λ₁ − a)` (axis-aligned when that is degenerate); `None`
+/// when the smaller eigenvalue is ≤ 0. Returns `[a, b, c, det]`.
+pub(super) fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64; 4]> {
+    let mid = 0.5 * (a + c);
+    let r = (mid * mid - det).max(0.1).sqrt();
+    let (l1, l2) = (mid + r, mid - r);
+    if l2 <= 0.0 {
+        return None;
+    }
+    let e1 = major_axis(a, b, c, l1);
+    let e2 = [-e1[1], e1[0]];
+    Some([
+        l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
+        l1 * e1[0] * e1[1] + l2 * e2[0] * e2[1],
+        l1 * e1[1] * e1[1] + l2 * e2[1] * e2[1],
+        l1 * l2,
+    ])
+}
+
+/// The unit eigenvector of [[a, b], [b, c]] for its larger eigenvalue `l1`: `(b, l1 − a)`
+/// normalised, or the axis of the larger diagonal entry when `b` is 0 (to rounding).
+fn major_axis(a: f64, b: f64, c: f64, l1: f64) -> [f64; 2] {
+    if b.abs() > 1e-12 * (a.abs() + c.abs()) {
+        let (x, y) = (b, l1 - a);
+        let n = (x * x + y * y).sqrt();
+        [x / n, y / n]
+    } else if a >= c {
+        [1.0, 0.0]
+    } else {
+        [0.0, 1.0]
+    }
+}
+
+/// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
+/// scaled by 3.33·√λ.
+pub(super) fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
+    let (mid, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
+    let (l1, l2) = (mid + half, (mid - half).max(0.0));
+    let e1 = major_axis(a, b, c, l1);
+    let e2 = [-e1[1], e1[0]];
+    let k = 3.33;
+    [
+        [k * l1.sqrt() * e1[0], k * l1.sqrt() * e1[1]],
+        [k * l2.sqrt() * e2[0], k * l2.sqrt() * e2[1]],
+    ]
+}

@@ -1,0 +1,133 @@
+//! [`Variant`]: implementation variants the model can switch on beside the errata.
+
+/// Implementation variants beside the errata: choices and mistakes seen in real renderers,
+/// which the runner's diagnosis tests an image against ([`render_with`](super::render_with)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Variant {
+    /// Splats cut by their oriented 3.33σ bounding box instead of the 3σ ellipse.
+    BoxCut,
+    /// Blending order by view depth (camera-space z; per tile or global, the same per pixel)
+    /// instead of camera distance.
+    ViewDepthOrder,
+    /// Opacity scaled by √(det Σ' / det(Σ' + 0.3 I)) (Mip-Splatting / gsplat antialiasing).
+    AaCompensation,
+    /// SH evaluated up to degree 0 only (the RC: "MAY ignore higher-degree coefficients").
+    ShDegree0,
+    /// SH evaluated up to degree 1 only (allowed likewise).
+    ShDegree1,
+    /// SH evaluated up to degree 2 only (allowed likewise).
+    ShDegree2,
+    /// ROTATION read as `(w, x, y, z)` instead of glTF's `(x, y, z, w)`.
+    QuatWxyz,
+    /// SCALE read as log-space (`exp(s)`, the review draft) instead of linear.
+    LogScale,
+    /// Colour as `sigmoid(Σ SH·Y)` instead of `Σ SH·Y + 0.5`.
+    SigmoidColour,
+    /// The DC colour (`SH_C0·DC + 0.5`) and the opacity stored in 8 bits, rounded down
+    /// (GaussianSplats3D's splat buffers).
+    Colour8Bit,
+    /// Σ' rebuilt from eigenvalues `mid ± √max(0.1, mid² − det)`, and dropped when the smaller
+    /// is ≤ 0 (GaussianSplats3D's vertex shader): near-round footprints come out slightly
+    /// anisotropic, sub-pixel splats vanish.
+    EigenvalueFloor,
+}
+
+impl Variant {
+    /// All of them.
+    pub const ALL: [Variant; 11] = [
+        Variant::BoxCut,
+        Variant::ViewDepthOrder,
+        Variant::AaCompensation,
+        Variant::ShDegree0,
+        Variant::ShDegree1,
+        Variant::ShDegree2,
+        Variant::QuatWxyz,
+        Variant::LogScale,
+        Variant::SigmoidColour,
+        Variant::Colour8Bit,
+        Variant::EigenvalueFloor,
+    ];
+    /// A short identifier (the diagnosis's `rule`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::BoxCut => "bounding_box_cutoff",
+            Variant::ViewDepthOrder => "view_depth_order",
+            Variant::AaCompensation => "antialiasing_compensation",
+            Variant::ShDegree0 => "sh_ignored_above_degree_0",
+            Variant::ShDegree1 => "sh_ignored_above_degree_1",
+            Variant::ShDegree2 => "sh_ignored_above_degree_2",
+            Variant::QuatWxyz => "quaternion_read_as_wxyz",
+            Variant::LogScale => "scale_read_as_log",
+            Variant::SigmoidColour => "sigmoid_colour",
+            Variant::Colour8Bit => "colour_and_opacity_8bit",
+            Variant::EigenvalueFloor => "eigenvalue_floor",
+        }
+    }
+    /// What a renderer with this variant does, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Variant::BoxCut => "splats cut by a 3.33σ bounding box instead of the 3σ ellipse",
+            Variant::ViewDepthOrder => {
+                "splats ordered by view depth (camera-space z) instead of distance to the camera"
+            }
+            Variant::AaCompensation => {
+                "opacity scaled by √(det Σ' / det(Σ' + 0.3 I)) (antialiased kernel)"
+            }
+            Variant::ShDegree0 => "SH coefficients above degree 0 ignored",
+            Variant::ShDegree1 => "SH coefficients above degree 1 ignored",
+            Variant::ShDegree2 => "SH coefficients above degree 2 ignored",
+            Variant::QuatWxyz => "ROTATION read as (w, x, y, z) instead of (x, y, z, w)",
+            Variant::LogScale => "SCALE read as ln(scale) (the review draft) instead of linear",
+            Variant::SigmoidColour => "colour = sigmoid(Σ SH·Y) instead of Σ SH·Y + 0.5",
+            Variant::Colour8Bit => {
+                "DC colour and opacity stored in 8 bits, rounded down (lossy storage)"
+            }
+            Variant::EigenvalueFloor => {
+                "Σ' rebuilt from eigenvalues mid ± √max(0.1, mid² − det) (near-round footprints anisotropic, sub-pixel splats dropped)"
+            }
+        }
+    }
+    /// The RC section whose rule the variant departs from.
+    pub fn rc_section(self) -> &'static str {
+        match self {
+            Variant::BoxCut => "RC Ellipse Kernel Rendering (3σ cut-off)",
+            Variant::ViewDepthOrder => "RC Sorting Method (cameraDistance)",
+            Variant::AaCompensation => "RC Ellipse Kernel Rendering (α = opacity · G(x))",
+            Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2 => {
+                "RC Splat Projection: \"Implementations MAY ignore higher-degree coefficients\""
+            }
+            Variant::QuatWxyz => "RC Attributes (ROTATION: xyzw, the usual glTF order)",
+            Variant::LogScale => "RC Attributes (SCALE: linear)",
+            Variant::SigmoidColour => "RC Lighting (colour = Σ SH·Y + 0.5)",
+            Variant::Colour8Bit => {
+                "RC Attributes (float SH, OPACITY); the RC does not specify a renderer's precision"
+            }
+            Variant::EigenvalueFloor => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
+        }
+    }
+    /// Whether the RC allows it: an image that matches it passes.
+    pub fn rc_allowed(self) -> bool {
+        matches!(
+            self,
+            Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2
+        )
+    }
+    /// Whether it is only a precision the RC does not specify (8-bit storage): every asset's
+    /// bound admits it, so an image with it passes.
+    pub fn precision_only(self) -> bool {
+        self == Variant::Colour8Bit
+    }
+    /// The highest SH degree evaluated (3: all).
+    pub(super) fn sh_cap(v: &[Variant]) -> usize {
+        [
+            (Variant::ShDegree0, 0),
+            (Variant::ShDegree1, 1),
+            (Variant::ShDegree2, 2),
+        ]
+        .into_iter()
+        .filter(|(x, _)| v.contains(x))
+        .map(|(_, d)| d)
+        .min()
+        .unwrap_or(3)
+    }
+}
