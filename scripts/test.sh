@@ -12,7 +12,7 @@ cargo fmt --manifest-path fuzz/Cargo.toml -- --check
 cargo clippy --all-targets --all-features --locked -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --all-features --locked
 cargo build --locked --quiet
-python3 scripts/xcheck_reference.py target/debug/splatgl
+python3 scripts/xcheck_reference.py "${CARGO_TARGET_DIR:-target}/debug/splatgl"
 skipped="${CARGO_TARGET_DIR:-target}/tmp/skipped-tests.txt"
 rm -f "$skipped"
 cargo test --all-targets --all-features --locked
