@@ -135,6 +135,7 @@ fn both_backends_pass_the_suite() {
     }
 }
 
+#[cfg(feature = "testing")]
 #[test]
 fn erratum_proof_gl_fails_exactly_the_assets_that_catch_it() {
     let (d, m) = suite();

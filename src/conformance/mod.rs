@@ -99,8 +99,8 @@ impl Erratum {
             }
         }
     }
-    /// The GL backend's switch for this erratum.
-    #[cfg(feature = "gl")]
+    /// The GL backend's switch for this erratum (feature `testing`: the erratum proof).
+    #[cfg(all(feature = "gl", feature = "testing"))]
     pub fn gl_errata(self) -> crate::gl::Errata {
         let mut e = crate::gl::Errata::default();
         match self {

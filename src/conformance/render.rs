@@ -58,23 +58,37 @@ pub fn render_suite(dir: &Path, m: &Manifest, backend: Backend) -> Result<Images
             Ok(out)
         }
         #[cfg(feature = "gl")]
-        Backend::Gl => render_suite_gl(dir, m, crate::gl::Errata::default(), false),
+        Backend::Gl => {
+            let r = crate::headless::HeadlessRenderer::new().map_err(|e| e.to_string())?;
+            render_suite_with(dir, m, r, false)
+        }
         #[cfg(not(feature = "gl"))]
         Backend::Gl => Err("this splatgl was built without the `gl` feature".into()),
     }
 }
 
 /// Renders the suite with the GL backend and `errata` switched in; `front_to_back` draws in
-/// the reversed (appendix, erratum g) order.
-#[cfg(feature = "gl")]
+/// the reversed (appendix, erratum g) order. The erratum proof's (feature `testing`).
+#[cfg(all(feature = "gl", feature = "testing"))]
 pub fn render_suite_gl(
     dir: &Path,
     m: &Manifest,
     errata: crate::gl::Errata,
     front_to_back: bool,
 ) -> Result<Images, String> {
-    use crate::headless::{HeadlessOptions, HeadlessRenderer};
-    let mut r = HeadlessRenderer::with_errata(errata).map_err(|e| e.to_string())?;
+    let r = crate::headless::HeadlessRenderer::with_errata(errata).map_err(|e| e.to_string())?;
+    render_suite_with(dir, m, r, front_to_back)
+}
+
+/// Renders the suite with `r`, in the reversed order when `front_to_back`.
+#[cfg(feature = "gl")]
+fn render_suite_with(
+    dir: &Path,
+    m: &Manifest,
+    mut r: crate::headless::HeadlessRenderer,
+    front_to_back: bool,
+) -> Result<Images, String> {
+    use crate::headless::HeadlessOptions;
     let opts = HeadlessOptions {
         background: m.background.map(|v| v as f32),
         ..Default::default()

@@ -73,8 +73,12 @@ mod view;
 
 pub use error::GlError;
 pub(crate) use error::check_error;
+// The review draft's errata as shader switches: for the erratum proof (feature `testing`).
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use glsl::Errata;
+#[cfg(not(feature = "testing"))]
+pub(crate) use glsl::Errata;
 pub use prepass::PREPASS_MIN_SPLATS;
 #[doc(hidden)]
 pub use program::build_program;

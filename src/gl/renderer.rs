@@ -81,9 +81,19 @@ impl SplatRenderer {
     }
 
     /// Like [`SplatRenderer::new`], with some of the review draft's Appendix A errata switched
-    /// back in. **Erratum tests only** (hidden from the documented API).
+    /// back in. **Erratum tests only** (feature `testing`; hidden from the documented API).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn with_errata(gl: &glow::Context, errata: Errata) -> Result<Self, GlError> {
+        Self::build(gl, errata)
+    }
+
+    #[cfg(not(feature = "testing"))]
+    pub(crate) fn with_errata(gl: &glow::Context, errata: Errata) -> Result<Self, GlError> {
+        Self::build(gl, errata)
+    }
+
+    fn build(gl: &glow::Context, errata: Errata) -> Result<Self, GlError> {
         let ctx = ContextInfo::check(gl)?;
         let version = GlslVersion::for_context(ctx);
         let layout = TextureLayout::for_context(gl);

@@ -75,7 +75,8 @@ impl HeadlessRenderer {
     }
 
     /// Like [`HeadlessRenderer::new`] with Appendix A errata switched in. **Erratum tests
-    /// only** (hidden from the documented API).
+    /// only** (feature `testing`; hidden from the documented API).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn with_errata(errata: Errata) -> Result<Self, HeadlessError> {
         Self::with_context_and_errata(HeadlessContext::new()?, errata)

@@ -32,6 +32,7 @@ pub use splatgl::SplatCloud;
 pub use splatgl::camera::Camera;
 pub use splatgl::cloud::ColorSpace;
 pub use splatgl::compare::compare;
+#[cfg(feature = "testing")]
 pub use splatgl::gl::Errata;
 pub use splatgl::headless::{
     GlApi, HeadlessContext, HeadlessError, HeadlessOptions, HeadlessRenderer, TargetKind,
@@ -59,13 +60,16 @@ pub fn or_skip<T>(r: Result<T, HeadlessError>, what: &str) -> Option<T> {
     }
 }
 
-/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
+/// A headless renderer with review-draft errata switched in (feature `testing`), or `None`
+/// (test skipped, with a message) when EGL cannot be opened.
+#[cfg(feature = "testing")]
 pub fn headless_with(errata: Errata) -> Option<HeadlessRenderer> {
     or_skip(HeadlessRenderer::with_errata(errata), "headless GL failed")
 }
 
+/// A headless renderer, or `None` (test skipped, with a message) when EGL cannot be opened.
 pub fn headless() -> Option<HeadlessRenderer> {
-    headless_with(Errata::default())
+    or_skip(HeadlessRenderer::new(), "headless GL failed")
 }
 
 pub fn ref_opts(degree: u8, background: [f32; 3]) -> reference::RenderOptions {
