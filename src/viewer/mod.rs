@@ -32,8 +32,7 @@ mod rig;
 mod stats;
 mod surface;
 
-pub use budget::{kept_indices, subset};
-pub use order::{Freshness, StaleBound, decide};
+pub use order::StaleBound;
 
 use std::path::PathBuf;
 
@@ -92,7 +91,7 @@ pub struct ViewerOptions {
     pub vsync: bool,
     /// Render at this fraction of the window's pixels (stretched to the window).
     pub resolution_scale: f32,
-    /// Draw at most this many splats ([`subset`]).
+    /// Draw at most this many splats (the opacity × area ranking of `budget.rs`).
     pub max_splats: Option<usize>,
     /// Every frame waits for the sort of its own camera.
     pub sort_sync: bool,
