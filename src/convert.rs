@@ -385,8 +385,9 @@ pub fn camera_node(
     r: DMat3,
 ) -> Result<(CameraNode, Option<String>), String> {
     let cam = Camera::from_3dgs(e).map_err(|err| format!("view {index}: {err}"))?;
-    // The entry's own f64 numbers (Camera::from_3dgs has checked them): rows of camera → world.
-    let c2w = DMat3::from_cols_array_2d(&e.rotation).transpose();
+    // The rotation as the renderer uses it (Camera::from_3dgs orthonormalises it), so that the
+    // node shows what `render --camera` shows; the centre as written (f64).
+    let c2w = DMat3::from_mat4(cam.world_to_camera.as_dmat4()).transpose();
     let axes = r * c2w * DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0));
     let q = DQuat::from_mat3(&axes).normalize();
     let eye = r * DVec3::from_array(e.position);
@@ -411,6 +412,23 @@ pub fn camera_node(
             e.cy.unwrap_or(0.5 * h)
         )
     });
+    let finite = [
+        camera.yfov,
+        camera.aspect_ratio.unwrap_or(1.0),
+        q.x,
+        q.y,
+        q.z,
+        q.w,
+    ]
+    .iter()
+    .chain(&eye.to_array())
+    .all(|v| v.is_finite());
+    if !finite || camera.aspect_ratio.is_some_and(|a| a <= 0.0) {
+        return Err(format!(
+            "view {index} ({name}): its numbers give no finite glTF camera (yfov {}, aspectRatio {:?})",
+            camera.yfov, camera.aspect_ratio
+        ));
+    }
     let node = CameraNode {
         name,
         camera,

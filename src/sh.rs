@@ -122,9 +122,8 @@ impl ShRotation {
                 }
             }
             solve(&mut a, &mut b, n);
-            // Entries within solver noise of 0 or ±1 are those values: a turn by a signed
-            // permutation (an exact axis turn such as 180° about Z) then moves coefficients
-            // without rounding.
+            // Entries within solver noise of 0 or ±1 are those values: a 180° turn about an
+            // axis (whose matrices are diagonal ±1) then moves coefficients without rounding.
             for v in &mut b {
                 let r = v.round();
                 if r.abs() <= 1.0 && (*v - r).abs() <= 1e-12 {

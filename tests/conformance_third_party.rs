@@ -26,12 +26,14 @@ fn missing_tools() -> Option<String> {
     if !npm.exists() {
         return Some(format!("{} not installed", npm.display()));
     }
-    for tool in ["node", "chromium"] {
-        if Command::new(tool).arg("--version").output().is_err() {
-            return Some(format!("{tool} not runnable"));
-        }
+    if Command::new("node").arg("--version").output().is_err() {
+        return Some("node not runnable".into());
     }
-    None
+    // The browsers gs3d.mjs looks for.
+    let browser = ["chromium", "chromium-browser"]
+        .iter()
+        .any(|b| Command::new(b).arg("--version").output().is_ok());
+    (!browser).then(|| "chromium (or chromium-browser) not runnable".into())
 }
 
 #[test]

@@ -104,14 +104,20 @@ const inside = (base, rel) => {
 let done;
 const finished = new Promise((r) => { done = r; });
 let received = 0;
+const expected = new Set(views.map((v) => v.image));
 const server = http.createServer((req, res) => {
-  const url = decodeURIComponent(req.url.split('?')[0]);
+  let url;
+  try { url = decodeURIComponent(req.url.split('?')[0]); } catch { return send(res, 400, 'text/plain', 'bad url'); }
   if (req.method === 'POST') {
     let body = '';
     req.on('data', (d) => { body += d; });
     req.on('end', () => {
       if (url === '/result') {
-        const { image, png } = JSON.parse(body);
+        let msg;
+        try { msg = JSON.parse(body); } catch { return send(res, 400, 'text/plain', 'bad json'); }
+        const { image, png } = msg;
+        // Only the suite's own image names: nothing is written outside OUT.
+        if (!expected.has(image) || typeof png !== 'string') return send(res, 400, 'text/plain', 'unknown image');
         const file = path.join(out, `${image}.png`);
         fs.mkdirSync(path.dirname(file), { recursive: true });
         fs.writeFileSync(file, Buffer.from(png.split(',')[1], 'base64'));

@@ -1,6 +1,6 @@
 //! Explaining failures with models: each failing camera's image is tested against the f64
 //! model ([`super::model`]) with known deviations switched on — the review draft's errata,
-//! the implementation [`Variant`]s, flipped images — singly and in pairs; then the smallest
+//! the implementation [`Variant`]s, flipped images — singly, in pairs and in triples; then the smallest
 //! set of deviations that explains every failing camera is chosen ([`diagnose`]).
 //!
 //! A deviation *explains* a camera when the image passes that camera's tolerance (per-pixel
@@ -261,26 +261,27 @@ pub fn diagnose(failures: &[Failure]) -> (Vec<Diagnosis>, Vec<Option<Explanation
     loop {
         let covered =
             |e: &Explanation, with: &[Deviation]| e.deviations.iter().all(|d| with.contains(d));
-        // Candidates: every explanation's deviation set; score = cameras it would newly cover.
+        // Candidates: every distinct deviation set that explains some camera still open;
+        // score = the open cameras it (with what is chosen) would explain.
+        let mut candidates: Vec<&Vec<Deviation>> = failures
+            .iter()
+            .zip(&assigned)
+            .filter(|(_, a)| a.is_none())
+            .flat_map(|(f, _)| f.explained_by.iter().map(|e| &e.deviations))
+            .collect();
+        candidates.sort();
+        candidates.dedup();
         let mut best: Option<(usize, Vec<Deviation>)> = None;
-        for f in failures.iter().zip(&assigned).filter(|(_, a)| a.is_none()) {
-            for e in f.0.explained_by {
-                let mut with = chosen.clone();
-                with.extend(e.deviations.iter().copied());
-                let n = failures
-                    .iter()
-                    .zip(&assigned)
-                    .filter(|(g, a)| {
-                        a.is_none() && g.explained_by.iter().any(|x| covered(x, &with))
-                    })
-                    .count();
-                let better = match &best {
-                    None => true,
-                    Some((m, d)) => n > *m || (n == *m && e.deviations < *d),
-                };
-                if better {
-                    best = Some((n, e.deviations.clone()));
-                }
+        for devs in candidates {
+            let mut with = chosen.clone();
+            with.extend(devs.iter().copied());
+            let n = failures
+                .iter()
+                .zip(&assigned)
+                .filter(|(g, a)| a.is_none() && g.explained_by.iter().any(|x| covered(x, &with)))
+                .count();
+            if best.as_ref().is_none_or(|(m, _)| n > *m) {
+                best = Some((n, devs.clone()));
             }
         }
         let Some((n, devs)) = best else { break };

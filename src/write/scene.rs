@@ -227,6 +227,10 @@ pub fn add_camera_nodes(doc: &mut Value, cameras: &[CameraNode]) {
     if cameras.is_empty() {
         return;
     }
+    if doc["scenes"].as_array().is_none_or(|s| s.is_empty()) {
+        doc["scenes"] = json!([{ "nodes": [] }]);
+        doc["scene"] = json!(0);
+    }
     let (first_node, first_camera) = (
         doc["nodes"].as_array().map_or(0, Vec::len),
         doc["cameras"].as_array().map_or(0, Vec::len),

@@ -323,12 +323,20 @@ fn assemble(
     // rule as errors (ROTATION_NON_UNIT). Naming the writer tells the user whom to ask.
     let by = match ctx.doc.as_json().asset.generator.as_deref() {
         Some(g) if !g.trim().is_empty() => {
-            // A file's own text: control characters shown as '?', at most 80 characters.
+            // A file's own text, at most 80 characters: control, zero-width and bidirectional
+            // characters (which would let a file rewrite what the terminal shows) as '?'.
+            let shown = |c: char| {
+                !(c.is_control()
+                    || ('\u{200B}'..='\u{200F}').contains(&c)
+                    || ('\u{202A}'..='\u{202E}').contains(&c)
+                    || ('\u{2066}'..='\u{2069}').contains(&c)
+                    || c == '\u{FEFF}')
+            };
             let g: String = g
                 .trim()
                 .chars()
                 .take(80)
-                .map(|c| if c.is_control() { '?' } else { c })
+                .map(|c| if shown(c) { c } else { '?' })
                 .collect();
             format!(" (the file was written by {g})")
         }

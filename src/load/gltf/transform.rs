@@ -67,7 +67,7 @@ pub fn apply(local: &SplatCloud, m: DMat4, node: usize, findings: &mut Vec<Findi
                     let ql = DQuat::from_xyzw(q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64);
                     // |qm · ql| = |ql|: the product is rounded to f32 and normalised only
                     // where f32 rounding is not all that separates it from unit length, so a
-                    // signed-permutation matrix (an exact axis turn) moves quaternions
+                    // 180° turn about an axis (qm a unit axis quaternion) moves quaternions
                     // without rounding.
                     let g = qm * ql;
                     let g = [g.x as f32, g.y as f32, g.z as f32, g.w as f32];

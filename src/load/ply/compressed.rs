@@ -90,9 +90,10 @@ impl<'a> Columns<'a> {
     }
 }
 
-/// The decoding is in f64, each value rounded to f32 once, as the format's own JavaScript
-/// readers compute it (an f32 lerp rounds three times, which `exp` of a log scale turns into
-/// ~1e-6 relative).
+/// The decoding is in f64, as the format's own JavaScript readers compute it: positions and
+/// log scales are rounded to f32 once after the lerp (as they store them; an f32 lerp rounds
+/// three times, which `exp` of a log scale turns into ~1e-6 relative), colours only when their
+/// DC term is.
 fn unorm(v: u32, bits: u32) -> f64 {
     let max = (1u32 << bits) - 1;
     (v & max) as f64 / max as f64
@@ -100,8 +101,13 @@ fn unorm(v: u32, bits: u32) -> f64 {
 
 /// `a·(1 − t) + b·t`, rounded once.
 fn lerp(a: f32, b: f32, t: f64) -> f32 {
+    lerp64(a, b, t) as f32
+}
+
+/// `a·(1 − t) + b·t` in f64.
+fn lerp64(a: f32, b: f32, t: f64) -> f64 {
     let (a, b) = (a as f64, b as f64);
-    (a * (1.0 - t) + b * t) as f32
+    a * (1.0 - t) + b * t
 }
 
 /// 11/10/11 unorm triple (x in the high bits).
@@ -298,11 +304,12 @@ fn push_splat(
         unorm(col, 8),
     ];
     for ch in 0..3 {
+        // The colour stays in f64 until its DC term is rounded (once).
         let v = match (fields.colours[ch], fields.colours[ch + 3]) {
-            (Some(lo), Some(hi)) => lerp(chunk_val(lo), chunk_val(hi), rgba[ch]),
-            _ => rgba[ch] as f32,
+            (Some(lo), Some(hi)) => lerp64(chunk_val(lo), chunk_val(hi), rgba[ch]),
+            _ => rgba[ch],
         };
-        coeffs[0][ch] = crate::sh::dc_from_color(v as f64);
+        coeffs[0][ch] = crate::sh::dc_from_color(v);
     }
     let finite = pos
         .iter()
