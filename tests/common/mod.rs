@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 pub use splatgl::synthetic::{Rng, random_cloud};
 
+#[cfg(feature = "cli")]
 pub mod cli;
 #[cfg(feature = "gl")]
 pub mod gl;
