@@ -52,11 +52,12 @@ fn num(v: Option<f64>) -> Value {
 
 /// `report.json`: `diagnosis` (the smallest set of deviations that explains every failing
 /// camera: `rule`, `rc_section`, `description`, `rc_allowed`, `assets`, `evidence`), `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
-/// `skipped`, `catches`, `cameras` with the same per camera plus the tolerance and `cause`),
+/// `skipped`, `catches`, `cause`, `cameras` with the same per camera plus the tolerance and `cause`),
 /// `passed`, `failed`, `skipped` (counts of the RC assets), `profile` {`matched`, `differ`},
 /// `source`.
 pub fn to_json(results: &[AssetResult], source: &str) -> Value {
     let s = summary(results);
+    let diagnosis = diagnosis(results);
     let assets: Vec<Value> = results
         .iter()
         .map(|r| {
@@ -80,19 +81,39 @@ pub fn to_json(results: &[AssetResult], source: &str) -> Value {
                 "pass": !r.skipped && r.pass(), "skipped": r.skipped, "optional": r.asset.optional,
                 "psnr": num(r.psnr()), "max_abs": num(r.max_abs()),
                 "catches": r.asset.catches.iter().map(|e| e.letter()).collect::<Vec<_>>(),
+                "cause": asset_cause(r, &diagnosis),
                 "cameras": cams,
             })
         })
         .collect();
     json!({
         "source": source,
-        "diagnosis": diagnosis(results).iter().map(diagnosis_json).collect::<Vec<_>>(),
+        "diagnosis": diagnosis.iter().map(diagnosis_json).collect::<Vec<_>>(),
         "passed": s.passed,
         "failed": s.failed,
         "skipped": s.skipped,
         "profile": {"matched": s.profile_matched, "differ": s.profile_differ},
         "assets": assets,
     })
+}
+
+/// A failing asset's `cause`: the deviations the diagnosis attributes its cameras to
+/// (`explained by …`), or `unexplained:` with its stock hint; `null` when it passes or is
+/// skipped.
+fn asset_cause(r: &AssetResult, diagnosis: &[Diagnosis]) -> Value {
+    if r.skipped || r.pass() {
+        return Value::Null;
+    }
+    let named: Vec<String> = diagnosis
+        .iter()
+        .filter(|d| d.assets.contains(&r.asset.name))
+        .map(|d| d.deviation.name())
+        .collect();
+    if named.is_empty() {
+        json!(format!("unexplained: {}", r.asset.failure_means))
+    } else {
+        json!(format!("explained by {}", named.join(" + ")))
+    }
 }
 
 /// One `diagnosis` entry: `rule`, `rc_section`, `description`, `rc_allowed`, `assets`,
