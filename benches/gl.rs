@@ -41,10 +41,10 @@ use glow::HasContext;
 use splatgl::camera::Camera;
 use splatgl::cull::{CullBounds, visible_into};
 use splatgl::gl::{
-    ColorFormat, DistanceSorter, DrawPath, Pipeline, ReadbackTarget, SplatRenderer,
-    frustum_for_camera,
+    ColorFormat, DrawPath, Pipeline, ReadbackTarget, SplatRenderer, frustum_for_camera,
 };
 use splatgl::headless::{GlApi, HeadlessContext};
+use splatgl::sort::{SortRequest, Sorter};
 use splatgl::{SplatCloud, synthetic};
 
 /// CPU time of the whole process (all threads, so llvmpipe's threads count).
@@ -160,8 +160,7 @@ impl Row {
 struct Bench<'a> {
     gl: &'a glow::Context,
     renderer: SplatRenderer,
-    sorter: DistanceSorter,
-    order: Vec<u32>,
+    sorter: Sorter,
     query: Option<(u32, glow::Query)>,
     frames: usize,
     size: (u32, u32),
@@ -191,16 +190,17 @@ impl Bench<'_> {
                 gl.finish();
             }
             let t0 = Instant::now();
-            if path.culls() {
+            let eye = cam.eye().to_array();
+            let order = if path.culls() {
                 let frustum = frustum_for_camera(&cam, [0, 0, w as i32, h as i32]);
-                let p = &cloud.positions;
+                let request = SortRequest::distance(eye);
                 self.sorter
-                    .sort_visible(p, bounds, &frustum, cam.eye(), &mut self.order);
+                    .sort_visible(&cloud.positions, bounds, &frustum, &request)
             } else {
-                self.sorter
-                    .sort(&cloud.positions, cam.eye(), &mut self.order);
-            }
-            self.renderer.set_order(gl, &self.order).unwrap();
+                self.sorter.sort_by_distance(&cloud.positions, eye)
+            };
+            let drawn = order.len();
+            self.renderer.set_order(gl, order).unwrap();
             // SAFETY: glFinish has no preconditions.
             unsafe { gl.finish() };
             let (t1, c1) = (Instant::now(), cpu_time());
@@ -223,7 +223,7 @@ impl Bench<'_> {
             let (t2, c2) = (Instant::now(), cpu_time());
             if f > 0 {
                 rows.push(Row {
-                    drawn: self.order.len(),
+                    drawn,
                     fragments,
                     sort: ms(t1 - t0),
                     draw: ms(t2 - t1),
@@ -405,8 +405,7 @@ fn main() {
     let mut b = Bench {
         gl,
         renderer: SplatRenderer::new(gl).unwrap(),
-        sorter: DistanceSorter::default(),
-        order: Vec::new(),
+        sorter: Sorter::new(),
         query,
         frames,
         size: (w, h),

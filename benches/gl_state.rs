@@ -21,7 +21,7 @@ use common::gl::or_skip;
 use glam::Vec3;
 use glow::HasContext;
 use splatgl::camera::Camera;
-use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer, sort_back_to_front};
+use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer};
 use splatgl::headless::{GlApi, HeadlessContext};
 use splatgl::synthetic;
 
@@ -48,8 +48,9 @@ fn run(ctx: &HeadlessContext, draws: usize) {
     frame.bind(gl).unwrap();
     let cloud = synthetic::random_cloud(1000, 1, 0.8, 5);
     let cam = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9, 64, 64);
-    let mut order = Vec::new();
-    sort_back_to_front(&cloud.positions, cam.eye(), &mut order);
+    let order = splatgl::sort::Sorter::new()
+        .sort_by_distance(&cloud.positions, cam.eye().to_array())
+        .to_vec();
     let mut r = SplatRenderer::new(gl).unwrap();
     r.upload(gl, &cloud).unwrap();
     r.settings_mut().depth_test = false;

@@ -9,6 +9,15 @@
 //! PNG / PFM files and [`write`](mod@write) for glTF / PLY output. [`camera`] holds the camera model,
 //! [`profile`] every number of the rendering profile and [`sh`] the spherical harmonics.
 //! The module map with the documentation pages is in the README.
+//!
+//! ## Embedding in a GL host (feature `gl`)
+//!
+//! The host keeps its context, framebuffer, depth buffer and camera; the renderer culls, sorts
+//! and draws into whatever is bound (`docs/embedding.md`; C and C++ hosts: feature `capi`):
+//!
+#![cfg_attr(feature = "gl", doc = "```no_run")]
+#![cfg_attr(feature = "gl", doc = include_str!("../docs/snippets/embed.rs"))]
+#![cfg_attr(feature = "gl", doc = "```")]
 #![warn(missing_docs)]
 
 pub mod camera;

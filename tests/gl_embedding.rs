@@ -17,7 +17,7 @@ use host_state::{Host, Piece, pieces, query_all};
 use splatgl::gl::state::{Contexts, LEFT_WITHOUT_RESTORE, Left, LeftValue};
 use splatgl::gl::{
     ColorFormat, DepthFormat, DepthFunc, DrawPath, DrawSettings, Pipeline, ReadbackTarget,
-    SplatRenderer, SplatScene, sort_back_to_front,
+    SplatRenderer, SplatScene,
 };
 
 const APIS: [GlApi; 3] = [GlApi::Gles3, GlApi::DesktopCore33, GlApi::DesktopCompat];
@@ -59,6 +59,7 @@ fn every_call(gl: &glow::Context, settings: DrawSettings) {
     let (view, proj) = (cam.gl_view(), cam.gl_projection());
     r.draw_with_matrices(gl, view, proj, [3, 4, 50, 60], &order)
         .unwrap();
+    r.draw_frame(gl, view, proj, [3, 4, 50, 60]).unwrap();
     // The same through the transform-feedback pre-pass (its program, vertex arrays,
     // transform-feedback object and rasterizer discard), created after the upload.
     r.set_draw_path(gl, prepass()).unwrap();
@@ -246,8 +247,9 @@ fn render_with(
     cam: &Camera,
     hostile: impl Fn(),
 ) -> Image {
-    let mut order = Vec::new();
-    sort_back_to_front(&cloud.positions, cam.eye(), &mut order);
+    let order = splatgl::sort::Sorter::new()
+        .sort_by_distance(&cloud.positions, cam.eye().to_array())
+        .to_vec();
     target.bind(gl).unwrap();
     // SAFETY: a clear of the bound target.
     unsafe {
@@ -450,8 +452,9 @@ fn reversed_z_host_occludes_splats_exactly_where_its_geometry_is_in_front() {
     let back =
         Mat4::from_translation(Vec3::new(-0.6, -0.2, -1.5)) * Mat4::from_scale(Vec3::splat(1.2));
     let cloud = splat_wall();
-    let mut order = Vec::new();
-    sort_back_to_front(&cloud.positions, cam.eye(), &mut order);
+    let order = splatgl::sort::Sorter::new()
+        .sort_by_distance(&cloud.positions, cam.eye().to_array())
+        .to_vec();
     let mut r = SplatRenderer::new(gl).unwrap();
     r.upload(gl, &cloud).unwrap();
     r.settings_mut().restore_state = true;
@@ -529,8 +532,9 @@ fn draw_with_a_cameras_matrices_equals_draw_with_the_camera() {
     let mut cam = look_at_fov_deg(Vec3::new(0.4, 0.3, 2.8), Vec3::ZERO, 55.0, 64, 48);
     cam.cx = 30.0; // off-centre principal point
     let target = ReadbackTarget::new(gl, 96, 48, ColorFormat::Rgba8, None).unwrap();
-    let mut order = Vec::new();
-    sort_back_to_front(&cloud.positions, cam.eye(), &mut order);
+    let order = splatgl::sort::Sorter::new()
+        .sort_by_distance(&cloud.positions, cam.eye().to_array())
+        .to_vec();
     let mut draw = |viewport: [i32; 4], f: &mut dyn FnMut(&mut SplatRenderer)| -> Image {
         target.bind(gl).unwrap();
         // SAFETY: clear and viewport of the bound target.
@@ -642,8 +646,9 @@ fn interleaved_clouds_render_like_the_merged_cloud_through_the_reference() {
         for (cloud, model) in [(&a, ma), (&b, mb(0.3))] {
             let placed = place(cloud, model);
             r.upload(gl, &placed).unwrap();
-            let mut order = Vec::new();
-            sort_back_to_front(&placed.positions, cam.eye(), &mut order);
+            let order = splatgl::sort::Sorter::new()
+                .sort_by_distance(&placed.positions, cam.eye().to_array())
+                .to_vec();
             r.draw(gl, &cam, &order).unwrap();
         }
     });

@@ -18,8 +18,9 @@ fn erratum_scores(
     let mut bad = headless_with(errata)?;
     bad.upload(cloud).unwrap();
     let literal = if reversed_order {
-        let mut order = Vec::new();
-        splatgl::gl::sort_back_to_front(&cloud.positions, c.eye(), &mut order);
+        let mut order = splatgl::sort::Sorter::new()
+            .sort_by_distance(&cloud.positions, c.eye().to_array())
+            .to_vec();
         order.reverse(); // the appendix's front-to-back
         bad.render_with_order(c, &HeadlessOptions::default(), &order)
             .unwrap()

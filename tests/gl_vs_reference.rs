@@ -431,8 +431,9 @@ fn empty_cloud_and_partial_orders() {
             .is_empty()
     );
     // Indices past the cloud are culled by the shader: the same image as without them.
-    let mut order = Vec::new();
-    splatgl::gl::sort_back_to_front(&cloud.positions[..5], c.eye(), &mut order);
+    let order = splatgl::sort::Sorter::new()
+        .sort_by_distance(&cloud.positions[..5], c.eye().to_array())
+        .to_vec();
     let five = r
         .render_with_order(&c, &HeadlessOptions::default(), &order)
         .unwrap();

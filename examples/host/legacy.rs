@@ -15,7 +15,7 @@ use std::ffi::c_void;
 use glam::Mat4;
 use glow::HasContext;
 use splatgl::SplatCloud;
-use splatgl::gl::{ColorFormat, DepthFormat, DistanceSorter, ReadbackTarget, SplatRenderer};
+use splatgl::gl::{ColorFormat, DepthFormat, ReadbackTarget, SplatRenderer};
 use splatgl::headless::HeadlessContext;
 use splatgl::image::Image;
 
@@ -170,14 +170,11 @@ pub fn run(
     let mut renderer = SplatRenderer::new(gl)?;
     renderer.settings_mut().restore_state = true;
     renderer.upload(gl, cloud)?;
-    let mut sorter = DistanceSorter::default();
-    let mut order = Vec::new();
     let viewport = [0, 0, width as i32, height as i32];
     let mut images = Vec::new();
     for _ in 0..frames {
         host.ground_pass(gl, projection, view);
-        sorter.sort(&cloud.positions, cam.eye(), &mut order);
-        renderer.draw_with_matrices(gl, view, projection, viewport, &order)?;
+        renderer.draw_frame(gl, view, projection, viewport)?; // culls, sorts, draws
         host.cube_pass(gl, view);
         images.push(window.read_image(gl)?);
     }

@@ -13,7 +13,7 @@ use glam::{Mat4, Vec3};
 use glow::HasContext;
 use splatgl::SplatCloud;
 use splatgl::camera::Camera;
-use splatgl::gl::{ColorFormat, DepthFormat, DistanceSorter, ReadbackTarget, SplatRenderer};
+use splatgl::gl::{ColorFormat, DepthFormat, ReadbackTarget, SplatRenderer};
 use splatgl::headless::HeadlessContext;
 use splatgl::image::Image;
 
@@ -207,14 +207,11 @@ pub fn run(
     renderer.settings_mut().restore_state = true;
     renderer.settings_mut().depth_test = true; // the host's depth buffer occludes splats
     renderer.upload(gl, cloud)?;
-    let mut sorter = DistanceSorter::default();
-    let mut order = Vec::new();
     let viewport = [0, 0, width as i32, height as i32];
     let mut with_splats = Vec::new();
     for _ in 0..frames {
         host.draw(gl, mvp);
-        sorter.sort(&cloud.positions, cam.eye(), &mut order);
-        renderer.draw_with_matrices(gl, view, projection, viewport, &order)?;
+        renderer.draw_frame(gl, view, projection, viewport)?; // culls, sorts, draws
         with_splats.push(window.read_image(gl)?);
     }
     host.draw(gl, mvp);

@@ -99,8 +99,9 @@ fn render_suite_with(
         r.upload(&scene.cloud).map_err(|e| e.to_string())?;
         for (c, cam) in a.cameras.iter().zip(&cams) {
             let img = if front_to_back {
-                let mut order = Vec::new();
-                crate::gl::sort_back_to_front(&scene.cloud.positions, cam.eye(), &mut order);
+                let mut order = crate::sort::Sorter::new()
+                    .sort_by_distance(&scene.cloud.positions, cam.eye().to_array())
+                    .to_vec();
                 order.reverse();
                 r.render_with_order(cam, &opts, &order)
             } else {

@@ -91,6 +91,9 @@ pub enum GlError {
         /// Splats uploaded.
         capacity: usize,
     },
+    /// A viewport without pixels (`x, y, width, height` with a width or height ≤ 0).
+    #[error("viewport {0:?} has no pixels (x, y, width, height)")]
+    Viewport([i32; 4]),
     /// `draw` was called before `upload`.
     #[error("draw called before upload")]
     NotUploaded,

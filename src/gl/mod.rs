@@ -4,21 +4,14 @@
 //! [`glow::Context`] and never owns it, so it draws into whatever framebuffer the host has bound.
 //!
 //! ```no_run
-//! # fn demo(gl: &glow::Context, cloud: &splatgl::SplatCloud, camera: &splatgl::camera::Camera)
-//! # -> Result<(), splatgl::gl::GlError> {
-//! use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer, sort_back_to_front};
-//! let mut renderer = SplatRenderer::new(gl)?;
-//! renderer.upload(gl, cloud)?;                  // once: splat data → textures
-//! let mut target = ReadbackTarget::new(gl, camera.width, camera.height, ColorFormat::Rgba8, None)?;
-//! target.bind(gl)?;                              // or draw into the host's own framebuffer
-//! let mut order = Vec::new();
-//! sort_back_to_front(&cloud.positions, camera.eye(), &mut order); // per frame
-//! renderer.draw(gl, camera, &order)?;            // per frame: 4 bytes/splat uploaded
-//! let image = target.read_image(gl)?;            // top row first
-//! target.destroy(gl);
-//! renderer.destroy(gl);
-//! # Ok(()) }
+#![doc = include_str!("../../docs/snippets/embed.rs")]
 //! ```
+//!
+//! [`SplatRenderer::draw_frame`] derives the eye from the host's view matrix, culls, sorts
+//! ([`crate::sort::Sorter`], or a background [`AsyncSorter`](crate::sort::AsyncSorter) with
+//! [`FrameSort::Async`]) and draws. Hosts that sort themselves (the advanced path) upload
+//! their own order with [`SplatRenderer::set_order`] and draw it with `draw_current*` or
+//! `draw_with_matrices`; headless images come from a [`ReadbackTarget`].
 //!
 //! * [`SplatRenderer`] and its [`DrawSettings`]: upload once, draw per frame — with a
 //!   [`Camera`](crate::camera::Camera) (`draw`) or the host's own view and projection
@@ -29,8 +22,9 @@
 //! * [`ReadbackTarget`]: a framebuffer (RGBA8 / SRGB8_ALPHA8 / RGBA16F colour, optional depth)
 //!   read back into an [`Image`](crate::image::Image), for headless use, tests and hosts.
 //! * [`OffscreenTarget`]: the RGBA16F accumulation target with a resolve pass.
-//! * [`sort_back_to_front`] / [`DistanceSorter`]: the draw order, over the crate's radix sorter
-//!   ([`crate::sort::Sorter`]). `examples/embed.rs` shows a host-owned context.
+//! * The draw order of the advanced path: [`crate::sort::Sorter`] (the crate's one sorter;
+//!   [`sort_back_to_front`] and [`DistanceSorter`] are deprecated wrappers of it).
+//!   `examples/embed.rs` shows a host-owned context.
 //! * [`state`]: every piece of GL state the backend touches, in both modes
 //!   (`docs/embedding.md` is the guide for hosts).
 //!
@@ -58,6 +52,7 @@ pub mod fault;
 #[cfg(not(feature = "testing"))]
 mod fault;
 mod glsl;
+mod host_sort;
 mod objects;
 mod prepass;
 mod program;
@@ -85,9 +80,10 @@ pub use program::build_program;
 pub use readback::{ColorFormat, DepthFormat, ReadbackTarget};
 pub use renderer::SplatRenderer;
 pub use scene::SplatScene;
-pub use settings::{DepthFunc, DrawSettings};
+pub use settings::{DepthFunc, DrawSettings, FrameSort};
 #[doc(hidden)]
 pub use settings::{DrawPath, Pipeline};
+#[allow(deprecated)]
 pub use sort::{DistanceSorter, sort_back_to_front};
 #[doc(hidden)]
 pub use state::StateCalls;

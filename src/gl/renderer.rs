@@ -69,6 +69,8 @@ pub struct SplatRenderer {
     /// Whether the last draw ran the pre-pass.
     pub(super) used_prepass: Cell<bool>,
     pub(super) owned: Owned,
+    /// What [`SplatRenderer::draw_frame`] sorts (from [`SplatRenderer::upload`]).
+    pub(super) host_sort: Option<super::host_sort::HostSort>,
 }
 
 impl SplatRenderer {
@@ -146,6 +148,7 @@ impl SplatRenderer {
             prepass: None,
             used_prepass: Cell::new(false),
             owned: objects.keep("SplatRenderer"),
+            host_sort: None,
         })
     }
 
@@ -212,10 +215,12 @@ impl SplatRenderer {
     /// [`GlError::Capacity`]. GL errors (e.g. `GL_OUT_OF_MEMORY`) are returned as
     /// [`GlError::Gl`]; the host's pending errors are kept ([`super::state`]). On failure the
     /// previous cloud stays uploaded. Leaves every binding and the unpack state as it found
-    /// them.
+    /// them. Keeps a copy of the positions and the cull radii on the host (16 bytes per
+    /// splat) for [`SplatRenderer::draw_frame`]'s sort.
     pub fn upload(&mut self, gl: &glow::Context, cloud: &SplatCloud) -> Result<(), GlError> {
         self.upload_clouds(gl, &[cloud])?;
         self.models = Models::IDENTITY;
+        self.host_sort = Some(super::host_sort::HostSort::new(cloud));
         Ok(())
     }
 
@@ -256,6 +261,7 @@ impl SplatRenderer {
             .map_or(ColorSpace::default(), |c| c.meta.color_space.effective());
         self.instances = 0;
         self.order_capacity = n;
+        self.host_sort = None;
         Ok(())
     }
 
@@ -383,6 +389,7 @@ impl SplatRenderer {
             p.destroy(gl);
         }
         self.owned.destroy(gl);
+        self.host_sort = None;
         self.order_capacity = 0;
         self.instances = 0;
     }

@@ -7,11 +7,11 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::renderer::SplatRenderer;
 use super::settings::DrawSettings;
-use super::sort::DistanceSorter;
 use super::{GlError, view::ViewParams};
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
 use crate::cull::{CullBounds, radius_scale};
+use crate::sort::{SortRequest, Sorter};
 use glow::HasContext;
 
 /// Several clouds, each placed by a model matrix (its local → world transform, e.g. an
@@ -30,7 +30,7 @@ use glow::HasContext;
 ///
 /// The order: each draw sorts all splats the view may see ([`crate::cull`], tested on their
 /// world positions and radii) together by the distance of their **world** positions to the
-/// eye (one [`DistanceSorter`]). World positions are recomputed on the CPU
+/// eye (one [`Sorter`](crate::sort::Sorter)). World positions are recomputed on the CPU
 /// only for clouds whose model changed since the last draw: per-frame work proportional to
 /// the splats of the moving clouds, on top of the sort itself.
 ///
@@ -50,8 +50,7 @@ pub struct SplatScene {
     /// Cull radii in model space, and in world space (scaled by each model's largest stretch).
     local_bounds: CullBounds,
     world_bounds: CullBounds,
-    sorter: DistanceSorter,
-    order: Vec<u32>,
+    sorter: Sorter,
 }
 
 /// Tolerance of the affine check on model matrices (bottom row `0, 0, 0, 1`).
@@ -82,8 +81,7 @@ impl SplatScene {
             world: Vec::new(),
             local_bounds: CullBounds::default(),
             world_bounds: CullBounds::default(),
-            sorter: DistanceSorter::default(),
-            order: Vec::new(),
+            sorter: Sorter::new(),
         })
     }
 
@@ -136,7 +134,7 @@ impl SplatScene {
         self.world_bounds = self.local_bounds.clone();
         self.world_bounds.set_extent(&self.world);
         self.stale = self.models.iter().map(|m| *m != Mat4::IDENTITY).collect();
-        self.order.clear();
+        self.sorter = Sorter::new();
         Ok(())
     }
 
@@ -206,7 +204,7 @@ impl SplatScene {
 
     /// The last draw's order (indices into the scene, back to front).
     pub fn order(&self) -> &[u32] {
-        &self.order
+        self.sorter.order()
     }
 
     /// Sorts the splats the view may see ([`crate::cull`], on their world positions and
@@ -231,10 +229,10 @@ impl SplatScene {
             self.world_bounds.set_extent(&self.world);
         }
         let frustum = view.frustum();
+        let request = SortRequest::distance(view.eye.to_array());
         let (world, bounds) = (&self.world, &self.world_bounds);
-        self.sorter
-            .sort_visible(world, bounds, &frustum, view.eye, &mut self.order);
-        self.renderer.set_order(gl, &self.order)
+        let order = self.sorter.sort_visible(world, bounds, &frustum, &request);
+        self.renderer.set_order(gl, order)
     }
 
     /// Sorts for `camera` and draws every cloud into the bound framebuffer and viewport (as

@@ -3,6 +3,7 @@
 //! and benches use to compare paths.
 
 use crate::cloud::ColorSpace;
+use crate::sort::StaleBound;
 
 /// The depth comparison of [`DrawSettings::depth_func`] (the host's convention: `Less` /
 /// `LessEqual` for a standard depth buffer cleared to 1, `Greater` / `GreaterEqual` for a
@@ -52,6 +53,24 @@ pub struct DrawSettings {
     /// The colour space to draw as (`None` = the uploaded cloud's): decides
     /// `GL_FRAMEBUFFER_SRGB` where it can be switched (see [`SplatRenderer`](super::SplatRenderer)).
     pub color_space: Option<ColorSpace>,
+    /// How [`SplatRenderer::draw_frame`](super::SplatRenderer::draw_frame) sorts: on the
+    /// calling thread (the default) or on a background thread with bounded staleness.
+    pub sort: FrameSort,
+}
+
+/// Where [`SplatRenderer::draw_frame`](super::SplatRenderer::draw_frame) sorts the splats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FrameSort {
+    /// Every frame culls to its view and sorts on the calling thread before it draws (rayon's
+    /// pool does the sort): the exact back-to-front order of this frame's eye.
+    #[default]
+    Sync,
+    /// A background thread (an [`AsyncSorter`](crate::sort::AsyncSorter) the renderer owns)
+    /// sorts every splat for the newest eye; a frame draws the newest finished order while the
+    /// eye moved no more than the bound allows since it was sorted, else it waits for the sort
+    /// of its own eye (the viewer's rule, `docs/viewer.md`). No culling in this mode: an order
+    /// sorted for an older view must still cover the new one.
+    Async(StaleBound),
 }
 
 impl Default for DrawSettings {
@@ -62,6 +81,7 @@ impl Default for DrawSettings {
             depth_func: DepthFunc::Less,
             restore_state: false,
             color_space: None,
+            sort: FrameSort::Sync,
         }
     }
 }

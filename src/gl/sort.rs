@@ -5,11 +5,16 @@
 use glam::Vec3;
 
 /// A reusable distance sorter (no allocation per frame once warm).
+#[deprecated(
+    since = "0.1.0",
+    note = "use `splatgl::sort::Sorter` (its `sort_by_distance` / `sort_visible` return the order), or let `SplatRenderer::draw_frame` sort"
+)]
 #[derive(Debug, Default)]
 pub struct DistanceSorter {
     sorter: crate::sort::Sorter,
 }
 
+#[allow(deprecated)]
 impl DistanceSorter {
     /// Writes into `order` the indices of `positions` sorted back to front: squared Euclidean
     /// distance to `eye` descending, ties by index ascending (what a stable sort gives; NaN
@@ -21,6 +26,7 @@ impl DistanceSorter {
     }
 }
 
+#[allow(deprecated)]
 impl DistanceSorter {
     /// [`DistanceSorter::sort`] of only the splats `frustum` may see
     /// ([`crate::sort::Sorter::sort_visible`]): `bounds` are the cloud's
@@ -45,13 +51,18 @@ impl DistanceSorter {
     }
 }
 
-/// [`DistanceSorter::sort`] with fresh scratch (allocates; keep a [`DistanceSorter`] per frame
-/// loop instead).
+/// [`DistanceSorter::sort`] with fresh scratch (allocates on every call).
+#[deprecated(
+    since = "0.1.0",
+    note = "use `splatgl::sort::Sorter::sort_by_distance` (keeps its scratch), or let `SplatRenderer::draw_frame` sort"
+)]
+#[allow(deprecated)]
 pub fn sort_back_to_front(positions: &[[f32; 3]], eye: Vec3, order: &mut Vec<u32>) {
     DistanceSorter::default().sort(positions, eye, order);
 }
 
 #[cfg(test)]
+#[allow(deprecated)]
 mod tests {
     use super::*;
 

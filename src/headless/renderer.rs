@@ -6,10 +6,9 @@ use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
 use crate::cull::CullBounds;
 use crate::gl::frame::{Blend, FrameTargets, Output};
-use crate::gl::{
-    DistanceSorter, DrawPath, DrawSettings, Errata, SplatRenderer, frustum_for_camera,
-};
+use crate::gl::{DrawPath, DrawSettings, Errata, SplatRenderer, frustum_for_camera};
 use crate::image::Image;
+use crate::sort::{SortRequest, Sorter};
 use glow::HasContext;
 
 /// Which framebuffer the splats are blended in.
@@ -57,8 +56,7 @@ pub struct HeadlessRenderer {
     /// Sort only the splats the camera may see (off for erratum variants, which must draw
     /// exactly as before the cull).
     cull: bool,
-    sorter: DistanceSorter,
-    order: Vec<u32>,
+    sorter: Sorter,
     // Declared last: dropped after the GL objects above are deleted in `Drop`.
     ctx: HeadlessContext,
 }
@@ -94,8 +92,7 @@ impl HeadlessRenderer {
             positions: Vec::new(),
             bounds: CullBounds::default(),
             cull: errata == Errata::default(),
-            sorter: DistanceSorter::default(),
-            order: Vec::new(),
+            sorter: Sorter::new(),
             ctx,
         })
     }
@@ -137,19 +134,20 @@ impl HeadlessRenderer {
         camera: &Camera,
         opts: &HeadlessOptions,
     ) -> Result<Image, HeadlessError> {
-        let mut order = std::mem::take(&mut self.order);
+        // The sorter is taken out while its order is drawn (a move, no allocation).
+        let mut sorter = std::mem::take(&mut self.sorter);
+        let eye = camera.eye().to_array();
         // (A 0-sized camera renders no pixel: nothing to cull for.)
-        if self.cull && camera.width > 0 && camera.height > 0 {
+        let order = if self.cull && camera.width > 0 && camera.height > 0 {
             let viewport = [0, 0, camera.width as i32, camera.height as i32];
             let frustum = frustum_for_camera(camera, viewport);
-            let (p, b) = (&self.positions, &self.bounds);
-            self.sorter
-                .sort_visible(p, b, &frustum, camera.eye(), &mut order);
+            let request = SortRequest::distance(eye);
+            sorter.sort_visible(&self.positions, &self.bounds, &frustum, &request)
         } else {
-            self.sorter.sort(&self.positions, camera.eye(), &mut order);
-        }
-        let result = self.render_with_order(camera, opts, &order);
-        self.order = order;
+            sorter.sort_by_distance(&self.positions, eye)
+        };
+        let result = self.render_with_order(camera, opts, order);
+        self.sorter = sorter;
         result
     }
 

@@ -6,7 +6,7 @@
 //!    [`RenderOptions::cull_depth`], Σ = R S² Rᵀ (global), Σ' = J W Σ Wᵀ Jᵀ with the
 //!    ±1.3·tan(half fov) clamp inside J, + 0.3 px² on the diagonal, colour from SH of degree
 //!    min(cloud, requested) along normalize(mean − eye), the 3σ bounding box.
-//! 2. [`back_to_front`]: camera distance (default) or view depth, stable, ties by index.
+//! 2. the order, [`crate::sort::Sorter::sort_for_camera`]: camera distance (default) or view depth, stable, ties by index.
 //! 3. binning into 16×16 tiles, then rasterizing per tile row in parallel:
 //!    at each pixel centre (x + 0.5, y + 0.5), m² = dᵀ Σ'⁻¹ d, skip m² > 9,
 //!    α = min(0.99, opacity · exp(−½ m²)), skip α < 1/255, and in f32
@@ -23,7 +23,9 @@ mod sort;
 #[doc(hidden)]
 pub use project::PixelBox;
 use project::{Projected, ViewContext};
-pub use sort::{SortMode, back_to_front, sort_key};
+pub use sort::SortMode;
+#[allow(deprecated)]
+pub use sort::{back_to_front, sort_key};
 
 /// Most (splat, tile) bin entries held at once (4 bytes each): 64 MiB.
 pub const MAX_BIN_ENTRIES: u64 = 16 << 20;
@@ -158,9 +160,10 @@ pub fn render_with_path(
             .into_par_iter()
             .map(|i| ctx.project(cloud, i))
             .collect();
-        back_to_front(&cloud.positions, camera, opts.sort)
-            .into_iter()
-            .filter_map(|i| projected[i as usize])
+        Sorter::new()
+            .sort_for_camera(&cloud.positions, camera, opts.sort)
+            .iter()
+            .filter_map(|&i| projected[i as usize])
             .collect()
     };
     // Bin and rasterize in bands of tile rows holding at most MAX_BIN_ENTRIES (splat, tile)

@@ -9,6 +9,10 @@ pub use crate::sort::SortMode;
 /// `dx·dx + dy·dy + dz·dz` ([`crate::sort::squared_distance`]); for [`SortMode::ViewDepth`]
 /// the depth `(p − eye)·forward` along the camera's optical axis ([`crate::sort::view_depth`]).
 /// Evaluated left to right, without fused multiply-add.
+#[deprecated(
+    since = "0.1.0",
+    note = "use `splatgl::sort::{squared_distance, view_depth}`"
+)]
 pub fn sort_key(p: [f32; 3], camera: &Camera, mode: SortMode) -> f32 {
     let eye = camera.eye().to_array();
     match mode {
@@ -23,6 +27,7 @@ pub fn sort_key(p: [f32; 3], camera: &Camera, mode: SortMode) -> f32 {
 /// Indices of `positions` in blending order: back to front (largest [`sort_key`] first), ties
 /// broken by ascending index — exactly a stable sort by key descending. NaN keys come first
 /// (the rasterizer culls non-finite means anyway); see [`crate::sort::far_first_key`].
+#[deprecated(since = "0.1.0", note = "use `splatgl::sort::Sorter::sort_for_camera`")]
 pub fn back_to_front(positions: &[[f32; 3]], camera: &Camera, mode: SortMode) -> Vec<u32> {
     crate::sort::Sorter::new()
         .sort_for_camera(positions, camera, mode)
@@ -30,6 +35,7 @@ pub fn back_to_front(positions: &[[f32; 3]], camera: &Camera, mode: SortMode) ->
 }
 
 #[cfg(test)]
+#[allow(deprecated)]
 mod tests {
     use super::*;
     use glam::Vec3;

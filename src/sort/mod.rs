@@ -34,12 +34,15 @@ mod keys;
 mod quantize;
 mod radix;
 mod reuse;
+mod stale;
 mod visible;
 
 pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
 pub use quantize::quantized_bucket_width;
 pub use reuse::Outcome;
+pub(crate) use stale::StaleOrders;
+pub use stale::{Freshness, StaleBound};
 
 use quantize::{given_keys_range, quantized_key, visible_range};
 use radix::{RadixBuffers, chunk_count, fill_keys};

@@ -18,7 +18,6 @@ use super::controls::Controls;
 use super::draw::Targets;
 use super::frame::BenchRun;
 use super::loading::{LoadEvent, Loaded, display_name, spawn};
-use super::order::Orders;
 use super::rig::Rig;
 use super::stats::Stats;
 use super::surface::GlSurfaceWindow;
@@ -26,6 +25,7 @@ use super::{ViewerError, ViewerOptions};
 use crate::camera::{Camera, CamerasJsonEntry, Extent, GltfPerspective, SceneView, UpAxis};
 use crate::gl::{DrawSettings, SplatRenderer};
 use crate::load::{Format, LoadOptions};
+use crate::sort::StaleOrders as Orders;
 
 /// Events from other threads.
 #[derive(Debug)]

@@ -8,10 +8,10 @@ use glow::HasContext;
 use winit::event_loop::ActiveEventLoop;
 
 use super::app::App;
-use super::order::Freshness;
 use super::rig::Rig;
 use super::stats::BenchLog;
 use super::{Bench, ViewerError};
+use crate::sort::Freshness;
 
 /// Frames drawn before `--bench-frames` starts measuring (upload, first sort, shader warm-up).
 const BENCH_WARMUP: usize = 2;

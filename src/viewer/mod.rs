@@ -27,12 +27,11 @@ mod controls;
 mod draw;
 mod frame;
 mod loading;
-mod order;
 mod rig;
 mod stats;
 mod surface;
 
-pub use order::StaleBound;
+pub use crate::sort::StaleBound;
 
 use std::path::PathBuf;
 

@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-use super::order::Freshness;
+use crate::sort::Freshness;
 
 /// The frames of the last second.
 #[derive(Debug, Default)]

@@ -17,7 +17,7 @@ use crate::covariance::c_matrix;
 use crate::image::Image;
 use crate::profile::srgb_encode;
 use crate::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2, JACOBIAN_CLAMP, NEAR_CULL};
-use crate::reference::{SortMode, back_to_front};
+use crate::reference::SortMode;
 use glam::{DMat3, DQuat, DVec3};
 
 mod footprint;
@@ -160,7 +160,9 @@ fn project(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], vars: &[Variant]) ->
     } else {
         SortMode::Distance
     };
-    let mut order = back_to_front(&cloud.positions, cam, mode);
+    let mut order = crate::sort::Sorter::new()
+        .sort_for_camera(&cloud.positions, cam, mode)
+        .to_vec();
     if view.on(Erratum::G) {
         order.reverse(); // the appendix's front-to-back
     }

@@ -1,5 +1,7 @@
-//! Draw orders for the viewer's frames: the newest finished order of an [`AsyncSorter`], with a
-//! bounded staleness ([`StaleBound`], see `docs/viewer.md`).
+//! Draw orders sorted on a background thread: the newest finished order of an [`AsyncSorter`],
+//! drawn while it is stale by no more than a bound ([`StaleBound`], see `docs/viewer.md`). The
+//! viewer's frames and [`SplatRenderer::draw_frame`](crate::gl::SplatRenderer::draw_frame)
+//! with [`FrameSort::Async`](crate::gl::FrameSort::Async) use it.
 //!
 //! An order sorted (by `cameraDistance`) for eye `e₀` and drawn from eye `e₁`, `δ = |e₁ − e₀|`:
 //! - **exact** when `δ` is within the frame's [`SortedFrame::exact_radius`] (the sorter's
@@ -15,11 +17,11 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
+use super::{AsyncSorter, Reuse, SortRequest, SortedFrame, Sorter};
 use crate::cloud::SplatCloud;
-use crate::sort::{AsyncSorter, Reuse, SortRequest, SortedFrame, Sorter};
 
 /// How stale an order may be before a frame waits for the next sort.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub enum StaleBound {
     /// Only provably exact orders ([`SortedFrame::exact_radius`]); any other motion waits.
     Strict,
@@ -31,6 +33,20 @@ pub enum StaleBound {
     /// A fixed τ in world units.
     Distance(f32),
 }
+
+/// Equal when the same variant with bit-identical distances (so `Eq` holds for every value,
+/// NaN included).
+impl PartialEq for StaleBound {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (StaleBound::Strict, StaleBound::Strict) | (StaleBound::Auto, StaleBound::Auto) => true,
+            (StaleBound::Distance(a), StaleBound::Distance(b)) => a.to_bits() == b.to_bits(),
+            _ => false,
+        }
+    }
+}
+
+impl Eq for StaleBound {}
 
 impl StaleBound {
     /// τ for `cloud`.
@@ -77,7 +93,7 @@ pub enum Freshness {
 
 /// The decision for one frame: the order's eye moved `moved` from the request it was sorted
 /// for, which has exact radius `exact`; tolerance `tau`.
-pub fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
+pub(crate) fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
     if moved <= exact {
         Some(Freshness::Exact)
     } else if 2.0 * moved <= tau {
@@ -89,10 +105,10 @@ pub fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
     }
 }
 
-/// The viewer's orders: an [`AsyncSorter`] over the cloud's positions with
+/// Orders from a background sorter: an [`AsyncSorter`] over the cloud's positions with
 /// [`Reuse::MotionBound`], and the staleness rule.
 #[derive(Debug)]
-pub struct Orders {
+pub(crate) struct StaleOrders {
     sorter: AsyncSorter,
     tau: f32,
     sync: bool,
@@ -100,12 +116,12 @@ pub struct Orders {
     generation: u64,
 }
 
-impl Orders {
+impl StaleOrders {
     /// A sorter thread for `positions`; `tau` from [`StaleBound::tolerance`]; `sync` makes
     /// every frame wait (`--sort-sync`).
-    pub fn new(positions: Arc<[[f32; 3]]>, tau: f32, sync: bool) -> std::io::Result<Self> {
+    pub(crate) fn new(positions: Arc<[[f32; 3]]>, tau: f32, sync: bool) -> std::io::Result<Self> {
         let sorter = Sorter::new().with_reuse(Reuse::MotionBound);
-        Ok(Orders {
+        Ok(StaleOrders {
             sorter: AsyncSorter::new(positions, sorter)?,
             tau,
             sync,
@@ -115,7 +131,7 @@ impl Orders {
     }
 
     /// Posts a sort for `eye` unless it is the last one posted (never waits).
-    pub fn request(&mut self, eye: Vec3) {
+    pub(crate) fn request(&mut self, eye: Vec3) {
         let e = eye.to_array();
         if self.requested.map(|r| r.map(f32::to_bits)) != Some(e.map(f32::to_bits)) {
             self.generation = self.sorter.request(SortRequest::distance(e));
@@ -125,7 +141,7 @@ impl Orders {
 
     /// The order to draw from `eye`: the newest finished one if the bound allows it, else
     /// (waiting) the order sorted for `eye`. `None` only if the sorter thread died.
-    pub fn for_frame(&mut self, eye: Vec3) -> Option<(&SortedFrame, Freshness)> {
+    pub(crate) fn for_frame(&mut self, eye: Vec3) -> Option<(&SortedFrame, Freshness)> {
         let decision = match self.sorter.latest() {
             Some(f) if !self.sync => f.request().and_then(|req| {
                 let moved = (eye - Vec3::from_array(req.eye)).length() as f64;
