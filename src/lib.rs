@@ -21,6 +21,8 @@
 #![warn(missing_docs)]
 
 pub mod camera;
+#[cfg(feature = "capi")]
+pub mod capi;
 pub mod cloud;
 pub mod compare;
 pub mod conformance;
