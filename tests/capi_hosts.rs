@@ -34,6 +34,7 @@ fn library() -> &'static Result<PathBuf, String> {
                 "build",
                 "--lib",
                 "--locked",
+                "--no-default-features",
                 "--features",
                 "capi",
                 "--target-dir",

@@ -21,8 +21,8 @@ const LAYERS: &[&[&str]] = &[
     &["reference", "gl"],
     // Driving a renderer: headless EGL.
     &["headless"],
-    // Applications of the library: the viewer, the conformance kit.
-    &["viewer", "conformance"],
+    // Applications of the library: the viewer, the conformance kit, the C API.
+    &["viewer", "conformance", "capi"],
 ];
 
 fn layer_of(module: &str) -> Option<usize> {
