@@ -98,8 +98,12 @@ fn compile(compiler: &str, std: &str, source: &str, name: &str, libs: &[&str]) -
 
 /// Runs a host example; its exit status is its verdict (it prints each failed check).
 fn run(exe: &Path, args: &[&Path]) -> String {
+    // cargo's LD_LIBRARY_PATH names the main target folder, whose libsplatgl.so may be a build
+    // without `capi` (and it outranks the executable's run path): point it at ours.
+    let lib = library().as_ref().expect("the C library builds");
     let out = Command::new(exe)
         .args(args)
+        .env("LD_LIBRARY_PATH", lib)
         .output()
         .expect("the host runs");
     let text = format!(
