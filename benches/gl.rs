@@ -324,7 +324,7 @@ fn scene(name: &str, w: u32, h: u32, scale: f32) -> Option<(SplatCloud, Camera, 
             } else {
                 (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y)
             };
-            let cam = Camera::frame_points_along(&cloud.positions, fwd, up, fov, w, h)?;
+            let cam = common::frame_points_along(&cloud.positions, fwd, up, fov, w, h)?;
             let target = cam.eye() + cam.world_to_camera.inverse().z_axis.truncate();
             (cloud, cam, target)
         }

@@ -2,6 +2,9 @@
 //! footprints: a worst case), and the real 50,000-splat `mujoco_warp_fox_sh0.ply` when
 //! `../shared/data/real/` is present.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use glam::Vec3;
 use splatgl::camera::Camera;
@@ -35,7 +38,7 @@ fn bench(c: &mut Criterion) {
         .join("../shared/data/real/mujoco_warp_fox_sh0.ply");
     match splatgl::load::load_path(&fox, &Default::default()) {
         Ok(l) => {
-            let cam = Camera::frame_points(&l.cloud.positions, 50f32.to_radians(), 640, 480)
+            let cam = common::frame_points(&l.cloud.positions, 50f32.to_radians(), 640, 480)
                 .expect("finite means");
             g.bench_function("fox 50k splats 640x480", |b| {
                 b.iter(|| render_with_stats(&l.cloud, &cam, &opts))

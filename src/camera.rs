@@ -287,18 +287,30 @@ impl Camera {
         .validated()
     }
 
-    /// A camera that frames `points` in glTF's convention (+Y up): see [`Self::frame_points_along`]
-    /// with `forward = (0, −0.35, −1)`, `up = +Y` (looking from +Z, slightly from above).
+    /// A camera that frames `points` in glTF's convention (+Y up), looking from +Z slightly
+    /// from above: [`Self::frame_points_along`] with `forward = (0, −0.35, −1)`, `up = +Y`.
+    #[deprecated(
+        since = "0.1.0",
+        note = "use `Camera::frame_extent_along(&Extent::of_points(points)?, …)` (or `frame_cloud`)"
+    )]
     pub fn frame_points(points: &[[f32; 3]], fov_y: f32, width: u32, height: u32) -> Option<Self> {
         let fwd = Vec3::new(0.0, -0.35, -1.0);
-        Self::frame_points_along(points, fwd, Vec3::Y, fov_y, width, height)
+        Self::frame_extent_along(
+            &Extent::of_points(points)?,
+            fwd,
+            Vec3::Y,
+            fov_y,
+            width,
+            height,
+        )
     }
 
-    /// A camera looking along `forward` with `up` roughly up that frames `points` (non-finite
-    /// ones ignored): it looks at the centre of the box spanned by the 1st..99th percentile of
-    /// each coordinate (robust to stray splats), far enough that the box's bounding sphere fits
-    /// the smaller field of view (10 % margin). For INRIA PLY scenes (COLMAP axes, usually −Y
-    /// up) the CLI uses `forward = (0, 0.35, −1)`, `up = −Y`. `None` when there is no finite point or `forward ∥ up`.
+    /// A camera looking along `forward` with `up` roughly up that frames the box of `points`
+    /// ([`Extent::of_points`]) by the one framing rule ([`Self::frame_extent_along`]).
+    #[deprecated(
+        since = "0.1.0",
+        note = "use `Camera::frame_extent_along(&Extent::of_points(points)?, …)`"
+    )]
     pub fn frame_points_along(
         points: &[[f32; 3]],
         forward: Vec3,
@@ -307,23 +319,14 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Option<Self> {
-        if forward.cross(up).length_squared() <= 1e-12 {
-            return None;
-        }
-        let (lo, hi) = frame::points_box(points.iter())?;
-        let centre = 0.5 * (lo + hi);
-        // A single point (or coincident ones) has no extent: frame a unit sphere around it, so
-        // the camera stays outside the near cull.
-        let half = 0.5 * (hi - lo).length();
-        let radius = if half > 1e-6 { half.max(1e-3) } else { 1.0 };
-        let tan_y = (0.5 * fov_y).tan();
-        let tan_min = tan_y.min(tan_y * width as f32 / height.max(1) as f32);
-        // The bounding sphere fits when dist · sin(half fov) ≥ radius; 10 % margin.
-        let dist = 1.1 * radius / tan_min.atan().sin();
-        let eye = centre - forward.normalize() * dist;
-        let mut cam = Self::look_at(eye, centre, up, fov_y, width, height);
-        cam.far = (dist + 2.0 * radius).max(cam.far);
-        Some(cam)
+        Self::frame_extent_along(
+            &Extent::of_points(points)?,
+            forward,
+            up,
+            fov_y,
+            width,
+            height,
+        )
     }
 
     /// The same view at another resolution: focal lengths and principal point scale with the

@@ -28,6 +28,7 @@ pub mod compare;
 pub mod conformance;
 pub mod convert;
 pub mod cull;
+pub mod engine;
 // Covariance algebra behind the loader's node transforms: public for the node-transform tests,
 // not part of the documented API (`SplatCloud::covariance` is the user-facing form).
 #[doc(hidden)]

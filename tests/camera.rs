@@ -1,5 +1,7 @@
 //! Camera constructors against independent computations (f64, written from the formats' text).
 
+mod common;
+
 use glam::{DMat3, DQuat, DVec3, Mat4, Quat, Vec3};
 use splatgl::camera::{Camera, CameraError, GltfPerspective, parse_cameras_json};
 
@@ -176,14 +178,14 @@ fn framing_keeps_the_bulk_of_the_points_in_view() {
         .collect();
     pts.push([1e6, 0.0, 0.0]); // a stray splat must not shrink the view
     pts.push([f32::NAN, 0.0, 0.0]);
-    let cam = Camera::frame_points(&pts, 0.8, 160, 120).unwrap();
+    let cam = common::frame_points(&pts, 0.8, 160, 120).unwrap();
     let inside = pts[..1000]
         .iter()
         .filter_map(|p| cam.project(Vec3::from_array(*p)))
         .filter(|(px, _)| px.x >= 0.0 && px.x <= 160.0 && px.y >= 0.0 && px.y <= 120.0)
         .count();
     assert_eq!(inside, 1000);
-    assert!(Camera::frame_points(&[], 0.8, 10, 10).is_none());
+    assert!(common::frame_points(&[], 0.8, 10, 10).is_none());
 }
 
 /// Framing uses the splats' 3σ boxes, not their centres: coincident splats with large scales

@@ -127,10 +127,7 @@ fn cameras(c: &SplatCloud) -> Vec<splatgl::camera::Camera> {
         Vec3::new(0.7, 0.25, 0.7),
     ]
     .iter()
-    .map(|&f| {
-        splatgl::camera::Camera::frame_points_along(&c.positions, f, Vec3::NEG_Y, 0.9, 200, 150)
-            .unwrap()
-    })
+    .map(|&f| common::frame_points_along(&c.positions, f, Vec3::NEG_Y, 0.9, 200, 150).unwrap())
     .collect()
 }
 

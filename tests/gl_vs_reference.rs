@@ -485,7 +485,7 @@ fn real_files_render_without_gl_errors() {
             continue;
         };
         let cloud = l.cloud;
-        let c = Camera::frame_points(&cloud.positions, 0.9, 80, 60).expect("finite means");
+        let c = common::frame_points(&cloud.positions, 0.9, 80, 60).expect("finite means");
         r.upload(&cloud)
             .unwrap_or_else(|e| panic!("{}: upload: {e}", path.display()));
         let img = r

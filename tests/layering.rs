@@ -19,8 +19,8 @@ const LAYERS: &[&[&str]] = &[
     &["cull", "sort", "convert"],
     // The two renderers.
     &["reference", "gl"],
-    // Driving a renderer: headless EGL.
-    &["headless"],
+    // Driving a renderer: headless EGL; either renderer for offline images.
+    &["headless", "engine"],
     // Applications of the library: the viewer, the conformance kit, the C API.
     &["viewer", "conformance", "capi"],
 ];

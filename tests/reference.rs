@@ -570,7 +570,7 @@ fn renders_every_real_file_that_loads() {
                 continue;
             }
         };
-        let c = Camera::frame_points(&cloud.positions, 0.9, 80, 60).expect("finite means");
+        let c = common::frame_points(&cloud.positions, 0.9, 80, 60).expect("finite means");
         let img = render(&cloud, &c, &opts());
         assert!(
             img.pixels.iter().flatten().all(|v| v.is_finite()),

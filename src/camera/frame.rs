@@ -74,6 +74,13 @@ impl Extent {
         Self::of_cloud_at(cloud, crate::profile::CUTOFF_M2.sqrt()) // 3σ
     }
 
+    /// The box of points (their 1st..99th percentile per axis, non-finite ones ignored), for
+    /// framing points that are not splats; `None` without a finite point.
+    pub fn of_points(points: &[[f32; 3]]) -> Option<Self> {
+        let (lo, hi) = points_box(points.iter())?;
+        Some(Extent { lo, hi })
+    }
+
     /// [`Extent::of_cloud`] with boxes `k` standard deviations wide instead of 3
     /// ([`FIT_SIGMAS`] for the part of the content a default view fits to the image).
     pub fn of_cloud_at(cloud: &SplatCloud, k: f32) -> Option<Self> {

@@ -6,30 +6,8 @@
 //! there and needs far less memory); GL otherwise (a hardware driver). `--target` asks for GL.
 
 use splatgl::SplatCloud;
-use splatgl::camera::Camera;
-use splatgl::image::Image;
+use splatgl::engine::{Engine, is_software};
 use splatgl::reference::RenderOptions;
-
-/// GL renderer strings of software rasterizers (lower case).
-pub const SOFTWARE_RENDERERS: [&str; 3] = ["llvmpipe", "softpipe", "swiftshader"];
-
-/// Whether a `GL_VERSION / GL_RENDERER` string names a software rasterizer.
-pub fn is_software(description: &str) -> bool {
-    let d = description.to_ascii_lowercase();
-    SOFTWARE_RENDERERS.iter().any(|s| d.contains(s))
-}
-
-/// The renderer chosen, with the GL state it keeps across the images of a batch.
-pub enum Engine {
-    /// The CPU reference rasterizer.
-    Reference,
-    /// Headless GL with the cloud uploaded.
-    #[cfg(feature = "gl")]
-    Gl(
-        Box<splatgl::headless::HeadlessRenderer>,
-        splatgl::headless::HeadlessOptions,
-    ),
-}
 
 /// What the flags ask of the backend.
 #[derive(Debug, Clone, Copy)]
@@ -130,84 +108,27 @@ impl Wanted {
     }
 
     #[cfg(feature = "gl")]
-    fn gl(&self, cloud: &SplatCloud, opts: &RenderOptions) -> Result<(Engine, String), String> {
+    fn gl(&self, cloud: &SplatCloud, _: &RenderOptions) -> Result<(Engine, String), String> {
         use super::render::TargetArg;
-        use splatgl::headless::{HeadlessOptions, HeadlessRenderer, TargetKind};
-        let mut r = HeadlessRenderer::new().map_err(|e| e.to_string())?;
-        let driver = r.context().describe();
-        let o = HeadlessOptions {
-            target: match self.target.unwrap_or(TargetArg::Rgba8) {
-                TargetArg::Rgba8 => TargetKind::Rgba8,
-                TargetArg::Rgba16f => TargetKind::Rgba16fResolve,
-            },
-            background: opts.background,
-            sh_degree: Some(opts.sh_degree),
-            color_space: None,
+        use splatgl::headless::TargetKind;
+        let target = match self.target.unwrap_or(TargetArg::Rgba8) {
+            TargetArg::Rgba8 => TargetKind::Rgba8,
+            TargetArg::Rgba16f => TargetKind::Rgba16fResolve,
         };
+        let mut engine = Engine::gl(target)?;
+        let driver = engine.describe().unwrap_or_default();
         // Software GL under auto falls back to the reference: no upload needed then.
         let auto_software = self.backend == super::render::Backend::Auto
             && self.target.is_none()
             && is_software(&driver);
         if !auto_software {
-            r.upload(cloud).map_err(|e| e.to_string())?;
+            engine.upload(cloud)?;
         }
-        Ok((Engine::Gl(Box::new(r), o), driver))
+        Ok((engine, driver))
     }
 
     #[cfg(not(feature = "gl"))]
     fn gl(&self, _: &SplatCloud, _: &RenderOptions) -> Result<(Engine, String), String> {
         Err("this splatgl was built without the `gl` feature".into())
-    }
-}
-
-impl Engine {
-    /// The backend's name in the summary line.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Engine::Reference => "reference",
-            #[cfg(feature = "gl")]
-            Engine::Gl(..) => "gl",
-        }
-    }
-
-    /// Renders one image; the reference also says how many splats it drew.
-    pub fn render(
-        &mut self,
-        cloud: &SplatCloud,
-        cam: &Camera,
-        opts: &RenderOptions,
-    ) -> Result<(Image, Option<usize>), String> {
-        match self {
-            Engine::Reference => {
-                // As displayed (sRGB-encoded for lin_rec709_display): what GL gives.
-                let space = cloud.meta.color_space.effective();
-                let (img, stats) = splatgl::reference::render_display(cloud, cam, opts, space);
-                Ok((img, Some(stats.visible)))
-            }
-            #[cfg(feature = "gl")]
-            Engine::Gl(r, o) => r
-                .render(cam, o)
-                .map(|img| (img, None))
-                .map_err(|e| format!("GL: {e}")),
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn software_rasterizers_are_recognised_by_their_renderer_string() {
-        use super::is_software;
-        assert!(is_software(
-            "OpenGL ES 3.2 Mesa 24.2.8 / llvmpipe (LLVM 19.1.7, 256 bits)"
-        ));
-        assert!(is_software("OpenGL ES 3.0 / Google SwiftShader"));
-        assert!(is_software("3.3 (Core Profile) Mesa 23 / softpipe"));
-        assert!(!is_software(
-            "OpenGL ES 3.2 NVIDIA 550.54 / NVIDIA GeForce RTX 4090/PCIe/SSE2"
-        ));
-        assert!(!is_software(
-            "OpenGL ES 3.2 Mesa 24.2 / AMD Radeon RX 7900 (radeonsi)"
-        ));
     }
 }

@@ -3,18 +3,12 @@
 
 use super::manifest::Manifest;
 use crate::camera::Camera;
+use crate::engine::Engine;
 use crate::image::Image;
 use crate::load::{LoadOptions, Scene, load_path};
 use std::path::Path;
 
-/// splatgl's backends.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Backend {
-    /// The CPU reference rasterizer (float output).
-    Reference,
-    /// OpenGL ES 3 through headless EGL (8-bit output).
-    Gl,
-}
+pub use crate::engine::Backend;
 
 /// One asset loaded with its cameras at the manifest's image sizes.
 pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<Camera>), String> {
@@ -38,33 +32,23 @@ pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<
 /// Every camera's image, `(image path, image)` in manifest order.
 pub type Images = Vec<(String, Image)>;
 
-/// Renders the suite with `backend` (errata off).
+/// Renders the suite with `backend` (errata off): one [`Engine`] for every asset.
 pub fn render_suite(dir: &Path, m: &Manifest, backend: Backend) -> Result<Images, String> {
-    match backend {
-        Backend::Reference => {
-            let mut out = Vec::new();
-            for (i, a) in m.assets.iter().enumerate() {
-                let (scene, cams) = load_asset(dir, m, i)?;
-                let space = scene.cloud.meta.color_space.effective();
-                for (c, cam) in a.cameras.iter().zip(&cams) {
-                    let opts = crate::reference::RenderOptions {
-                        background: m.background.map(|v| v as f32),
-                        ..Default::default()
-                    };
-                    let img = crate::reference::render_display(&scene.cloud, cam, &opts, space).0;
-                    out.push((c.image.clone(), img));
-                }
-            }
-            Ok(out)
+    let mut engine = Engine::new(backend)?;
+    let opts = crate::reference::RenderOptions {
+        background: m.background.map(|v| v as f32),
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    for (i, a) in m.assets.iter().enumerate() {
+        let (scene, cams) = load_asset(dir, m, i)?;
+        engine.upload(&scene.cloud)?;
+        for (c, cam) in a.cameras.iter().zip(&cams) {
+            let (img, _) = engine.render(&scene.cloud, cam, &opts)?;
+            out.push((c.image.clone(), img));
         }
-        #[cfg(feature = "gl")]
-        Backend::Gl => {
-            let r = crate::headless::HeadlessRenderer::new().map_err(|e| e.to_string())?;
-            render_suite_with(dir, m, r, false)
-        }
-        #[cfg(not(feature = "gl"))]
-        Backend::Gl => Err("this splatgl was built without the `gl` feature".into()),
     }
+    Ok(out)
 }
 
 /// Renders the suite with the GL backend and `errata` switched in; `front_to_back` draws in

@@ -95,7 +95,7 @@ pub fn large_real_scenes() -> Option<Vec<RealScene>> {
         }
         let (fwd, up) = (Vec3::new(0.0, 0.35, -1.0), -Vec3::Y);
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let framed = Camera::frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120)
+        let framed = frame_points_along(&cloud.positions, fwd, up, 0.9, 160, 120)
             .unwrap_or_else(|| panic!("{name}: no camera frames it"));
         let centre = Vec3::from_array(cloud.bounds().unwrap().center());
         let inside = Camera::look_at(centre, centre + Vec3::X, up, 1.2, 160, 120);
@@ -124,4 +124,23 @@ pub fn sh_for(rgb: [f32; 3], degree: u8) -> Vec<[f32; 3]> {
     let mut sh = vec![[0.0; 3]; splatgl::cloud::sh_coeff_count(degree)];
     sh[0] = rgb.map(|c| splatgl::sh::dc_from_color(c as f64));
     sh
+}
+
+/// A camera looking along `forward` (`up` roughly up) that frames the box of `points` by the
+/// library's one framing rule (`Camera::frame_extent_along` of `Extent::of_points`).
+pub fn frame_points_along(
+    points: &[[f32; 3]],
+    forward: Vec3,
+    up: Vec3,
+    fov_y: f32,
+    w: u32,
+    h: u32,
+) -> Option<Camera> {
+    let extent = splatgl::camera::Extent::of_points(points)?;
+    Camera::frame_extent_along(&extent, forward, up, fov_y, w, h)
+}
+
+/// [`frame_points_along`] in glTF's convention: from +Z slightly above, +Y up.
+pub fn frame_points(points: &[[f32; 3]], fov_y: f32, w: u32, h: u32) -> Option<Camera> {
+    frame_points_along(points, Vec3::new(0.0, -0.35, -1.0), Vec3::Y, fov_y, w, h)
 }
