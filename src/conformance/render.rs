@@ -65,7 +65,7 @@ pub fn render_suite_gl(
 }
 
 /// Renders the suite with `r`, in the reversed order when `front_to_back`.
-#[cfg(feature = "gl")]
+#[cfg(all(feature = "gl", feature = "testing"))]
 fn render_suite_with(
     dir: &Path,
     m: &Manifest,

@@ -14,9 +14,11 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy}
 use winit::keyboard::PhysicalKey;
 use winit::window::{Fullscreen, Window, WindowId};
 
+mod commands;
+mod frame;
+
 use super::controls::Controls;
 use super::draw::Targets;
-use super::frame::BenchRun;
 use super::loading::{LoadEvent, Loaded, display_name, spawn};
 use super::rig::Rig;
 use super::stats::Stats;
@@ -26,6 +28,7 @@ use crate::camera::{Camera, CamerasJsonEntry, Extent, GltfPerspective, SceneView
 use crate::gl::{DrawSettings, SplatRenderer};
 use crate::load::{Format, LoadOptions};
 use crate::sort::StaleOrders as Orders;
+use frame::BenchRun;
 
 /// Events from other threads.
 #[derive(Debug)]
@@ -38,54 +41,54 @@ pub(super) enum UserEvent {
 
 /// The scene on screen.
 pub(super) struct Shown {
-    pub name: String,
-    pub path: Option<PathBuf>,
-    pub len: usize,
-    pub file_len: usize,
-    pub sh_degree: u8,
-    pub cameras: Vec<GltfPerspective>,
-    pub extent: Option<Extent>,
+    name: String,
+    path: Option<PathBuf>,
+    len: usize,
+    file_len: usize,
+    sh_degree: u8,
+    cameras: Vec<GltfPerspective>,
+    extent: Option<Extent>,
     /// The part of the content default views fit to the image ([`crate::camera::FIT_SIGMAS`]
     /// boxes); its centre is the pivot.
-    pub fit: Option<Extent>,
-    pub orders: Orders,
+    fit: Option<Extent>,
+    orders: Orders,
     /// Generation of the order in the renderer's buffer.
-    pub uploaded: Option<u64>,
-    pub up: UpAxis,
-    pub home: Rig,
+    uploaded: Option<u64>,
+    up: UpAxis,
+    home: Rig,
 }
 
 /// The viewer's state.
 pub(super) struct App {
-    pub opts: ViewerOptions,
+    opts: ViewerOptions,
     load_opts: Arc<LoadOptions>,
-    pub proxy: EventLoopProxy<UserEvent>,
-    pub win: Option<GlSurfaceWindow>,
-    pub renderer: Option<SplatRenderer>,
-    pub targets: Targets,
-    pub shown: Option<Shown>,
-    pub rig: Option<Rig>,
-    pub controls: Controls,
-    pub settings: DrawSettings,
-    pub stats: Stats,
-    pub bench: Option<BenchRun>,
+    proxy: EventLoopProxy<UserEvent>,
+    win: Option<GlSurfaceWindow>,
+    renderer: Option<SplatRenderer>,
+    targets: Targets,
+    shown: Option<Shown>,
+    rig: Option<Rig>,
+    controls: Controls,
+    settings: DrawSettings,
+    stats: Stats,
+    bench: Option<BenchRun>,
     load_id: u64,
-    pub loading_name: String,
+    loading_name: String,
     /// Progress of the load under way (title).
-    pub status: Option<String>,
+    status: Option<String>,
     /// The last error, shown in the title for a few seconds.
-    pub message: Option<(String, Instant)>,
-    pub screenshot: bool,
-    pub camera_index: usize,
-    pub json_cameras: Vec<CamerasJsonEntry>,
-    pub last_frame: Option<Instant>,
-    pub last_title: Option<Instant>,
-    pub frames_shown: u64,
-    pub prev_eye: Option<Vec3>,
+    message: Option<(String, Instant)>,
+    screenshot: bool,
+    camera_index: usize,
+    json_cameras: Vec<CamerasJsonEntry>,
+    last_frame: Option<Instant>,
+    last_title: Option<Instant>,
+    frames_shown: u64,
+    prev_eye: Option<Vec3>,
     /// The last frame wants a next one without new input.
-    pub animating: bool,
-    pub dialog_open: Arc<AtomicBool>,
-    pub result: Result<(), ViewerError>,
+    animating: bool,
+    dialog_open: Arc<AtomicBool>,
+    result: Result<(), ViewerError>,
 }
 
 pub(super) fn run(opts: ViewerOptions) -> Result<(), ViewerError> {

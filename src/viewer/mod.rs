@@ -22,10 +22,8 @@
 
 mod app;
 mod budget;
-mod commands;
 mod controls;
 mod draw;
-mod frame;
 mod loading;
 mod rig;
 mod stats;

@@ -7,11 +7,11 @@ use std::time::{Duration, Instant};
 use glow::HasContext;
 use winit::event_loop::ActiveEventLoop;
 
-use super::app::App;
-use super::rig::Rig;
-use super::stats::BenchLog;
-use super::{Bench, ViewerError};
+use super::App;
 use crate::sort::Freshness;
+use crate::viewer::rig::Rig;
+use crate::viewer::stats::BenchLog;
+use crate::viewer::{Bench, ViewerError};
 
 /// Frames drawn before `--bench-frames` starts measuring (upload, first sort, shader warm-up).
 const BENCH_WARMUP: usize = 2;
@@ -65,6 +65,45 @@ pub fn thousands(n: usize) -> String {
     out
 }
 
+/// Clears the default framebuffer to `bg` (the window before anything is loaded).
+fn clear_window(gl: &glow::Context, window: (u32, u32), bg: [f32; 3]) {
+    // SAFETY: clearing the default framebuffer.
+    unsafe {
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        gl.viewport(0, 0, window.0 as i32, window.1 as i32);
+        gl.clear_color(bg[0], bg[1], bg[2], 1.0);
+        gl.clear(glow::COLOR_BUFFER_BIT);
+    }
+}
+
+/// Writes the default framebuffer as a timestamped PNG in the current folder (`P`).
+fn screenshot(gl: &glow::Context, window: (u32, u32)) {
+    let img = crate::viewer::draw::read_back_buffer(gl, window.0, window.1);
+    let path = screenshot_name();
+    match img.write_png(&path, crate::image::PngDepth::Eight, false) {
+        Ok(()) => println!("screenshot: {} ({}x{})", path.display(), window.0, window.1),
+        Err(e) => eprintln!("error: screenshot {}: {e}", path.display()),
+    }
+}
+
+impl BenchRun {
+    /// Times the frame just drawn (after `glFinish`; warm-up frames are not logged); whether
+    /// the run has all its frames.
+    fn record(&mut self, gl: &glow::Context, sort_time: Duration, fresh: Freshness) -> bool {
+        // SAFETY: glFinish has no preconditions: the frame is complete when timed.
+        unsafe { gl.finish() };
+        let end = Instant::now();
+        if self.done >= BENCH_WARMUP
+            && let Some(last) = self.last_end
+        {
+            self.log.push(end - last, sort_time, fresh);
+        }
+        self.last_end = Some(end);
+        self.done += 1;
+        self.done >= self.spec.frames + BENCH_WARMUP
+    }
+}
+
 impl App {
     /// Draws one frame (on `RedrawRequested`).
     pub fn frame(&mut self, el: &ActiveEventLoop) {
@@ -92,14 +131,7 @@ impl App {
         let gl = &win.gl;
         let (Some(shown), Some(rig)) = (&mut self.shown, &mut self.rig) else {
             // Nothing loaded yet: the background, and the title says what is loading.
-            let bg = self.opts.background;
-            // SAFETY: clearing the default framebuffer.
-            unsafe {
-                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-                gl.viewport(0, 0, window.0 as i32, window.1 as i32);
-                gl.clear_color(bg[0], bg[1], bg[2], 1.0);
-                gl.clear(glow::COLOR_BUFFER_BIT);
-            }
+            clear_window(gl, window, self.opts.background);
             return win.swap().map_err(ViewerError::Window);
         };
         let moving = match &self.bench {
@@ -131,41 +163,26 @@ impl App {
         self.targets
             .draw(gl, renderer, &cam, &self.settings, bg, window)?;
         if std::mem::take(&mut self.screenshot) {
-            let img = super::draw::read_back_buffer(gl, window.0, window.1);
-            let path = screenshot_name();
-            match img.write_png(&path, crate::image::PngDepth::Eight, false) {
-                Ok(()) => println!("screenshot: {} ({}x{})", path.display(), window.0, window.1),
-                Err(e) => eprintln!("error: screenshot {}: {e}", path.display()),
-            }
+            screenshot(gl, window);
         }
         win.swap().map_err(ViewerError::Window)?;
         self.frames_shown += 1;
         self.animating = moving || matches!(fresh, Freshness::Stale { .. });
         let frame_time = Duration::from_secs_f32(dt);
         self.stats.push(now, frame_time, sort_time, fresh);
-        if let Some(b) = &mut self.bench {
-            // SAFETY: glFinish has no preconditions: the frame is complete when timed.
-            unsafe { gl.finish() };
-            let end = Instant::now();
-            if b.done >= BENCH_WARMUP
-                && let Some(last) = b.last_end
-            {
-                b.log.push(end - last, sort_time, fresh);
-            }
-            b.last_end = Some(end);
-            b.done += 1;
-            if b.done >= b.spec.frames + BENCH_WARMUP {
-                let what = format!(
-                    "{} ({} splats, {}x{}{})",
-                    shown.name,
-                    thousands(shown.len),
-                    render.0,
-                    render.1,
-                    if b.spec.orbit { ", orbit" } else { ", still" }
-                );
-                println!("{}", b.log.report(&what, &win.info()));
-                el.exit();
-            }
+        if let Some(b) = &mut self.bench
+            && b.record(gl, sort_time, fresh)
+        {
+            let what = format!(
+                "{} ({} splats, {}x{}{})",
+                shown.name,
+                thousands(shown.len),
+                render.0,
+                render.1,
+                if b.spec.orbit { ", orbit" } else { ", still" }
+            );
+            println!("{}", b.log.report(&what, &win.info()));
+            el.exit();
         }
         self.update_title(false);
         Ok(())
@@ -189,7 +206,7 @@ impl App {
             }
             let d = self.settings.sh_degree.unwrap_or(3).min(s.sh_degree);
             t += &format!(" — SH {d}/{} — {}", s.sh_degree, self.stats.title_part());
-            if self.controls.mode == super::controls::Mode::Fly {
+            if self.controls.mode == crate::viewer::controls::Mode::Fly {
                 t += " — fly";
             }
         }

@@ -9,10 +9,10 @@ use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::{Key, KeyCode};
 use winit::window::Fullscreen;
 
-use super::app::{App, UserEvent};
-use super::controls::Mode;
-use super::rig::Rig;
+use super::{App, UserEvent};
 use crate::camera::Camera;
+use crate::viewer::controls::Mode;
+use crate::viewer::rig::Rig;
 
 /// A path as a shell word (single-quoted unless plain).
 fn shell_word(s: &str) -> String {
@@ -35,7 +35,7 @@ impl App {
         };
         match (code, ch) {
             (KeyCode::Escape, _) => el.exit(),
-            (KeyCode::F1, _) | (_, Some('h')) => println!("{}", super::HELP),
+            (KeyCode::F1, _) | (_, Some('h')) => println!("{}", crate::viewer::HELP),
             (KeyCode::Tab, _) => {
                 self.controls.mode = match self.controls.mode {
                     Mode::Orbit => Mode::Fly,
