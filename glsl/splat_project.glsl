@@ -37,6 +37,7 @@ uniform int u_model_count;
 uniform vec4 u_model_rows[3 * MAX_CLOUDS]; // rows 0..2 of each model's affine matrix
 uniform mat3 u_sh_rotation[MAX_CLOUDS];    // world -> model directions (polar rotation^T)
 uniform int u_former_quads;        // 1: the former quads (3 sigma, FORMER_QUAD_MARGIN_PX)
+uniform int u_antialiased;         // 1: opacity compensated for the dilation (antialiased kernel)
 
 // What the quad's corners and the fragments need of one splat.
 struct Splat {
@@ -150,6 +151,7 @@ bool project_splat(uint index, out Splat s) {
     mat2 cov2d = mat2(dot(p0, p0), dot(p0, p1), dot(p0, p1), dot(p1, p1));
     vec3 minors = cross(p0, p1);
     float det = dot(minors, minors);
+    float det_undilated = det;
 #ifndef ERRATUM_I
     // Erratum i: 3DGS's low-pass dilation of 0.3 px^2: det(S + dI) = det S + d tr S + d^2.
     det += DILATION * (cov2d[0][0] + cov2d[1][1]) + DILATION * DILATION;
@@ -161,11 +163,20 @@ bool project_splat(uint index, out Splat s) {
     if (!(det > 0.0) || isinf(det)) {
         return false;
     }
+    // Antialiased kernel (Mip-Splatting's 2D filter, gsplat's `antialiased`): the dilation
+    // keeps the splat's integral, opacity * sqrt(det S / det(S + dI)) (rendering-profile.md).
+    float opacity = a_glob_opacity;
+    if (u_antialiased != 0) {
+        opacity *= sqrt(max(det_undilated / det, 0.0));
+        if (!(min(opacity, ALPHA_MAX) >= ALPHA_MIN)) {
+            return false;
+        }
+    }
     // Opacity-aware extent (docs/rendering-profile.md section 3): no pixel beyond Mahalanobis^2
     // k2 = 2 ln(opacity / ALPHA_MIN) can pass the alpha test (ALPHA_MAX >= ALPHA_MIN), so
     // the quad bounds the ellipse of k2 (plus a margin for log/exp rounding), capped at the
     // 3-sigma cut-off. The fragment test is unchanged: the image is the same.
-    float k2 = min(CUTOFF_M2, 2.0 * log(a_glob_opacity / ALPHA_MIN) + OPACITY_M2_MARGIN);
+    float k2 = min(CUTOFF_M2, 2.0 * log(opacity / ALPHA_MIN) + OPACITY_M2_MARGIN);
     float quad_margin = QUAD_MARGIN_PX;
 #ifdef FORMER_QUADS
     // Erratum variants draw exactly the former quads (erratum d's is no bounding box).
@@ -238,7 +249,7 @@ bool project_splat(uint index, out Splat s) {
     }
 
     // --- STEP 6: data for the fragment shader ---
-    s.opacity = a_glob_opacity;
+    s.opacity = opacity;
     float inv_det = 1.0 / det;
     s.conic = vec3(cov2d[1][1], -cov2d[0][1], cov2d[0][0]) * inv_det;
     return true;

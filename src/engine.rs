@@ -130,6 +130,7 @@ impl Engine {
                     background: opts.background,
                     sh_degree: Some(opts.sh_degree),
                     color_space: None,
+                    antialiased: opts.antialiased,
                 };
                 renderer
                     .render(camera, &o)

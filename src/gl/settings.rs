@@ -53,6 +53,12 @@ pub struct DrawSettings {
     /// The colour space to draw as (`None` = the uploaded cloud's): decides
     /// `GL_FRAMEBUFFER_SRGB` where it can be switched (see [`SplatRenderer`](super::SplatRenderer)).
     pub color_space: Option<ColorSpace>,
+    /// The antialiased kernel (scenes trained with Mip-Splatting's 2D filter or gsplat's
+    /// `antialiased` mode; SPZ header flag 0x1): each splat's opacity is scaled by
+    /// `sqrt(det Σ' / det(Σ' + 0.3 I))`, so the dilation keeps its integral instead of growing
+    /// it. Off by default (the plain 3DGS kernel); `docs/rendering-profile.md` § Antialiased
+    /// kernel.
+    pub antialiased: bool,
     /// How [`SplatRenderer::draw_frame`](super::SplatRenderer::draw_frame) sorts: on the
     /// calling thread (the default) or on a background thread with bounded staleness.
     pub sort: FrameSort,
@@ -81,6 +87,7 @@ impl Default for DrawSettings {
             depth_func: DepthFunc::Less,
             restore_state: false,
             color_space: None,
+            antialiased: false,
             sort: FrameSort::Sync,
         }
     }

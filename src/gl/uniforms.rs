@@ -36,6 +36,7 @@ uniforms! {
     u_geometry, u_sh, u_sh_texels, u_sh_fetch_texels, u_sh_degree, u_view_matrix,
     u_projection_matrix, u_focal_length, u_tan_half_fov, u_camera_position, u_viewport,
     u_cull_depth, u_splat_count, u_model_count, u_model_rows, u_sh_rotation, u_former_quads,
+    u_antialiased,
 }
 
 /// The model matrices of the uploaded clouds, as the shader reads them: rows 0..2 of each
@@ -113,6 +114,8 @@ impl SplatRenderer {
             gl.uniform_1_i32(u.u_model_count.as_ref(), m.count as i32);
             let full = i32::from(self.path.former_quads);
             gl.uniform_1_i32(u.u_former_quads.as_ref(), full);
+            let aa = i32::from(settings.antialiased);
+            gl.uniform_1_i32(u.u_antialiased.as_ref(), aa);
             if m.count > 0 {
                 let rows = bytemuck::cast_slice(&m.rows[..m.count]);
                 gl.uniform_4_f32_slice(u.u_model_rows.as_ref(), rows);

@@ -36,6 +36,8 @@ pub struct HeadlessOptions {
     pub sh_degree: Option<u8>,
     /// Colour space override; `None` = the cloud's `meta.color_space` (unknown → default).
     pub color_space: Option<ColorSpace>,
+    /// The antialiased kernel ([`DrawSettings::antialiased`]).
+    pub antialiased: bool,
 }
 
 /// A headless context with a [`SplatRenderer`], an uploaded cloud and cached framebuffers.
@@ -167,6 +169,7 @@ impl HeadlessRenderer {
             sh_degree: opts.sh_degree,
             depth_test: false,
             color_space: Some(opts.color_space.unwrap_or(self.renderer.color_space())),
+            antialiased: opts.antialiased,
             ..DrawSettings::default()
         };
         let blend = match opts.target {

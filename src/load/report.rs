@@ -63,6 +63,12 @@ impl LoadReport {
         }
     }
 
+    /// Whether the file says its splats were trained with antialiasing (SPZ header flag 0x1,
+    /// also inside glTF SPZ payloads): what `--antialiased auto` follows.
+    pub fn trained_antialiased(&self) -> bool {
+        self.details.as_ref().is_some_and(|d| d.antialiased)
+    }
+
     /// Every finding as one line ([`Finding::warning_line`]): the `warnings` of
     /// `splatgl info --json`.
     pub fn warning_lines(&self) -> Vec<String> {

@@ -49,6 +49,11 @@ pub struct RenderOptions {
     pub sort: SortMode,
     /// Splats with view z ≤ max(`near_cull`, camera.near, 0) are culled (3DGS: 0.2).
     pub near_cull: f32,
+    /// The antialiased kernel: each splat's opacity × √(det Σ' / det(Σ' + 0.3 I)) (scenes
+    /// trained with Mip-Splatting's 2D filter or gsplat's `antialiased` mode; the GL
+    /// backend's [`DrawSettings::antialiased`](crate::gl::DrawSettings::antialiased)). Off by
+    /// default.
+    pub antialiased: bool,
 }
 
 impl Default for RenderOptions {
@@ -58,6 +63,7 @@ impl Default for RenderOptions {
             background: [0.0; 3],
             sort: SortMode::Distance,
             near_cull: crate::profile::NEAR_CULL as f32,
+            antialiased: false,
         }
     }
 }
@@ -143,7 +149,8 @@ pub fn render_with_path(
     }
     let degree = opts.sh_degree.min(cloud.sh_degree);
     let cull_depth = opts.cull_depth(camera);
-    let ctx = ViewContext::new(camera, cull_depth as f64, degree, path.extent);
+    let ctx = ViewContext::new(camera, cull_depth as f64, degree, path.extent)
+        .with_antialiased(opts.antialiased);
     let splats: Vec<Projected> = if path.cull {
         // The same visible set and order the GL backend draws (`docs/rendering-profile.md`).
         let frustum = Frustum::from_camera(camera, cull_depth);
@@ -203,7 +210,8 @@ pub fn footprints(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> 
         opts.cull_depth(camera) as f64,
         degree,
         PixelBox::Full,
-    );
+    )
+    .with_antialiased(opts.antialiased);
     (0..cloud.len())
         .into_par_iter()
         .filter_map(|i| ctx.project(cloud, i))

@@ -64,9 +64,17 @@ pub(crate) struct ViewContext {
     size: [u32; 2],
     sh_degree: u8,
     extent: PixelBox,
+    /// The antialiased kernel: opacity × √(det Σ' / det(Σ' + 0.3 I)).
+    antialiased: bool,
 }
 
 impl ViewContext {
+    /// With the antialiased kernel on or off ([`RenderOptions::antialiased`](super::RenderOptions::antialiased)).
+    pub(crate) fn with_antialiased(mut self, on: bool) -> Self {
+        self.antialiased = on;
+        self
+    }
+
     /// Constants for `camera`; splats with view z ≤ `cull_z` are culled; SH up to `sh_degree`;
     /// pixel boxes by `extent`.
     pub(crate) fn new(camera: &Camera, cull_z: f64, sh_degree: u8, extent: PixelBox) -> Self {
@@ -85,14 +93,16 @@ impl ViewContext {
             size: [camera.width, camera.height],
             sh_degree,
             extent,
+            antialiased: false,
         }
     }
 
     /// Σ' = J W Σ Wᵀ Jᵀ + 0.3·I from the factor C of Σ = C Cᵀ (C = R·diag(s)): with
     /// P = J W C (rows p₀, p₁), Σ' = P Pᵀ + 0.3·I, returned as `([xx, xy, yy], det)` where the determinant comes from
     /// Cauchy–Binet, `|p₀ × p₁|² + 0.3·(|p₀|² + |p₁|²) + 0.09`. Positive definite by
-    /// construction: no cancellation even for needles seen end-on.
-    pub(crate) fn cov2d_factored(&self, t: DVec3, c: DMat3) -> ([f64; 3], f64) {
+    /// construction: no cancellation even for needles seen end-on. Also returns the
+    /// determinant before the dilation, `|p₀ × p₁|²` (the antialiased kernel's numerator).
+    pub(crate) fn cov2d_factored(&self, t: DVec3, c: DMat3) -> ([f64; 3], f64, f64) {
         let txtz = (t.x / t.z).max(-self.lim[0]).min(self.lim[0]);
         let tytz = (t.y / t.z).max(-self.lim[1]).min(self.lim[1]);
         let j0 = DVec3::new(self.fx / t.z, 0.0, -self.fx * txtz / t.z);
@@ -102,8 +112,9 @@ impl ViewContext {
         let (p0, p1) = (ct_wt * j0, ct_wt * j1);
         let (aa, cc) = (p0.dot(p0), p1.dot(p1));
         let d = DILATION_PX2;
-        let det = p0.cross(p1).length_squared() + d * (aa + cc) + d * d;
-        ([aa + d, p0.dot(p1), cc + d], det)
+        let det0 = p0.cross(p1).length_squared();
+        let det = det0 + d * (aa + cc) + d * d;
+        ([aa + d, p0.dot(p1), cc + d], det, det0)
     }
 
     /// Preprocesses splat `i`; `None` when it is culled or cannot contribute to any pixel.
@@ -122,11 +133,20 @@ impl ViewContext {
             return None;
         }
         let factor = c_matrix(cloud.scales[i], cloud.rotations[i]);
-        let ([a, b, c], det) = self.cov2d_factored(t, factor);
+        let ([a, b, c], det, det0) = self.cov2d_factored(t, factor);
         // Positive definite by construction; only overflow to infinity is left to reject.
         if !(a > 0.0 && det > 0.0 && det.is_finite() && c.is_finite()) {
             return None;
         }
+        let opacity = if self.antialiased {
+            let o = (f64::from(opacity) * (det0 / det).max(0.0).sqrt()) as f32;
+            if o.min(ALPHA_MAX) < ALPHA_MIN {
+                return None;
+            }
+            o
+        } else {
+            opacity
+        };
         let u = self.fx * t.x / t.z + self.cx;
         let v = self.fy * t.y / t.z + self.cy;
         let m2_max = (opacity_cutoff_m2(opacity) + OPACITY_M2_MARGIN).min(f64::from(CUTOFF_M2));
