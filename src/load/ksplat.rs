@@ -13,9 +13,12 @@
 //! bucket centre, `(v − range)·(block/2)/range`, and scale and rotation as f16; SH is f32 /
 //! f16 / u8 in [min, max] for levels 0 / 1 / 2. PLY axes.
 
-use super::codec::{self, build_cloud, f16_to_f32, finish_cloud};
+use super::codec::{self, build_cloud, finish_cloud};
 use super::{Details, Finding, LimitExceeded, LoadOptions, LoadReport, ScaleSeen};
 use crate::cloud::SplatCloud;
+use records::Records;
+
+mod records;
 
 /// Size of the main header.
 pub const HEADER: usize = 4096;
@@ -98,17 +101,22 @@ pub(crate) fn looks_like(bytes: &[u8]) -> bool {
         && sections(bytes).is_ok_and(|(_, end)| end == bytes.len() as u64)
 }
 
-/// Parses the section headers; returns them and where the last section's data ends.
-fn sections(b: &[u8]) -> Result<(Vec<Section>, u64), KsplatError> {
-    let len = b.len();
-    let short = |what: String, start: u64, end: u64| KsplatError::Truncated {
+/// A [`KsplatError::Truncated`] for a file of `len` bytes.
+fn truncated(what: String, start: u64, end: u64, len: usize) -> KsplatError {
+    KsplatError::Truncated {
         what,
         start,
         end,
         len,
-    };
+    }
+}
+
+/// Checks the main header (size, version, compression level) and that the section headers it
+/// announces are present. Returns the level, the number of section headers and where they end.
+fn main_header(b: &[u8]) -> Result<(u16, u64, u64), KsplatError> {
+    let len = b.len();
     if len < HEADER {
-        return Err(short("main header".into(), 0, HEADER as u64));
+        return Err(truncated("main header".into(), 0, HEADER as u64, len));
     }
     let (major, minor) = (b[0], b[1]);
     if major != 0 || minor < 1 {
@@ -121,21 +129,47 @@ fn sections(b: &[u8]) -> Result<(Vec<Section>, u64), KsplatError> {
     let max_sections = codec::u32_at(b, 4) as u64;
     let headers_end = HEADER as u64 + SECTION_HEADER as u64 * max_sections;
     if headers_end > len as u64 {
-        return Err(short(
+        return Err(truncated(
             format!("{max_sections} section headers"),
             HEADER as u64,
             headers_end,
+            len,
         ));
     }
-    let (cb, shb) = component_bytes(level);
+    Ok((level, max_sections, headers_end))
+}
+
+/// Parses the section headers; returns them and where the last section's data ends.
+fn sections(b: &[u8]) -> Result<(Vec<Section>, u64), KsplatError> {
+    let (level, max_sections, headers_end) = main_header(b)?;
     let mut out = Vec::with_capacity(max_sections as usize);
     let mut base = headers_end;
     for s in 0..max_sections as usize {
         let h = &b[HEADER + s * SECTION_HEADER..][..SECTION_HEADER];
-        let bad = |message: String| KsplatError::Section {
-            section: s,
-            message,
-        };
+        let (section, storage) = RawSection::parse(h).resolve(b, s, level, base)?;
+        out.push(section);
+        base += storage;
+    }
+    Ok((out, base))
+}
+
+/// One section header's fields as stored (the position range with 0 read as 32767).
+struct RawSection {
+    count: u64,
+    max: u64,
+    bucket_size: u64,
+    buckets: u64,
+    block: f32,
+    bucket_bytes: u64,
+    range: u32,
+    full: u64,
+    partial: u64,
+    degree: u16,
+}
+
+impl RawSection {
+    /// Reads the fields of the 1024-byte section header `h`.
+    fn parse(h: &[u8]) -> RawSection {
         let (count, max) = (codec::u32_at(h, 0) as u64, codec::u32_at(h, 4) as u64);
         let (bucket_size, buckets) = (codec::u32_at(h, 8) as u64, codec::u32_at(h, 12) as u64);
         let block = codec::f32_at(h, 16);
@@ -146,59 +180,103 @@ fn sections(b: &[u8]) -> Result<(Vec<Section>, u64), KsplatError> {
         };
         let (full, partial) = (codec::u32_at(h, 32) as u64, codec::u32_at(h, 36) as u64);
         let degree = codec::u16_at(h, 40);
+        RawSection {
+            count,
+            max,
+            bucket_size,
+            buckets,
+            block,
+            bucket_bytes,
+            range,
+            full,
+            partial,
+            degree,
+        }
+    }
+
+    /// Checks section `s` of a level-`level` file, whose data starts at `base`, against the
+    /// file `b`. Returns the resolved section and the bytes its data takes.
+    fn resolve(
+        &self,
+        b: &[u8],
+        s: usize,
+        level: u16,
+        base: u64,
+    ) -> Result<(Section, u64), KsplatError> {
+        let len = b.len();
+        let bad = |message: String| KsplatError::Section {
+            section: s,
+            message,
+        };
+        let (count, max, degree) = (self.count, self.max, self.degree);
         if degree > 3 {
             return Err(bad(format!("SH degree {degree} (expected 0-3)")));
         }
         if count > max {
             return Err(bad(format!("{count} splats but room for {max}")));
         }
+        let (cb, shb) = component_bytes(level);
         let degree = degree as u8;
         let bytes_per_splat = 3 * cb + 3 * cb + 4 * cb + 4 + sh_values(degree) * shb;
-        let meta = 4 * partial;
-        let storage = bucket_bytes * buckets + meta + bytes_per_splat as u64 * max;
+        let meta = 4 * self.partial;
+        let buckets_bytes = self.bucket_bytes * self.buckets;
+        let storage = buckets_bytes + meta + bytes_per_splat as u64 * max;
         if base + storage > len as u64 {
-            return Err(short(format!("section {s} data"), base, base + storage));
+            return Err(truncated(
+                format!("section {s} data"),
+                base,
+                base + storage,
+                len,
+            ));
         }
-        let mut partial_ends = Vec::new();
-        let full_splats = full.saturating_mul(bucket_size);
-        if level >= 1 && count > 0 {
-            if bucket_bytes != 12 {
-                return Err(bad(format!(
-                    "bucket storage {bucket_bytes} bytes, expected 12"
-                )));
-            }
-            if full + partial > buckets {
-                return Err(bad(format!("{full} + {partial} buckets, {buckets} stored")));
-            }
-            let mut end = full_splats;
-            for k in 0..partial as usize {
-                end += codec::u32_at(b, base as usize + 4 * k) as u64;
-                partial_ends.push(end.min(count) as usize);
-            }
-            if end < count {
-                return Err(bad(format!(
-                    "buckets hold {end} splats, the section {count}"
-                )));
-            }
-            if !(block.is_finite() && block > 0.0) {
-                return Err(bad(format!("bucket block size {block}")));
-            }
-        }
-        out.push(Section {
+        let full_splats = self.full.saturating_mul(self.bucket_size);
+        let partial_ends = if level >= 1 && count > 0 {
+            self.bucket_ends(b, base, full_splats).map_err(bad)?
+        } else {
+            Vec::new()
+        };
+        let range = self.range;
+        let section = Section {
             count: count as usize,
             degree,
             bytes_per_splat,
             full: full_splats.min(count) as usize,
-            bucket_size: bucket_size.max(1) as usize,
+            bucket_size: self.bucket_size.max(1) as usize,
             partial_ends,
             centers: (base + meta) as usize,
-            data: (base + bucket_bytes * buckets + meta) as usize,
+            data: (base + buckets_bytes + meta) as usize,
             range: range as f32,
-            factor: 0.5 * block / range as f32,
-        });
-        base += storage;
+            factor: 0.5 * self.block / range as f32,
+        };
+        Ok((section, storage))
     }
-    Ok((out, base))
+
+    /// Levels 1–2: checks the buckets (storage size, counts, block size) and returns the end
+    /// index of each partial bucket, whose lengths are stored at `base` in `b`. The error is
+    /// the message of a [`KsplatError::Section`].
+    fn bucket_ends(&self, b: &[u8], base: u64, full_splats: u64) -> Result<Vec<usize>, String> {
+        let (count, full, partial, buckets) = (self.count, self.full, self.partial, self.buckets);
+        let (bucket_bytes, block) = (self.bucket_bytes, self.block);
+        if bucket_bytes != 12 {
+            return Err(format!("bucket storage {bucket_bytes} bytes, expected 12"));
+        }
+        if full + partial > buckets {
+            return Err(format!("{full} + {partial} buckets, {buckets} stored"));
+        }
+        let mut partial_ends = Vec::new();
+        let mut end = full_splats;
+        for k in 0..partial as usize {
+            end += codec::u32_at(b, base as usize + 4 * k) as u64;
+            partial_ends.push(end.min(count) as usize);
+        }
+        if end < count {
+            return Err(format!("buckets hold {end} splats, the section {count}"));
+        }
+        if !(block.is_finite() && block > 0.0) {
+            return Err(format!("bucket block size {block}"));
+        }
+        Ok(partial_ends)
+    }
 }
 
 impl Section {
@@ -219,6 +297,35 @@ pub(crate) fn read(
     let findings = &mut report.findings;
     let (secs, end) = sections(bytes)?;
     let level = codec::u16_at(bytes, 20);
+    let n = check_counts(bytes, &secs, end, opts, findings)?;
+    let degree = secs.iter().map(|s| s.degree).max().unwrap_or(0);
+    let records = Records::new(bytes, &secs, level);
+    let cloud = build_cloud::<std::convert::Infallible>(n, degree, |g, s| {
+        records.fill(g, s);
+        Ok(())
+    });
+    let Ok(mut cloud) = cloud;
+    finish_cloud(&mut cloud, codec::drop_site("splats", opts), findings);
+    if secs.iter().any(|s| s.degree < degree) {
+        findings.push(Finding::warning(
+            "sections",
+            format!("sections of lower SH degree zero-padded to {degree}"),
+        ));
+    }
+    report.details = Some(describe(bytes, level, degree));
+    report.scale_space = Some(ScaleSeen::Linear);
+    Ok(cloud)
+}
+
+/// The splat count the sections hold, checked against the limits; bytes after the last
+/// section (ending at `end`) and a main header stating another count are reported.
+fn check_counts(
+    bytes: &[u8],
+    secs: &[Section],
+    end: u64,
+    opts: &LoadOptions,
+    findings: &mut Vec<Finding>,
+) -> Result<usize, KsplatError> {
     if end < bytes.len() as u64 {
         findings.push(Finding::warning(
             "sections",
@@ -237,74 +344,7 @@ pub(crate) fn read(
             format!("states {stated} splats, the sections hold {n}; the sections are read"),
         ));
     }
-    let degree = secs.iter().map(|s| s.degree).max().unwrap_or(0);
-    let (lo, hi) = match (codec::f32_at(bytes, 36), codec::f32_at(bytes, 40)) {
-        (a, b) if a != 0.0 && b != 0.0 => (a, b),
-        _ => (-1.5, 1.5),
-    };
-    // Global splat index → section: start index of each section.
-    let starts: Vec<usize> = secs
-        .iter()
-        .scan(0, |acc, s| {
-            let st = *acc;
-            *acc += s.count;
-            Some(st)
-        })
-        .collect();
-    let (cb, shb) = component_bytes(level);
-    let cloud = build_cloud::<std::convert::Infallible>(n, degree, |g, s| {
-        let si = starts.partition_point(|&st| st <= g) - 1;
-        let sec = &secs[si];
-        let i = g - starts[si];
-        let r = &bytes[sec.data + i * sec.bytes_per_splat..][..sec.bytes_per_splat];
-        let val = |k: usize| match cb {
-            4 => codec::f32_at(r, 4 * k),
-            _ => f16_to_f32(codec::u16_at(r, 2 * k)),
-        };
-        *s.position = if level == 0 {
-            std::array::from_fn(|a| codec::f32_at(r, 4 * a))
-        } else {
-            let c = sec.centers + 12 * sec.bucket_of(i);
-            std::array::from_fn(|a| {
-                (codec::u16_at(r, 2 * a) as f32 - sec.range) * sec.factor
-                    + codec::f32_at(bytes, c + 4 * a)
-            })
-        };
-        *s.scale = std::array::from_fn(|a| val(3 + a));
-        *s.rotation = [val(7), val(8), val(9), val(6)];
-        let col = &r[10 * cb..];
-        s.sh[0] = std::array::from_fn(|c| crate::sh::dc_from_color(col[c] as f64 / 255.0));
-        *s.opacity = col[3] as f32 / 255.0;
-        let sh = &col[4..];
-        let value = |k: usize| match shb {
-            4 => codec::f32_at(sh, 4 * k),
-            2 => f16_to_f32(codec::u16_at(sh, 2 * k)),
-            _ => lo + sh[k] as f32 / 255.0 * (hi - lo),
-        };
-        // Degree l's 2l+1 coefficients per channel, channel-major, one degree after another.
-        let mut base = 0;
-        for l in 1..=sec.degree as usize {
-            let m = 2 * l + 1;
-            for c in 0..3 {
-                for j in 0..m {
-                    s.sh[l * l + j][c] = value(base + c * m + j);
-                }
-            }
-            base += 3 * m;
-        }
-        Ok(())
-    });
-    let Ok(mut cloud) = cloud;
-    finish_cloud(&mut cloud, codec::drop_site("splats", opts), findings);
-    if secs.iter().any(|s| s.degree < degree) {
-        findings.push(Finding::warning(
-            "sections",
-            format!("sections of lower SH degree zero-padded to {degree}"),
-        ));
-    }
-    report.details = Some(describe(bytes, level, degree));
-    report.scale_space = Some(ScaleSeen::Linear);
-    Ok(cloud)
+    Ok(n)
 }
 
 fn describe(bytes: &[u8], level: u16, degree: u8) -> Details {

@@ -119,6 +119,11 @@ pub(super) fn view_bytes<'b>(
         })
 }
 
+/// A blocking finding at `path` about accessor `acc`.
+fn accessor_error(acc: &gltf::Accessor, path: &str, msg: String) -> Finding {
+    Finding::fatal(path, format!("accessors[{}]: {msg}", acc.index()))
+}
+
 /// Decodes accessor `acc`. `path` names the attribute in findings. `budget` is the number of
 /// decoded values the whole document may still produce (bounded by the input size); it is
 /// checked before allocating and charged after.
@@ -128,7 +133,7 @@ pub fn decode(
     path: &str,
     budget: &std::cell::Cell<u64>,
 ) -> Result<Decoded, Finding> {
-    let fail = |msg: String| Finding::fatal(path, format!("accessors[{}]: {msg}", acc.index()));
+    let fail = |msg: String| accessor_error(acc, path, msg);
     let dims = dims_of(acc.dimensions()).ok_or_else(|| {
         fail(format!(
             "type {:?} is not SCALAR/VEC2/VEC3/VEC4",
@@ -136,8 +141,6 @@ pub fn decode(
         ))
     })?;
     let (t, norm) = (acc.data_type(), acc.normalized());
-    let csize = t.size();
-    let esize = dims * csize;
     let count = acc.count();
     let values = count as u128 * dims as u128;
     if values > budget.get() as u128 {
@@ -147,51 +150,9 @@ pub fn decode(
         )));
     }
     budget.set(budget.get() - values as u64);
-    let mut misaligned = None;
-    let mut data = match acc.view() {
-        Some(view) => {
-            let bytes = view_bytes(&view, buffers, path)?;
-            let stride = view.stride().unwrap_or(esize);
-            // glTF 2.0 §3.6.2.4: offsets are multiples of the component size, and vertex
-            // attribute elements start on 4-byte boundaries.
-            let offset = view.offset() as u128 + acc.offset() as u128;
-            if !offset.is_multiple_of(csize as u128) {
-                misaligned = Some(format!(
-                    "byte offset {offset} is not a multiple of the component size {csize}"
-                ));
-            } else if !offset.is_multiple_of(4) || stride % 4 != 0 {
-                misaligned = Some(format!(
-                    "vertex attribute elements must start on 4-byte boundaries (offset {offset}, stride {stride})"
-                ));
-            }
-            if stride < esize {
-                return Err(fail(format!(
-                    "byteStride {stride} is smaller than the element size {esize}"
-                )));
-            }
-            let start = acc.offset();
-            // u128: no count, stride or offset from the file can overflow this.
-            let needed = match count {
-                0 => 0,
-                n => (n as u128 - 1) * stride as u128 + start as u128 + esize as u128,
-            };
-            if needed > bytes.len() as u128 {
-                return Err(fail(format!(
-                    "count {count} × stride {stride} from offset {start} needs {needed} bytes; bufferViews[{}] has {}",
-                    view.index(),
-                    bytes.len()
-                )));
-            }
-            let mut out = Vec::with_capacity(count * dims);
-            for i in 0..count {
-                let e = &bytes[start + i * stride..];
-                for k in 0..dims {
-                    out.push(read(&e[k * csize..], t, norm));
-                }
-            }
-            out
-        }
-        None => vec![0.0; count * dims],
+    let (mut data, misaligned) = match acc.view() {
+        Some(view) => read_view(acc, &view, dims, buffers, path)?,
+        None => (vec![0.0; count * dims], None),
     };
     if let Some(sparse) = acc.sparse() {
         apply_sparse(&sparse, &mut data, dims, t, norm, count, buffers, path)
@@ -204,6 +165,65 @@ pub fn decode(
         normalized: norm,
         misaligned,
     })
+}
+
+/// The values of accessor `acc` (`dims` components per element) read from its bufferView
+/// `view`, with the glTF 2.0 alignment rule the layout breaks, if any. The stride and the
+/// extent of the elements are checked against the view before anything is allocated.
+fn read_view(
+    acc: &gltf::Accessor,
+    view: &gltf::buffer::View,
+    dims: usize,
+    buffers: &[Vec<u8>],
+    path: &str,
+) -> Result<(Vec<f32>, Option<String>), Finding> {
+    let fail = |msg: String| accessor_error(acc, path, msg);
+    let (t, norm) = (acc.data_type(), acc.normalized());
+    let csize = t.size();
+    let esize = dims * csize;
+    let count = acc.count();
+    let bytes = view_bytes(view, buffers, path)?;
+    let stride = view.stride().unwrap_or(esize);
+    // glTF 2.0 §3.6.2.4: offsets are multiples of the component size, and vertex
+    // attribute elements start on 4-byte boundaries.
+    let offset = view.offset() as u128 + acc.offset() as u128;
+    let misaligned = if !offset.is_multiple_of(csize as u128) {
+        Some(format!(
+            "byte offset {offset} is not a multiple of the component size {csize}"
+        ))
+    } else if !offset.is_multiple_of(4) || !stride.is_multiple_of(4) {
+        Some(format!(
+            "vertex attribute elements must start on 4-byte boundaries (offset {offset}, stride {stride})"
+        ))
+    } else {
+        None
+    };
+    if stride < esize {
+        return Err(fail(format!(
+            "byteStride {stride} is smaller than the element size {esize}"
+        )));
+    }
+    let start = acc.offset();
+    // u128: no count, stride or offset from the file can overflow this.
+    let needed = match count {
+        0 => 0,
+        n => (n as u128 - 1) * stride as u128 + start as u128 + esize as u128,
+    };
+    if needed > bytes.len() as u128 {
+        return Err(fail(format!(
+            "count {count} × stride {stride} from offset {start} needs {needed} bytes; bufferViews[{}] has {}",
+            view.index(),
+            bytes.len()
+        )));
+    }
+    let mut out = Vec::with_capacity(count * dims);
+    for i in 0..count {
+        let e = &bytes[start + i * stride..];
+        for k in 0..dims {
+            out.push(read(&e[k * csize..], t, norm));
+        }
+    }
+    Ok((out, misaligned))
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -167,43 +167,7 @@ fn check_required_extensions(json: &Value, findings: &mut Vec<Finding>) {
 /// validation, and returns the typed root when nothing blocking was found.
 fn schema_root(json: &Value, findings: &mut Vec<Finding>) -> Option<gltf::json::Root> {
     let mut v = json.clone();
-    let n_accessors = v
-        .get("accessors")
-        .and_then(Value::as_array)
-        .map_or(0, Vec::len);
-    if let Some(meshes) = v.get_mut("meshes").and_then(Value::as_array_mut) {
-        for (mi, mesh) in meshes.iter_mut().enumerate() {
-            let Some(prims) = mesh.get_mut("primitives").and_then(Value::as_array_mut) else {
-                continue;
-            };
-            for (pi, prim) in prims.iter_mut().enumerate() {
-                let Some(attrs) = prim.get_mut("attributes").and_then(Value::as_object_mut) else {
-                    continue;
-                };
-                // The gltf crate's primitive hook indexes accessors by POSITION unchecked.
-                if let Some(p) = attrs.get("POSITION") {
-                    let ok = p.as_u64().is_some_and(|i| (i as usize) < n_accessors);
-                    if !ok {
-                        findings.push(Finding::fatal(
-                            format!("meshes[{mi}].primitives[{pi}].attributes[\"POSITION\"]"),
-                            format!("accessor index {p} out of range (there are {n_accessors})"),
-                        ));
-                        return None;
-                    }
-                }
-                let keys: Vec<String> = attrs
-                    .keys()
-                    .filter(|k| k.starts_with(PREFIX))
-                    .cloned()
-                    .collect();
-                for k in keys {
-                    if let Some(val) = attrs.remove(&k) {
-                        attrs.insert(format!("_{k}"), val);
-                    }
-                }
-            }
-        }
-    }
+    rename_semantics(&mut v, findings)?;
     // Required extensions were judged above; the gltf crate knows none of ours.
     if let Some(obj) = v.as_object_mut() {
         obj.remove("extensionsRequired");
@@ -215,8 +179,65 @@ fn schema_root(json: &Value, findings: &mut Vec<Finding>) -> Option<gltf::json::
             return None;
         }
     };
+    let mut blocking = validate_schema(json, &root, findings);
+    if let Some(f) = node_graph_problem(&root) {
+        findings.push(f);
+        blocking = true;
+    }
+    (!blocking).then_some(root)
+}
+
+/// In every primitive of `v`, renames the `KHR_gaussian_splatting:*` attributes to `_`-prefixed
+/// custom ones. `None` (after a blocking finding) for a POSITION accessor index out of range,
+/// which the `gltf` crate's primitive hook would index unchecked.
+fn rename_semantics(v: &mut Value, findings: &mut Vec<Finding>) -> Option<()> {
+    let n_accessors = v
+        .get("accessors")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    let Some(meshes) = v.get_mut("meshes").and_then(Value::as_array_mut) else {
+        return Some(());
+    };
+    for (mi, mesh) in meshes.iter_mut().enumerate() {
+        let Some(prims) = mesh.get_mut("primitives").and_then(Value::as_array_mut) else {
+            continue;
+        };
+        for (pi, prim) in prims.iter_mut().enumerate() {
+            let Some(attrs) = prim.get_mut("attributes").and_then(Value::as_object_mut) else {
+                continue;
+            };
+            // The gltf crate's primitive hook indexes accessors by POSITION unchecked.
+            if let Some(p) = attrs.get("POSITION") {
+                let ok = p.as_u64().is_some_and(|i| (i as usize) < n_accessors);
+                if !ok {
+                    findings.push(Finding::fatal(
+                        format!("meshes[{mi}].primitives[{pi}].attributes[\"POSITION\"]"),
+                        format!("accessor index {p} out of range (there are {n_accessors})"),
+                    ));
+                    return None;
+                }
+            }
+            let keys: Vec<String> = attrs
+                .keys()
+                .filter(|k| k.starts_with(PREFIX))
+                .cloned()
+                .collect();
+            for k in keys {
+                if let Some(val) = attrs.remove(&k) {
+                    attrs.insert(format!("_{k}"), val);
+                }
+            }
+        }
+    }
+    Some(())
+}
+
+/// Runs the `gltf` crate's schema validation of `root` (read from `json`), reporting each
+/// problem: as an error where the splat data does not depend on it, else as fatal. Returns
+/// whether a fatal one was found.
+fn validate_schema(json: &Value, root: &gltf::json::Root, findings: &mut Vec<Finding>) -> bool {
     let mut blocking = false;
-    root.validate(&root, gltf::json::Path::new, &mut |path, err| {
+    root.validate(root, gltf::json::Path::new, &mut |path, err| {
         let p = path().as_str().to_owned();
         // Missing/invalid POSITION min/max is a glTF MUST the splat data does not depend on.
         // gltf-json also reports an accessor without bufferView, which glTF 2.0 allows
@@ -247,11 +268,7 @@ fn schema_root(json: &Value, findings: &mut Vec<Finding>) -> Option<gltf::json::
             Finding::fatal(p, msg)
         });
     });
-    if let Some(f) = node_graph_problem(&root) {
-        findings.push(f);
-        blocking = true;
-    }
-    (!blocking).then_some(root)
+    blocking
 }
 
 /// Node hierarchy must be a forest (no node with two parents, no cycles).

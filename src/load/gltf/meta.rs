@@ -16,23 +16,7 @@ pub fn read(
     f: &mut Vec<Finding>,
 ) -> SplatMeta {
     let p = format!("{path}.extensions.{EXT}");
-    let mut get = |key: &str, required: bool| -> Option<String> {
-        match ext.get(key) {
-            Some(Value::String(s)) => Some(s.clone()),
-            Some(_) => {
-                f.push(Finding::error(format!("{p}.{key}"), "must be a string"));
-                None
-            }
-            None if required => {
-                f.push(Finding::error(
-                    format!("{p}.{key}"),
-                    format!("required property '{key}' is missing"),
-                ));
-                None
-            }
-            None => None,
-        }
-    };
+    let mut get = |key: &str, required: bool| string(ext, &p, key, required, f);
     let (k, c) = (get("kernel", true), get("colorSpace", true));
     let (pr, s) = (get("projection", false), get("sortingMethod", false));
     let mut meta = SplatMeta::default();
@@ -48,6 +32,42 @@ pub fn read(
     if let Some(v) = s {
         meta.sorting_method = SortingMethod::parse(&v);
     }
+    report_unknown(&meta, &p, f);
+    if let Some(exts) = ext.get("extensions").and_then(Value::as_object) {
+        check_nested(exts, &p, used, f);
+    }
+    meta
+}
+
+/// The string property `key` of the extension object `ext` (at JSON path `p`); one of another
+/// type, or a missing `required` one, is reported.
+fn string(
+    ext: &Map<String, Value>,
+    p: &str,
+    key: &str,
+    required: bool,
+    f: &mut Vec<Finding>,
+) -> Option<String> {
+    match ext.get(key) {
+        Some(Value::String(s)) => Some(s.clone()),
+        Some(_) => {
+            f.push(Finding::error(format!("{p}.{key}"), "must be a string"));
+            None
+        }
+        None if required => {
+            f.push(Finding::error(
+                format!("{p}.{key}"),
+                format!("required property '{key}' is missing"),
+            ));
+            None
+        }
+        None => None,
+    }
+}
+
+/// A warning for each property of `meta` with a value splatgl does not know, naming the value
+/// it renders with instead.
+fn report_unknown(meta: &SplatMeta, p: &str, f: &mut Vec<Finding>) {
     let unknown = [
         ("kernel", unknown_of(&meta.kernel), "ellipse"),
         (
@@ -70,33 +90,37 @@ pub fn read(
             ));
         }
     }
-    if let Some(exts) = ext.get("extensions").and_then(Value::as_object) {
-        for name in exts.keys() {
-            let ep = format!("{p}.extensions.{name}");
-            if !used.contains(&name.as_str()) {
-                f.push(Finding::error(
-                    &ep,
-                    format!("{name:?} MUST also be listed in extensionsUsed"),
-                ));
-            }
-            if name == super::spz::SPZ_2 {
-                // Read by the primitive reader (`spz.rs`).
-            } else if name.to_ascii_lowercase().contains("compression") {
-                f.push(Finding::unsupported(
-                    ep,
-                    format!("compression extension {name:?} is not supported (yet)"),
-                ));
-            } else {
-                f.push(Finding::warning(
-                    ep,
-                    format!("extension {name:?} is not known to splatgl; ignored"),
-                ));
-            }
-        }
-    }
-    meta
 }
 
+/// The extensions nested in the extension object (`p` is its JSON path): each must be in
+/// `used`; SPZ_2 is read by the primitive reader, other compression is unsupported, the rest
+/// ignored with a warning.
+fn check_nested(exts: &Map<String, Value>, p: &str, used: &[&str], f: &mut Vec<Finding>) {
+    for name in exts.keys() {
+        let ep = format!("{p}.extensions.{name}");
+        if !used.contains(&name.as_str()) {
+            f.push(Finding::error(
+                &ep,
+                format!("{name:?} MUST also be listed in extensionsUsed"),
+            ));
+        }
+        if name == super::spz::SPZ_2 {
+            // Read by the primitive reader (`spz.rs`).
+        } else if name.to_ascii_lowercase().contains("compression") {
+            f.push(Finding::unsupported(
+                ep,
+                format!("compression extension {name:?} is not supported (yet)"),
+            ));
+        } else {
+            f.push(Finding::warning(
+                ep,
+                format!("extension {name:?} is not known to splatgl; ignored"),
+            ));
+        }
+    }
+}
+
+/// The text of a value splatgl does not know, `None` for a known one.
 fn unknown_of<T>(k: &Known<T>) -> Option<&str> {
     match k {
         Known::Unknown(s) => Some(s),

@@ -223,64 +223,98 @@ fn instantiate(
             let Some(ls) = decoded.get(&(mesh, pi)) else {
                 continue;
             };
-            let per_splat = 11 + 3 * ls.cloud.coeffs_per_splat() as u64;
-            let values = ls.cloud.len() as u64 * per_splat;
-            if values > budget.get() {
-                let l = &opts.limits;
-                report.findings.push(Finding::fatal(
-                    format!("nodes[{node}]"),
-                    format!(
-                        "instancing meshes[{mesh}] here would exceed the output this {input}-byte input can justify (limits: {} + {} values per input byte)",
-                        l.decode_budget_values, l.decode_values_per_byte
-                    ),
-                ));
-                return None;
-            }
-            budget.set(budget.get() - values);
-            total += ls.cloud.len() as u64;
-            if let Err(e) = opts.limits.check_splats(total, "the scene's instances") {
-                report
-                    .findings
-                    .push(Finding::fatal(format!("nodes[{node}]"), e.to_string()));
-                return None;
-            }
-            let mut global = transform::apply(&ls.cloud, *m, node, &mut report.findings);
+            let charge = (budget, &mut total, input);
+            charge_instance(ls, charge, (node, mesh), opts, &mut report.findings)?;
             let ppath = format!("meshes[{mesh}].primitives[{pi}]");
-            let site = hygiene::Site {
-                path: &format!("nodes[{node}]"),
-                what: &format!("{ppath} under this node's transform"),
-                severity: Severity::Error,
-                strict: opts.strict,
-                origin: ls.origin.as_deref(),
-            };
-            if let Err(f) = hygiene::clean(&mut global, &site, &mut report.findings) {
-                report.findings.push(f);
-                return None;
-            }
-            report.scale_space = Some(ScaleSeen::merge(report.scale_space, ls.scale_seen));
-            report.non_unit_quaternions += ls.non_unit;
-            if report.details.is_none() {
-                report.details.clone_from(&ls.details);
-            }
+            let global = place(ls, *m, node, &ppath, opts, report)?;
             let Some(c) = &mut cloud else {
                 cloud = Some(global);
                 continue;
             };
-            if c.meta != global.meta {
-                report.findings.push(Finding::warning(
-                    &ppath,
-                    "extension properties differ from the first splat primitive's; the first primitive's are used",
-                ));
-            }
-            if c.append(global) {
-                report.findings.push(Finding::warning(
-                    ppath,
-                    "primitives have different SH degrees; lower degrees are zero-padded (colours unchanged)",
-                ));
-            }
+            merge(c, global, ppath, &mut report.findings);
         }
     }
     cloud
+}
+
+/// Charges an instance of `ls` (of `meshes[mesh]` under `nodes[node]`) to the document's value
+/// budget (for an `input`-byte input) and its splats to the scene's `total`, checked against
+/// the limits. `None` after a blocking finding.
+fn charge_instance(
+    ls: &primitive::LocalSplats,
+    (budget, total, input): (&Cell<u64>, &mut u64, u64),
+    (node, mesh): (usize, usize),
+    opts: &LoadOptions,
+    findings: &mut Vec<Finding>,
+) -> Option<()> {
+    let per_splat = 11 + 3 * ls.cloud.coeffs_per_splat() as u64;
+    let values = ls.cloud.len() as u64 * per_splat;
+    if values > budget.get() {
+        let l = &opts.limits;
+        findings.push(Finding::fatal(
+            format!("nodes[{node}]"),
+            format!(
+                "instancing meshes[{mesh}] here would exceed the output this {input}-byte input can justify (limits: {} + {} values per input byte)",
+                l.decode_budget_values, l.decode_values_per_byte
+            ),
+        ));
+        return None;
+    }
+    budget.set(budget.get() - values);
+    *total += ls.cloud.len() as u64;
+    if let Err(e) = opts.limits.check_splats(*total, "the scene's instances") {
+        findings.push(Finding::fatal(format!("nodes[{node}]"), e.to_string()));
+        return None;
+    }
+    Some(())
+}
+
+/// The primitive at `ppath` (decoded as `ls`) under `nodes[node]`'s global matrix `m`:
+/// transformed, cleaned (numeric hygiene), and its scale space, non-unit quaternions and
+/// details added to `report`. `None` after a blocking finding.
+fn place(
+    ls: &primitive::LocalSplats,
+    m: DMat4,
+    node: usize,
+    ppath: &str,
+    opts: &LoadOptions,
+    report: &mut LoadReport,
+) -> Option<SplatCloud> {
+    let mut global = transform::apply(&ls.cloud, m, node, &mut report.findings);
+    let site = hygiene::Site {
+        path: &format!("nodes[{node}]"),
+        what: &format!("{ppath} under this node's transform"),
+        severity: Severity::Error,
+        strict: opts.strict,
+        origin: ls.origin.as_deref(),
+    };
+    if let Err(f) = hygiene::clean(&mut global, &site, &mut report.findings) {
+        report.findings.push(f);
+        return None;
+    }
+    report.scale_space = Some(ScaleSeen::merge(report.scale_space, ls.scale_seen));
+    report.non_unit_quaternions += ls.non_unit;
+    if report.details.is_none() {
+        report.details.clone_from(&ls.details);
+    }
+    Some(global)
+}
+
+/// Appends the instance `global` (of the primitive at `ppath`) to the cloud `c`, warning when
+/// its extension properties or SH degree differ.
+fn merge(c: &mut SplatCloud, global: SplatCloud, ppath: String, findings: &mut Vec<Finding>) {
+    if c.meta != global.meta {
+        findings.push(Finding::warning(
+            &ppath,
+            "extension properties differ from the first splat primitive's; the first primitive's are used",
+        ));
+    }
+    if c.append(global) {
+        findings.push(Finding::warning(
+            ppath,
+            "primitives have different SH degrees; lower degrees are zero-padded (colours unchanged)",
+        ));
+    }
 }
 
 /// Primitives with `KHR_gaussian_splatting` (and, with `legacy`, those with the legacy SPZ

@@ -124,40 +124,47 @@ fn check_primitive(path: &str, prim: &Value, f: &mut Vec<Finding>) {
     }
 }
 
+/// Decodes the attribute `name` (its semantic as in [`semantic`]) from the primitive's
+/// `attrs`. `Some(None)`: absent; `None`: present but undecodable (a finding says why).
+fn attribute(
+    ctx: &Ctx,
+    attrs: &Map<String, Value>,
+    name: &str,
+    f: &mut Vec<Finding>,
+) -> Option<Option<Decoded>> {
+    let full = semantic(name);
+    let ap = attr_path(&ctx.path, &full);
+    let Some(idx) = attrs.get(&full) else {
+        return Some(None);
+    };
+    let acc = idx
+        .as_u64()
+        .and_then(|i| ctx.doc.accessors().nth(i as usize));
+    let Some(acc) = acc else {
+        f.push(Finding::fatal(
+            ap,
+            format!("accessor index {idx} out of range"),
+        ));
+        return None;
+    };
+    match decode(&acc, ctx.buffers, &ap, ctx.budget) {
+        Ok(d) => Some(Some(d)),
+        Err(e) => {
+            f.push(e);
+            None
+        }
+    }
+}
+
 /// Decodes every attribute the extension defines, then checks the required ones are there.
 /// `None` after the first accessor that cannot be decoded, or a missing required attribute.
 fn fetch(ctx: &Ctx, prim: &Value, f: &mut Vec<Finding>) -> Option<Attributes> {
-    let path = &ctx.path;
     let empty = Map::new();
     let attrs = prim
         .get("attributes")
         .and_then(Value::as_object)
         .unwrap_or(&empty);
-    // `Some(None)`: absent; `None`: present but undecodable (a finding says why).
-    let mut get = |name: &str| -> Option<Option<Decoded>> {
-        let full = semantic(name);
-        let ap = attr_path(path, &full);
-        let Some(idx) = attrs.get(&full) else {
-            return Some(None);
-        };
-        let acc = idx
-            .as_u64()
-            .and_then(|i| ctx.doc.accessors().nth(i as usize));
-        let Some(acc) = acc else {
-            f.push(Finding::fatal(
-                ap,
-                format!("accessor index {idx} out of range"),
-            ));
-            return None;
-        };
-        match decode(&acc, ctx.buffers, &ap, ctx.budget) {
-            Ok(d) => Some(Some(d)),
-            Err(e) => {
-                f.push(e);
-                None
-            }
-        }
-    };
+    let mut get = |name: &str| attribute(ctx, attrs, name, f);
     let required = [
         get("POSITION")?,
         get("ROTATION")?,
@@ -174,34 +181,7 @@ fn fetch(ctx: &Ctx, prim: &Value, f: &mut Vec<Finding>) -> Option<Attributes> {
         }
         higher.push(coefs);
     }
-    let mut missing = false;
-    for (name, a) in ["POSITION", "ROTATION", "SCALE", "OPACITY"]
-        .iter()
-        .zip(&required)
-    {
-        if a.is_none() {
-            f.push(Finding::fatal(
-                attr_path(path, &semantic(name)),
-                "required attribute is missing",
-            ));
-            missing = true;
-        }
-    }
-    if sh0.is_none() {
-        let sh0_path = attr_path(path, &semantic("SH_DEGREE_0_COEF_0"));
-        if color0.is_some() {
-            f.push(Finding::error(
-                sh0_path,
-                "required attribute is missing; diffuse colour derived from COLOR_0",
-            ));
-        } else {
-            f.push(Finding::fatal(
-                sh0_path,
-                "required attribute is missing (and there is no COLOR_0 to fall back on)",
-            ));
-            missing = true;
-        }
-    }
+    let missing = report_missing(&ctx.path, &required, sh0.is_some(), color0.is_some(), f);
     let [Some(position), Some(rotation), Some(scale), Some(opacity)] = required else {
         return None;
     };
@@ -217,6 +197,47 @@ fn fetch(ctx: &Ctx, prim: &Value, f: &mut Vec<Finding>) -> Option<Attributes> {
         color0,
         higher,
     })
+}
+
+/// Reports each missing required attribute (POSITION, ROTATION, SCALE, OPACITY, then
+/// SH_DEGREE_0_COEF_0, which COLOR_0 may stand in for). Returns whether one is missing with
+/// nothing to stand in for it.
+fn report_missing(
+    path: &str,
+    required: &[Option<Decoded>; 4],
+    has_sh0: bool,
+    has_color0: bool,
+    f: &mut Vec<Finding>,
+) -> bool {
+    let mut missing = false;
+    for (name, a) in ["POSITION", "ROTATION", "SCALE", "OPACITY"]
+        .iter()
+        .zip(required)
+    {
+        if a.is_none() {
+            f.push(Finding::fatal(
+                attr_path(path, &semantic(name)),
+                "required attribute is missing",
+            ));
+            missing = true;
+        }
+    }
+    if !has_sh0 {
+        let sh0_path = attr_path(path, &semantic("SH_DEGREE_0_COEF_0"));
+        if has_color0 {
+            f.push(Finding::error(
+                sh0_path,
+                "required attribute is missing; diffuse colour derived from COLOR_0",
+            ));
+        } else {
+            f.push(Finding::fatal(
+                sh0_path,
+                "required attribute is missing (and there is no COLOR_0 to fall back on)",
+            ));
+            missing = true;
+        }
+    }
+    missing
 }
 
 /// Counts splats with one problem and remembers the first.
@@ -275,73 +296,15 @@ fn assemble(
     cloud.meta = meta.clone();
     let srgb = cloud.meta.color_space.effective() == ColorSpace::SrgbRec709Display;
     for i in 0..n {
-        let q: [f32; 4] = a.rotation.get(i);
-        let norm = q.iter().map(|v| (*v as f64).powi(2)).sum::<f64>().sqrt();
-        let q = if norm < 1e-12 {
-            zero.add(i);
-            q // not unit: dropped by the hygiene pass
-        } else {
-            if (norm - 1.0).abs() > tol {
-                non_unit.add(i);
-            }
-            if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
-                q // unit to f32 rounding: kept bit for bit
-            } else {
-                q.map(|v| (v as f64 / norm) as f32)
-            }
-        };
-        let s: [f32; 3] = a.scale.get(i);
-        let s = if log {
-            let e = s.map(f32::exp);
-            if s.iter().all(|v| v.is_finite()) && !e.iter().all(|v| v.is_finite()) {
-                overflow.add(i);
-            }
-            e
-        } else {
-            // -0 → 0; NaN stays NaN (f32::max would turn it into 0).
-            s.map(|v| if v.is_nan() { v } else { v.max(0.0) })
-        };
-        sh[0] = match (&a.sh0, &a.color0) {
-            (Some(d), _) => d.get(i),
-            (None, Some(c)) => dc_from_color0(c.get::<3>(i), srgb),
-            (None, None) => [0.0; 3],
-        };
-        for (l, coefs) in a.higher.iter().enumerate().take(degree as usize) {
-            for (c, d) in coefs.iter().enumerate() {
-                if let Some(d) = d {
-                    sh[(l + 1) * (l + 1) + c] = d.get(i);
-                }
-            }
-        }
+        let q = unit_rotation(a.rotation.get(i), tol, i, &mut zero, &mut non_unit);
+        let s = linear_scale(a.scale.get(i), log, i, &mut overflow);
+        gather_sh(a, i, degree, srgb, &mut sh);
         // Opacity is within 1e-6 of [0, 1] here (rules::check_opacity); NaN stays NaN.
         let o = a.opacity.data[i].clamp(0.0, 1.0);
         cloud.push(a.position.get(i), s, q, o, &sh);
     }
     let strict = ctx.opts.strict;
-    // The RC: "Rotation values are stored as unit quaternions" (so that renderers need not
-    // renormalise); glTF-Validator holds node rotations and animated rotations to the same
-    // rule as errors (ROTATION_NON_UNIT). Naming the writer tells the user whom to ask.
-    let by = match ctx.doc.as_json().asset.generator.as_deref() {
-        Some(g) if !g.trim().is_empty() => {
-            // A file's own text, at most 80 characters: control, zero-width and bidirectional
-            // characters (which would let a file rewrite what the terminal shows) as '?'.
-            let shown = |c: char| {
-                !(c.is_control()
-                    || ('\u{200B}'..='\u{200F}').contains(&c)
-                    || ('\u{202A}'..='\u{202E}').contains(&c)
-                    || ('\u{2066}'..='\u{2069}').contains(&c)
-                    || c == '\u{FEFF}')
-            };
-            let g: String = g
-                .trim()
-                .chars()
-                .take(80)
-                .map(|c| if shown(c) { c } else { '?' })
-                .collect();
-            format!(" (the file was written by {g})")
-        }
-        _ => String::new(),
-    };
+    let by = written_by(ctx);
     let unit = |n| format!("{n} quaternions are not unit length (tolerance {tol}); normalised{by}");
     non_unit.report(&rot_path, unit, false, f);
     let then = |n: usize| match (strict, n) {
@@ -365,6 +328,99 @@ fn assemble(
         origin: None,
         details: None,
     }
+}
+
+/// Splat `i`'s quaternion normalised: kept bit for bit when unit to f32 rounding, left as it
+/// is when zero (counted in `zero`, for the hygiene pass to drop); one off unit by more than
+/// `tol` is counted in `non_unit`.
+#[inline]
+fn unit_rotation(
+    q: [f32; 4],
+    tol: f64,
+    i: usize,
+    zero: &mut Tally,
+    non_unit: &mut Tally,
+) -> [f32; 4] {
+    let norm = q.iter().map(|v| (*v as f64).powi(2)).sum::<f64>().sqrt();
+    if norm < 1e-12 {
+        zero.add(i);
+        q // not unit: dropped by the hygiene pass
+    } else {
+        if (norm - 1.0).abs() > tol {
+            non_unit.add(i);
+        }
+        if (norm - 1.0).abs() <= crate::load::UNIT_NORM_ROUNDING {
+            q // unit to f32 rounding: kept bit for bit
+        } else {
+            q.map(|v| (v as f64 / norm) as f32)
+        }
+    }
+}
+
+/// Splat `i`'s scale made linear: `exp` of a log-space scale (an overflow of finite values is
+/// counted in `overflow`), a linear one with -0 as 0.
+#[inline]
+fn linear_scale(s: [f32; 3], log: bool, i: usize, overflow: &mut Tally) -> [f32; 3] {
+    if log {
+        let e = s.map(f32::exp);
+        if s.iter().all(|v| v.is_finite()) && !e.iter().all(|v| v.is_finite()) {
+            overflow.add(i);
+        }
+        e
+    } else {
+        // -0 → 0; NaN stays NaN (f32::max would turn it into 0).
+        s.map(|v| if v.is_nan() { v } else { v.max(0.0) })
+    }
+}
+
+/// Splat `i`'s SH coefficients into `sh`: DC from SH_DEGREE_0_COEF_0 (or derived from COLOR_0),
+/// then the present coefficients of degrees 1..=`degree`.
+#[inline]
+fn gather_sh(a: &Attributes, i: usize, degree: u8, srgb: bool, sh: &mut [[f32; 3]]) {
+    sh[0] = match (&a.sh0, &a.color0) {
+        (Some(d), _) => d.get(i),
+        (None, Some(c)) => dc_from_color0(c.get::<3>(i), srgb),
+        (None, None) => [0.0; 3],
+    };
+    for (l, coefs) in a.higher.iter().enumerate().take(degree as usize) {
+        for (c, d) in coefs.iter().enumerate() {
+            if let Some(d) = d {
+                sh[(l + 1) * (l + 1) + c] = d.get(i);
+            }
+        }
+    }
+}
+
+/// " (the file was written by …)" naming the asset's generator, or nothing without one.
+///
+/// The RC: "Rotation values are stored as unit quaternions" (so that renderers need not
+/// renormalise); glTF-Validator holds node rotations and animated rotations to the same rule as
+/// errors (ROTATION_NON_UNIT). Naming the writer tells the user whom to ask.
+fn written_by(ctx: &Ctx) -> String {
+    match ctx.doc.as_json().asset.generator.as_deref() {
+        Some(g) if !g.trim().is_empty() => {
+            // A file's own text, at most 80 characters: control, zero-width and bidirectional
+            // characters (which would let a file rewrite what the terminal shows) as '?'.
+            let g: String = g
+                .trim()
+                .chars()
+                .take(80)
+                .map(|c| if shown(c) { c } else { '?' })
+                .collect();
+            format!(" (the file was written by {g})")
+        }
+        _ => String::new(),
+    }
+}
+
+/// Whether a character of the file's own text may be shown as it is: not a control, zero-width
+/// or bidirectional character.
+fn shown(c: char) -> bool {
+    !(c.is_control()
+        || ('\u{200B}'..='\u{200F}').contains(&c)
+        || ('\u{202A}'..='\u{202E}').contains(&c)
+        || ('\u{2066}'..='\u{2069}').contains(&c)
+        || c == '\u{FEFF}')
 }
 
 /// Inverts the RC's COLOR_0 fallback: COLOR_0 = clamp(SH0·Y₀₀ + 0.5) (sRGB-decoded to linear

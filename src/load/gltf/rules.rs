@@ -54,11 +54,6 @@ pub(super) fn check_types_and_counts(
 ) -> Option<()> {
     let path = &ctx.path;
     let n = a.position.count();
-    let position_types: &[(DataType, bool)] = if ctx.quantization {
-        POSITION_QUANTIZED
-    } else {
-        &[(DataType::F32, false)]
-    };
     if let Err(e) = ctx
         .opts
         .limits
@@ -67,6 +62,34 @@ pub(super) fn check_types_and_counts(
         f.push(Finding::fatal(attr_path(path, "POSITION"), e.to_string()));
         return None;
     }
+    let typed = checks(ctx, a);
+    let mut blocked = false;
+    for check in &typed {
+        blocked |= check_attribute(ctx, check, n, f);
+    }
+    if let Some(c) = &a.color0 {
+        if c.count() != n || !(c.dims == 3 || c.dims == 4) {
+            f.push(Finding::fatal(
+                attr_path(path, "COLOR_0"),
+                "COLOR_0 must be VEC3/VEC4 with POSITION's count",
+            ));
+            blocked = true;
+        } else {
+            non_finite(&attr_path(path, "COLOR_0"), c, ctx.opts.strict, f);
+        }
+    }
+    (!blocked).then_some(())
+}
+
+/// The attributes to check with what the RC allows for each: POSITION (more types with
+/// `KHR_mesh_quantization`), ROTATION, SCALE, OPACITY, then the SH coefficients present.
+fn checks<'d>(ctx: &Ctx, a: &'d Attributes) -> Vec<Check<'d>> {
+    let path = &ctx.path;
+    let position_types: &[(DataType, bool)] = if ctx.quantization {
+        POSITION_QUANTIZED
+    } else {
+        &[(DataType::F32, false)]
+    };
     let mut typed: Vec<Check> = vec![(attr_path(path, "POSITION"), &a.position, 3, position_types)];
     for (name, d) in [
         ("ROTATION", &a.rotation),
@@ -92,53 +115,46 @@ pub(super) fn check_types_and_counts(
             }
         }
     }
+    typed
+}
+
+/// One attribute's component count, element count (POSITION's `n`), component type,
+/// alignment and finiteness. Returns whether a blocking finding was reported.
+fn check_attribute(ctx: &Ctx, (p, d, dims, ok): &Check, n: usize, f: &mut Vec<Finding>) -> bool {
     let mut blocked = false;
-    for (p, d, dims, ok) in &typed {
-        if d.dims != *dims {
-            f.push(Finding::fatal(
+    if d.dims != *dims {
+        f.push(Finding::fatal(
+            p.clone(),
+            format!("expected {dims} components, found {}", d.dims),
+        ));
+        blocked = true;
+    } else if d.count() != n {
+        f.push(Finding::fatal(
+            p.clone(),
+            format!("count {} differs from POSITION's count {n}", d.count()),
+        ));
+        blocked = true;
+    } else if !ok.is_empty() && !ok.contains(&(d.component, d.normalized)) {
+        // Signed SCALE is the review draft's log space: reported by the scale-space check,
+        // unless the caller insists on linear.
+        let is_legacy_scale = p.ends_with("SCALE\"]")
+            && matches!(d.component, DataType::I8 | DataType::I16)
+            && ctx.scale_space != ScaleSpace::Linear;
+        if !is_legacy_scale {
+            f.push(Finding::error(
                 p.clone(),
-                format!("expected {dims} components, found {}", d.dims),
+                format!(
+                    "component type {} is not allowed by the RC",
+                    component_name(d.component, d.normalized)
+                ),
             ));
-            blocked = true;
-        } else if d.count() != n {
-            f.push(Finding::fatal(
-                p.clone(),
-                format!("count {} differs from POSITION's count {n}", d.count()),
-            ));
-            blocked = true;
-        } else if !ok.is_empty() && !ok.contains(&(d.component, d.normalized)) {
-            // Signed SCALE is the review draft's log space: reported by the scale-space check,
-            // unless the caller insists on linear.
-            let is_legacy_scale = p.ends_with("SCALE\"]")
-                && matches!(d.component, DataType::I8 | DataType::I16)
-                && ctx.scale_space != ScaleSpace::Linear;
-            if !is_legacy_scale {
-                f.push(Finding::error(
-                    p.clone(),
-                    format!(
-                        "component type {} is not allowed by the RC",
-                        component_name(d.component, d.normalized)
-                    ),
-                ));
-            }
-        }
-        if let Some(m) = &d.misaligned {
-            f.push(Finding::error(p.clone(), format!("glTF 2.0 layout: {m}")));
-        }
-        non_finite(p, d, ctx.opts.strict, f);
-    }
-    if let Some(c) = &a.color0 {
-        if c.count() != n || !(c.dims == 3 || c.dims == 4) {
-            f.push(Finding::fatal(
-                attr_path(path, "COLOR_0"),
-                "COLOR_0 must be VEC3/VEC4 with POSITION's count",
-            ));
-            blocked = true;
-        } else {
-            non_finite(&attr_path(path, "COLOR_0"), c, ctx.opts.strict, f);
         }
     }
-    (!blocked).then_some(())
+    if let Some(m) = &d.misaligned {
+        f.push(Finding::error(p.clone(), format!("glTF 2.0 layout: {m}")));
+    }
+    non_finite(p, d, ctx.opts.strict, f);
+    blocked
 }
 
 /// glTF 2.0: accessor values MUST be finite. An error at the first offending element with the

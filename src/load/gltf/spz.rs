@@ -14,7 +14,7 @@ use super::container::PREFIX;
 use super::primitive::{Ctx, LocalSplats, attr_path};
 use crate::load::codec::flip_axes;
 use crate::load::spz::{Frame, SpzAxes, decode_bytes};
-use crate::load::{Finding, ScaleSeen};
+use crate::load::{Details, Finding, ScaleSeen};
 use serde_json::Value;
 
 /// The current extension (nested in `KHR_gaussian_splatting`).
@@ -53,63 +53,8 @@ pub fn read(
     f: &mut Vec<Finding>,
 ) -> Option<LocalSplats> {
     let bv_path = format!("{ext_path}.bufferView");
-    let Some(index) = ext.get("bufferView").and_then(Value::as_u64) else {
-        f.push(Finding::fatal(
-            bv_path,
-            "required property 'bufferView' is missing or not an index",
-        ));
-        return None;
-    };
-    let Some(view) = ctx.doc.views().nth(index as usize) else {
-        f.push(Finding::fatal(
-            bv_path,
-            format!("bufferViews[{index}] does not exist"),
-        ));
-        return None;
-    };
-    let bytes = match view_bytes(&view, ctx.buffers, &bv_path) {
-        Ok(b) => b,
-        Err(e) => {
-            f.push(e);
-            return None;
-        }
-    };
-    // Decoded converted (stored frame → LUF); the flips are undone if it is read as stored.
-    let (mut cloud, mut details, flips) = match decode_bytes(
-        bytes,
-        SpzAxes::Rub,
-        Frame::Gltf,
-        (&ctx.opts.limits, None),
-        f,
-    ) {
-        Ok(d) => d,
-        Err(e) => {
-            f.push(Finding::fatal(
-                bv_path,
-                format!("bufferViews[{index}]: SPZ: {e}"),
-            ));
-            return None;
-        }
-    };
-    if kind == Kind::Spz2 && details.version != "2" {
-        f.push(Finding::error(
-            &bv_path,
-            format!(
-                "{SPZ_2} pins SPZ version 2, the payload is version {}; read anyway",
-                details.version
-            ),
-        ));
-    }
-    details.gltf_extension = Some(kind.name());
-    let values = cloud.len() as u64 * (11 + 3 * cloud.coeffs_per_splat() as u64);
-    if values > ctx.budget.get() {
-        f.push(Finding::fatal(
-            bv_path,
-            "the SPZ payload decodes to more values than this file can justify",
-        ));
-        return None;
-    }
-    ctx.budget.set(ctx.budget.get() - values);
+    let (index, bytes) = payload(ctx, ext, &bv_path, f)?;
+    let (mut cloud, details, flips) = decode_payload(ctx, kind, bytes, index, &bv_path, f)?;
     check_placeholders(ctx, prim, kind, cloud.len(), cloud.sh_degree, f);
     let stored = as_stored(ctx, prim, kind, &cloud, flips, f);
     if stored {
@@ -135,6 +80,86 @@ pub fn read(
         origin: None,
         details: Some(details),
     })
+}
+
+/// The bufferView the extension object `ext` names (`bv_path` is its JSON path): its index
+/// and bytes. `None` after a blocking finding.
+fn payload<'b>(
+    ctx: &Ctx<'b>,
+    ext: &Value,
+    bv_path: &str,
+    f: &mut Vec<Finding>,
+) -> Option<(u64, &'b [u8])> {
+    let Some(index) = ext.get("bufferView").and_then(Value::as_u64) else {
+        f.push(Finding::fatal(
+            bv_path,
+            "required property 'bufferView' is missing or not an index",
+        ));
+        return None;
+    };
+    let Some(view) = ctx.doc.views().nth(index as usize) else {
+        f.push(Finding::fatal(
+            bv_path,
+            format!("bufferViews[{index}] does not exist"),
+        ));
+        return None;
+    };
+    match view_bytes(&view, ctx.buffers, bv_path) {
+        Ok(b) => Some((index, b)),
+        Err(e) => {
+            f.push(e);
+            None
+        }
+    }
+}
+
+/// Decodes the SPZ blob of `bufferViews[index]` converted (stored frame → LUF; the flips are
+/// returned so they can be undone if it is read as stored), with its version checked for
+/// `kind` and its values charged to the document's budget. `None` after a blocking finding.
+fn decode_payload(
+    ctx: &Ctx,
+    kind: Kind,
+    bytes: &[u8],
+    index: u64,
+    bv_path: &str,
+    f: &mut Vec<Finding>,
+) -> Option<(crate::SplatCloud, Details, [bool; 3])> {
+    let (cloud, mut details, flips) = match decode_bytes(
+        bytes,
+        SpzAxes::Rub,
+        Frame::Gltf,
+        (&ctx.opts.limits, None),
+        f,
+    ) {
+        Ok(d) => d,
+        Err(e) => {
+            f.push(Finding::fatal(
+                bv_path,
+                format!("bufferViews[{index}]: SPZ: {e}"),
+            ));
+            return None;
+        }
+    };
+    if kind == Kind::Spz2 && details.version != "2" {
+        f.push(Finding::error(
+            bv_path,
+            format!(
+                "{SPZ_2} pins SPZ version 2, the payload is version {}; read anyway",
+                details.version
+            ),
+        ));
+    }
+    details.gltf_extension = Some(kind.name());
+    let values = cloud.len() as u64 * (11 + 3 * cloud.coeffs_per_splat() as u64);
+    if values > ctx.budget.get() {
+        f.push(Finding::fatal(
+            bv_path,
+            "the SPZ payload decodes to more values than this file can justify",
+        ));
+        return None;
+    }
+    ctx.budget.set(ctx.budget.get() - values);
+    Some((cloud, details, flips))
 }
 
 /// The attribute's name without `KHR_gaussian_splatting:` or the legacy `_` prefix.

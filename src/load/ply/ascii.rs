@@ -1,6 +1,6 @@
 //! ASCII PLY bodies: one row per line, values parsed at their declared precision.
 
-use super::header::{Header, Scalar};
+use super::header::{Element, Header, Property, Scalar};
 use super::{Layout, PlyError, RowNotes, Unusable, convert_row};
 use crate::cloud::{SplatCloud, sh_coeff_count};
 
@@ -18,17 +18,7 @@ pub(super) fn decode(
         message: format!("body is not text ({e})"),
     })?;
     let mut lines = text.lines().enumerate();
-    for el in &header.elements[..vi] {
-        for r in 0..el.count {
-            if lines.next().is_none() {
-                return Err(PlyError::EndsEarly {
-                    element: el.name.clone(),
-                    count: el.count,
-                    rows_read: r,
-                });
-            }
-        }
-    }
+    skip_elements(&header.elements[..vi], &mut lines)?;
     let ncols = vertex.props.len();
     // Each value needs at least one digit and one separator.
     let min_bytes = vertex.count.saturating_mul(2 * ncols as u64);
@@ -52,26 +42,7 @@ pub(super) fn decode(
             count: vertex.count,
             rows_read: i as u64,
         })?;
-        let line_no = header.lines + ln + 1;
-        let mut it = line.split_ascii_whitespace();
-        for (c, v) in vals.iter_mut().enumerate() {
-            let tok = it.next().ok_or_else(|| PlyError::Ascii {
-                line: line_no,
-                message: format!("expected {ncols} values, found {c}"),
-            })?;
-            // Parse at the declared precision so ASCII equals the binary encoding exactly.
-            let parsed = match vertex.props[c].ty {
-                Scalar::F32 => tok.parse::<f32>().map(f64::from).ok(),
-                _ => tok.parse::<f64>().ok(),
-            };
-            *v = parsed.ok_or_else(|| PlyError::Ascii {
-                line: line_no,
-                message: format!(
-                    "value {tok:?} of property '{}' is not a number",
-                    vertex.props[c].name
-                ),
-            })?;
-        }
+        parse_row(line, header.lines + ln + 1, &vertex.props, &mut vals)?;
         let (mut p, mut s, mut r, mut o) = ([0.0; 3], [0.0; 3], [0.0; 4], 0.0);
         let off = convert_row(
             l,
@@ -91,4 +62,55 @@ pub(super) fn decode(
         cloud.push(p, s, r, o, &sh);
     }
     Ok((cloud, notes, bad))
+}
+
+/// Skips the rows of the elements before the vertex element, one line each.
+fn skip_elements<'t>(
+    elements: &[Element],
+    lines: &mut impl Iterator<Item = (usize, &'t str)>,
+) -> Result<(), PlyError> {
+    for el in elements {
+        for r in 0..el.count {
+            if lines.next().is_none() {
+                return Err(PlyError::EndsEarly {
+                    element: el.name.clone(),
+                    count: el.count,
+                    rows_read: r,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Parses the values of one row (file line `line_no`) into `vals`, one per property, each at
+/// its declared precision.
+#[inline]
+fn parse_row(
+    line: &str,
+    line_no: usize,
+    props: &[Property],
+    vals: &mut [f64],
+) -> Result<(), PlyError> {
+    let ncols = props.len();
+    let mut it = line.split_ascii_whitespace();
+    for (c, v) in vals.iter_mut().enumerate() {
+        let tok = it.next().ok_or_else(|| PlyError::Ascii {
+            line: line_no,
+            message: format!("expected {ncols} values, found {c}"),
+        })?;
+        // Parse at the declared precision so ASCII equals the binary encoding exactly.
+        let parsed = match props[c].ty {
+            Scalar::F32 => tok.parse::<f32>().map(f64::from).ok(),
+            _ => tok.parse::<f64>().ok(),
+        };
+        *v = parsed.ok_or_else(|| PlyError::Ascii {
+            line: line_no,
+            message: format!(
+                "value {tok:?} of property '{}' is not a number",
+                props[c].name
+            ),
+        })?;
+    }
+    Ok(())
 }

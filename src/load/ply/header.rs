@@ -97,27 +97,21 @@ pub(super) struct Header {
 
 const MAX_HEADER: usize = 1 << 20;
 
+/// A [`PlyError::Header`] at line `line`.
+fn header_err(line: usize, message: String) -> PlyError {
+    PlyError::Header { line, message }
+}
+
+/// Parses the header: the `ply` line, the format, the elements and their properties, up to
+/// `end_header`; returns them with where the body starts.
 pub(super) fn parse_header(bytes: &[u8]) -> Result<Header, PlyError> {
-    let err = |line: usize, message: String| PlyError::Header { line, message };
+    let err = header_err;
     let mut pos = 0;
     let mut line_no = 0;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
     loop {
-        if pos >= bytes.len() || pos > MAX_HEADER {
-            return Err(err(line_no + 1, "no 'end_header' line".into()));
-        }
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map(|e| pos + e)
-            .ok_or_else(|| err(line_no + 1, "no 'end_header' line".into()))?;
-        let raw = &bytes[pos..end];
-        pos = end + 1;
-        line_no += 1;
-        let line = std::str::from_utf8(raw)
-            .map_err(|_| err(line_no, "header is not ASCII text".into()))?
-            .trim_end_matches('\r');
+        let line = next_line(bytes, &mut pos, &mut line_no)?;
         let words: Vec<&str> = line.split_ascii_whitespace().collect();
         if line_no == 1 {
             if words != ["ply"] {
@@ -127,63 +121,13 @@ pub(super) fn parse_header(bytes: &[u8]) -> Result<Header, PlyError> {
         }
         match words.first().copied() {
             None | Some("comment") | Some("obj_info") => {}
-            Some("format") => {
-                encoding = Some(match words.get(1).copied() {
-                    Some("ascii") => Encoding::Ascii,
-                    Some("binary_little_endian") => Encoding::Le,
-                    Some("binary_big_endian") => Encoding::Be,
-                    other => {
-                        return Err(err(
-                            line_no,
-                            format!(
-                                "format {other:?}: expected ascii, binary_little_endian or binary_big_endian"
-                            ),
-                        ));
-                    }
-                });
-            }
-            Some("element") => {
-                let (Some(name), Some(count), None) = (words.get(1), words.get(2), words.get(3))
-                else {
-                    return Err(err(line_no, "expected 'element NAME COUNT'".into()));
-                };
-                let count = count.parse::<u64>().map_err(|_| {
-                    err(line_no, format!("element count {count:?} is not a number"))
-                })?;
-                elements.push(Element {
-                    name: (*name).to_owned(),
-                    count,
-                    props: Vec::new(),
-                });
-            }
+            Some("format") => encoding = Some(parse_format(&words, line_no)?),
+            Some("element") => elements.push(parse_element(&words, line_no)?),
             Some("property") => {
                 let el = elements
                     .last_mut()
                     .ok_or_else(|| err(line_no, "property before any element".into()))?;
-                let prop = match words.as_slice() {
-                    ["property", "list", ct, it, name] => Property {
-                        name: (*name).to_owned(),
-                        list: Some(Scalar::parse(ct).ok_or_else(|| {
-                            err(line_no, format!("unknown list count type {ct:?}"))
-                        })?),
-                        ty: Scalar::parse(it)
-                            .ok_or_else(|| err(line_no, format!("unknown type {it:?}")))?,
-                    },
-                    ["property", ty, name] => Property {
-                        name: (*name).to_owned(),
-                        list: None,
-                        ty: Scalar::parse(ty)
-                            .ok_or_else(|| err(line_no, format!("unknown type {ty:?}")))?,
-                    },
-                    _ => {
-                        return Err(err(
-                            line_no,
-                            "expected 'property TYPE NAME' or 'property list CTYPE TYPE NAME'"
-                                .into(),
-                        ));
-                    }
-                };
-                el.props.push(prop);
+                el.props.push(parse_property(&words, line_no)?);
             }
             Some("end_header") => break,
             Some(w) => return Err(err(line_no, format!("unknown header keyword {w:?}"))),
@@ -195,5 +139,90 @@ pub(super) fn parse_header(bytes: &[u8]) -> Result<Header, PlyError> {
         elements,
         body: pos,
         lines: line_no,
+    })
+}
+
+/// The header line starting at `*pos` (without its `\r\n` or `\n`), `*pos` moved past it and
+/// `*line_no` counting it. An error past [`MAX_HEADER`], at the end of the file, or for a line
+/// that is not text.
+fn next_line<'b>(
+    bytes: &'b [u8],
+    pos: &mut usize,
+    line_no: &mut usize,
+) -> Result<&'b str, PlyError> {
+    let err = header_err;
+    if *pos >= bytes.len() || *pos > MAX_HEADER {
+        return Err(err(*line_no + 1, "no 'end_header' line".into()));
+    }
+    let end = bytes[*pos..]
+        .iter()
+        .position(|&b| b == b'\n')
+        .map(|e| *pos + e)
+        .ok_or_else(|| err(*line_no + 1, "no 'end_header' line".into()))?;
+    let raw = &bytes[*pos..end];
+    *pos = end + 1;
+    *line_no += 1;
+    let line = std::str::from_utf8(raw)
+        .map_err(|_| err(*line_no, "header is not ASCII text".into()))?
+        .trim_end_matches('\r');
+    Ok(line)
+}
+
+/// A `format ENCODING VERSION` line's encoding.
+fn parse_format(words: &[&str], line_no: usize) -> Result<Encoding, PlyError> {
+    Ok(match words.get(1).copied() {
+        Some("ascii") => Encoding::Ascii,
+        Some("binary_little_endian") => Encoding::Le,
+        Some("binary_big_endian") => Encoding::Be,
+        other => {
+            return Err(header_err(
+                line_no,
+                format!(
+                    "format {other:?}: expected ascii, binary_little_endian or binary_big_endian"
+                ),
+            ));
+        }
+    })
+}
+
+/// An `element NAME COUNT` line, as an element without properties yet.
+fn parse_element(words: &[&str], line_no: usize) -> Result<Element, PlyError> {
+    let err = header_err;
+    let (Some(name), Some(count), None) = (words.get(1), words.get(2), words.get(3)) else {
+        return Err(err(line_no, "expected 'element NAME COUNT'".into()));
+    };
+    let count = count
+        .parse::<u64>()
+        .map_err(|_| err(line_no, format!("element count {count:?} is not a number")))?;
+    Ok(Element {
+        name: (*name).to_owned(),
+        count,
+        props: Vec::new(),
+    })
+}
+
+/// A `property TYPE NAME` or `property list CTYPE TYPE NAME` line.
+fn parse_property(words: &[&str], line_no: usize) -> Result<Property, PlyError> {
+    let err = header_err;
+    Ok(match words {
+        ["property", "list", ct, it, name] => Property {
+            name: (*name).to_owned(),
+            list: Some(
+                Scalar::parse(ct)
+                    .ok_or_else(|| err(line_no, format!("unknown list count type {ct:?}")))?,
+            ),
+            ty: Scalar::parse(it).ok_or_else(|| err(line_no, format!("unknown type {it:?}")))?,
+        },
+        ["property", ty, name] => Property {
+            name: (*name).to_owned(),
+            list: None,
+            ty: Scalar::parse(ty).ok_or_else(|| err(line_no, format!("unknown type {ty:?}")))?,
+        },
+        _ => {
+            return Err(err(
+                line_no,
+                "expected 'property TYPE NAME' or 'property list CTYPE TYPE NAME'".into(),
+            ));
+        }
     })
 }

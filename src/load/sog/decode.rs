@@ -190,6 +190,9 @@ fn lerp(q: &Quant, axis: usize, b: u8) -> f32 {
     }
 }
 
+/// Decodes the texels of the textures `t` (in [`names`] order) into the cloud of `m.count`
+/// splats; `sh` is (bands, palette entries, centroid texture width) with SH. Out-of-range
+/// labels and tags are reported, unusable splats dropped at `drop_at`.
 fn splats(
     m: &Meta,
     t: &[Tex],
@@ -205,7 +208,6 @@ fn splats(
     });
     let degree = sh.map_or(0, |s| s.0);
     let (bad_tag, bad_label) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let sqrt2 = std::f32::consts::SQRT_2;
     let cloud = build_cloud::<std::convert::Infallible>(m.count, degree, |i, s| {
         let o = 4 * i;
         *s.position = std::array::from_fn(|a| {
@@ -213,24 +215,10 @@ fn splats(
             let l = mins[a] + span[a] * v as f64 / 65535.0;
             (l.signum() * (l.abs().exp() - 1.0)) as f32
         });
-        let q = &t[2].rgba[o..o + 4];
-        *s.rotation = match q[3] {
-            tag @ 252..=255 => {
-                let largest = (tag - 252) as usize;
-                let mut wxyz = [0.0f32; 4];
-                let others = wxyz.iter_mut().enumerate().filter(|(j, _)| *j != largest);
-                for (k, (_, c)) in others.enumerate() {
-                    *c = (q[k] as f32 / 255.0 * 2.0 - 1.0) / sqrt2;
-                }
-                let sum: f32 = wxyz.iter().map(|v| v * v).sum();
-                wxyz[largest] = (1.0 - sum).max(0.0).sqrt();
-                [wxyz[1], wxyz[2], wxyz[3], wxyz[0]]
-            }
-            _ => {
-                bad_tag.fetch_add(1, Relaxed);
-                [0.0; 4]
-            }
-        };
+        *s.rotation = quaternion(&t[2].rgba[o..o + 4]).unwrap_or_else(|| {
+            bad_tag.fetch_add(1, Relaxed);
+            [0.0; 4]
+        });
         let sc = &t[3].rgba[o..o + 3];
         *s.scale = std::array::from_fn(|a| lerp(&m.scales, a, sc[a]).exp());
         let c = &t[4].rgba[o..o + 4];
@@ -255,7 +243,35 @@ fn splats(
         Ok(())
     });
     let Ok(mut cloud) = cloud;
-    let (tags, labels) = (bad_tag.into_inner(), bad_label.into_inner());
+    report_bad(bad_tag.into_inner(), bad_label.into_inner(), findings);
+    crate::load::codec::finish_cloud(&mut cloud, drop_at, findings);
+    cloud
+}
+
+/// One texel of `quats` as a quaternion `[x, y, z, w]`: the three smallest components and, from
+/// the tag in alpha (252 + its index in w, x, y, z), the largest rebuilt positive. `None` for a
+/// tag outside 252–255.
+#[inline]
+fn quaternion(q: &[u8]) -> Option<[f32; 4]> {
+    let sqrt2 = std::f32::consts::SQRT_2;
+    match q[3] {
+        tag @ 252..=255 => {
+            let largest = (tag - 252) as usize;
+            let mut wxyz = [0.0f32; 4];
+            let others = wxyz.iter_mut().enumerate().filter(|(j, _)| *j != largest);
+            for (k, (_, c)) in others.enumerate() {
+                *c = (q[k] as f32 / 255.0 * 2.0 - 1.0) / sqrt2;
+            }
+            let sum: f32 = wxyz.iter().map(|v| v * v).sum();
+            wxyz[largest] = (1.0 - sum).max(0.0).sqrt();
+            Some([wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
+        }
+        _ => None,
+    }
+}
+
+/// Warnings for the splats with an out-of-range palette label (`labels`) or quats tag (`tags`).
+fn report_bad(tags: usize, labels: usize, findings: &mut Vec<Finding>) {
     if labels > 0 {
         findings.push(Finding::warning(
             "shN_labels",
@@ -268,8 +284,6 @@ fn splats(
             format!("{tags} splats with a quats tag outside 252-255 (no rotation: dropped)"),
         ));
     }
-    crate::load::codec::finish_cloud(&mut cloud, drop_at, findings);
-    cloud
 }
 
 fn describe(m: &Meta, sh: Option<(u8, usize, usize)>) -> Details {

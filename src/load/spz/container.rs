@@ -205,8 +205,26 @@ pub(crate) fn v4<'a>(
         (limit, limits),
         bytes.len(),
     )?;
-    let (streams, toc) = (bytes[15] as usize, codec::u32_at(bytes, 16) as usize);
+    let toc = codec::u32_at(bytes, 16) as usize;
     let sz = sizes(&h);
+    let ranges = streams(bytes, &h, &sz)?;
+    let blocks = unpack(bytes, &ranges, &sz)?;
+    let ext = if h.flags & FLAG_EXTENSIONS != 0 {
+        &bytes[32..toc]
+    } else {
+        &[]
+    };
+    Ok((h, blocks, ext))
+}
+
+/// One zstd stream of a v4 file: its index in the TOC, the attribute it holds and its bytes'
+/// range in the file.
+type Stream = (usize, usize, usize, usize);
+
+/// Reads the v4 table of contents: one stream per non-empty attribute block, each unpacking
+/// to the block's size, the streams filling the file from the TOC's end to its last byte.
+fn streams(bytes: &[u8], h: &Header, sz: &[u64; 6]) -> Result<Vec<Stream>, SpzError> {
+    let (streams, toc) = (bytes[15] as usize, codec::u32_at(bytes, 16) as usize);
     let wanted: Vec<usize> = (0..6).filter(|&i| sz[i] > 0).collect();
     if streams != wanted.len() {
         return Err(SpzError::Toc(format!(
@@ -250,6 +268,12 @@ pub(crate) fn v4<'a>(
             bytes.len()
         )));
     }
+    Ok(ranges)
+}
+
+/// Decompresses the streams in parallel into the six attribute blocks (empty where the block
+/// size `sz` is 0).
+fn unpack(bytes: &[u8], ranges: &[Stream], sz: &[u64; 6]) -> Result<Blocks<'static>, SpzError> {
     let out: Vec<Vec<u8>> = ranges
         .par_iter()
         .map(|&(k, attr, a, b)| {
@@ -270,10 +294,5 @@ pub(crate) fn v4<'a>(
             })
         })
         .collect();
-    let ext = if h.flags & FLAG_EXTENSIONS != 0 {
-        &bytes[32..toc]
-    } else {
-        &[]
-    };
-    Ok((h, blocks, ext))
+    Ok(blocks)
 }
