@@ -44,6 +44,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         "scale_space": r.scale_space.map(|s| s.name()),
         "non_unit_quaternions": r.non_unit_quaternions,
         "non_finite_opacities": r.non_finite_opacities,
+        "antialiased_auto": splatgl::load::AntialiasMode::Auto.resolve(r.trained_antialiased()),
         "memory_bytes": c.memory_bytes(),
         "warnings": r.warning_lines(),
         "notes": r.note_lines(),
@@ -82,6 +83,14 @@ fn print_text(
         info["color_space"].as_str().unwrap_or("?")
     );
     println!("kernel:         {}", info["kernel"].as_str().unwrap_or("?"));
+    println!(
+        "--antialiased auto: {}",
+        if r.trained_antialiased() {
+            "on (the file says it was trained with antialiasing)"
+        } else {
+            "off (no antialiasing flag in the file)"
+        }
+    );
     match b {
         Some(b) => println!("bounds:         {:?} .. {:?}", b.min, b.max),
         None => println!("bounds:         (empty)"),

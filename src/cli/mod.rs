@@ -9,6 +9,7 @@ mod compare;
 mod conformance;
 mod convert;
 mod info;
+mod kernel;
 mod progress;
 mod render;
 mod render_backend;

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use super::camera_args::{CameraArgs, Pick, background};
+use super::kernel::AntialiasArg;
 use super::render::TargetArg;
 use splatgl::camera::ViewOptions;
 
@@ -77,6 +78,9 @@ pub struct Args {
     pub background: String,
     /// Render N frames (along one orbit with --orbit, else from the initial camera), print
     /// frame time min/median/p99, sort ms and the GL driver, and exit.
+    /// The kernel: `auto` is antialiased when the file says it was trained so (SPZ flag 0x1).
+    #[arg(long, value_enum, default_value_t = AntialiasArg::Auto)]
+    pub antialiased: AntialiasArg,
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub bench_frames: Option<u32>,
     /// With --bench-frames: one full orbit around the initial pivot.
@@ -119,6 +123,7 @@ fn go(a: Args) -> Result<(), String> {
         },
         sh_degree: a.sh_degree,
         background: bg,
+        antialiased: a.antialiased.mode(),
         bench: a.bench_frames.map(|n| splatgl::viewer::Bench {
             frames: n as usize,
             orbit: a.orbit,

@@ -36,7 +36,7 @@ pub use crate::files::{LimitExceeded, Limits, check_json_depth};
 pub use details::{AttributeBits, Details};
 pub use finding::{Finding, Severity};
 pub use format::detect_format;
-pub use report::{LoadReport, ScaleSeen};
+pub use report::{AntialiasMode, LoadReport, ScaleSeen};
 
 use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;

@@ -163,3 +163,30 @@ mod tests {
         );
     }
 }
+
+/// `--antialiased auto|on|off`: whether to draw with the antialiased kernel
+/// ([`DrawSettings::antialiased`](crate::gl::DrawSettings::antialiased),
+/// [`RenderOptions::antialiased`](crate::reference::RenderOptions::antialiased)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AntialiasMode {
+    /// On when the file says its splats were trained with antialiasing (the SPZ flag,
+    /// [`LoadReport::trained_antialiased`]), off otherwise (the default).
+    #[default]
+    Auto,
+    /// Always the antialiased kernel.
+    On,
+    /// Always the plain 3DGS kernel.
+    Off,
+}
+
+impl AntialiasMode {
+    /// The kernel for a file whose [`LoadReport::trained_antialiased`] is `trained`:
+    /// `true` = antialiased.
+    pub fn resolve(self, trained: bool) -> bool {
+        match self {
+            AntialiasMode::Auto => trained,
+            AntialiasMode::On => true,
+            AntialiasMode::Off => false,
+        }
+    }
+}

@@ -251,6 +251,7 @@ impl App {
         for w in &l.warnings {
             eprintln!("warning: {w}");
         }
+        self.settings.antialiased = self.opts.antialiased.resolve(l.trained_antialiased);
         let extent = Extent::of_cloud(&l.cloud);
         let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
         let rig = Rig::from_camera(&cam, focus, up.vector());
@@ -263,10 +264,12 @@ impl App {
         };
         let format = l.format.map_or("built in", Format::name);
         println!(
-            "loaded: {name}: {} splats{budget}, SH degree {}, {format}, up {}, stale tolerance {tau}",
+            "loaded: {name}: {} splats{budget}, SH degree {}, {format}, up {}, stale tolerance {tau}, \
+             kernel {}",
             l.cloud.len(),
             l.cloud.sh_degree,
-            up.name()
+            up.name(),
+            if self.settings.antialiased { "antialiased" } else { "plain" }
         );
         self.shown = Some(Shown {
             name,

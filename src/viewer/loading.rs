@@ -26,6 +26,8 @@ pub struct Loaded {
     pub cameras: Vec<GltfPerspective>,
     /// The loader's warnings, summarised.
     pub warnings: Vec<String>,
+    /// The file says it was trained with antialiasing (`--antialiased auto`).
+    pub trained_antialiased: bool,
 }
 
 impl Loaded {
@@ -99,12 +101,13 @@ fn load(
     max_splats: Option<usize>,
     send: &impl Fn(LoadEvent),
 ) -> Result<Box<Loaded>, String> {
-    let (cloud, format, cameras, warnings) = match &path {
+    let (cloud, format, cameras, warnings, trained_antialiased) = match &path {
         None => (
             crate::synthetic::default_scene(),
             None,
             Vec::new(),
             Vec::new(),
+            false,
         ),
         Some(p) => {
             let bytes = read_with_progress(id, p, opts.limits.max_bytes, send)?;
@@ -116,6 +119,7 @@ fn load(
                 Some(scene.report.format),
                 scene.cameras,
                 warnings,
+                scene.report.trained_antialiased(),
             )
         }
     };
@@ -137,6 +141,7 @@ fn load(
         format,
         cameras,
         warnings,
+        trained_antialiased,
     }))
 }
 

@@ -100,6 +100,8 @@ pub struct ViewerOptions {
     pub sh_degree: u8,
     /// Background, display values.
     pub background: [f32; 3],
+    /// The kernel: antialiased when the file says so (`Auto`), always, or never.
+    pub antialiased: crate::load::AntialiasMode,
     /// Measure frames and exit.
     pub bench: Option<Bench>,
     /// `V` also prints a cameras.json entry.
@@ -125,6 +127,7 @@ impl Default for ViewerOptions {
             target: TargetChoice::Float,
             sh_degree: 3,
             background: [0.0; 3],
+            antialiased: crate::load::AntialiasMode::Auto,
             bench: None,
             print_camera_json: false,
             test_drop: None,
