@@ -23,6 +23,7 @@
 use bytemuck::{Pod, Zeroable};
 
 mod check;
+mod select;
 pub use check::{Field, UNIT_QUAT_TOLERANCE, Violation};
 
 /// Number of RGB coefficients per splat for SH degree `degree` (1, 4, 9, 16 for 0..=3).

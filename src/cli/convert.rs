@@ -78,6 +78,10 @@ pub struct Args {
     /// Set colorSpace (a relabel for inputs that carry none, e.g. PLY; colours are unchanged).
     #[arg(long, value_name = "srgb_rec709_display|lin_rec709_display", value_parser = parse_color_space)]
     pub color_space: Option<ColorSpace>,
+    /// Write only the splats whose mean lies in this box, in the input's coordinates (as
+    /// `render IN --crop` draws them; both ends included; splat-transform's --filter-box order).
+    #[arg(long, value_name = "minx,miny,minz,maxx,maxy,maxz", value_parser = splatgl::cull::CropBox::parse, allow_hyphen_values = true)]
+    pub crop: Option<splatgl::cull::CropBox>,
     /// Overwrite OUT if it exists.
     #[arg(short, long)]
     pub force: bool,
@@ -152,6 +156,21 @@ fn options(a: &Args) -> Result<ConvertOptions, String> {
         },
         spz_compress: a.spz_compress,
     })
+}
+
+/// The splats inside `crop` (all without one); an error when none is.
+fn crop(cloud: SplatCloud, crop: Option<splatgl::cull::CropBox>) -> Result<SplatCloud, String> {
+    let Some(kept) = crop.and_then(|b| b.apply(&cloud)) else {
+        return Ok(cloud);
+    };
+    if kept.is_empty() {
+        return Err(format!(
+            "--crop: none of the {} splats is inside the box",
+            cloud.len()
+        ));
+    }
+    eprintln!("--crop: kept {} of {} splats", kept.len(), cloud.len());
+    Ok(kept)
 }
 
 /// Rotates by `r` in chunks (progress per chunk).
@@ -240,6 +259,7 @@ fn go(a: &Args) -> Result<(), String> {
         cloud.len(),
         t0.elapsed().as_secs_f64()
     ));
+    cloud = crop(cloud, a.crop)?;
     convert::relabel(&mut cloud, &o);
     let r = o.rotation_for(scene.report.format, &cloud, format);
     let mut cameras = Vec::with_capacity(views.len());

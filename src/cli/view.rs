@@ -78,6 +78,10 @@ pub struct Args {
     pub background: String,
     /// Render N frames (along one orbit with --orbit, else from the initial camera), print
     /// frame time min/median/p99, sort ms and the GL driver, and exit.
+    /// Draw only the splats whose mean lies in this box (scene coordinates, both ends
+    /// included; splat-transform's --filter-box order).
+    #[arg(long, value_name = "minx,miny,minz,maxx,maxy,maxz", value_parser = splatgl::cull::CropBox::parse, allow_hyphen_values = true)]
+    pub crop: Option<splatgl::cull::CropBox>,
     /// The kernel: `auto` is antialiased when the file says it was trained so (SPZ flag 0x1).
     #[arg(long, value_enum, default_value_t = AntialiasArg::Auto)]
     pub antialiased: AntialiasArg,
@@ -124,6 +128,7 @@ fn go(a: Args) -> Result<(), String> {
         sh_degree: a.sh_degree,
         background: bg,
         antialiased: a.antialiased.mode(),
+        crop: a.crop,
         bench: a.bench_frames.map(|n| splatgl::viewer::Bench {
             frames: n as usize,
             orbit: a.orbit,

@@ -180,7 +180,11 @@ impl App {
             let _ = proxy.send_event(UserEvent::Load(ev));
         };
         let opts = Arc::clone(&self.load_opts);
-        spawn(self.load_id, path, opts, self.opts.max_splats, send);
+        let keep = super::loading::Keep {
+            crop: self.opts.crop,
+            max_splats: self.opts.max_splats,
+        };
+        spawn(self.load_id, path, opts, keep, send);
         self.update_title(true);
     }
 
@@ -258,7 +262,7 @@ impl App {
         self.controls.fly_speed = extent.map_or(1.0, |e| (0.5 * e.radius()).max(0.05));
         self.controls.stop();
         let budget = if l.cloud.len() < l.file_len {
-            format!(" (of {}, --max-splats)", l.file_len)
+            format!(" (of {}, --crop / --max-splats)", l.file_len)
         } else {
             String::new()
         };

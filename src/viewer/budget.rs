@@ -40,18 +40,7 @@ pub fn subset(cloud: &SplatCloud, n: usize) -> Option<SplatCloud> {
         return None;
     }
     let kept = kept_indices(cloud, n);
-    let mut out = SplatCloud::with_capacity(cloud.sh_degree, kept.len());
-    out.meta = cloud.meta.clone();
-    for &i in &kept {
-        let i = i as usize;
-        out.push(
-            cloud.positions[i],
-            cloud.scales[i],
-            cloud.rotations[i],
-            cloud.opacities[i],
-            cloud.sh_of(i),
-        );
-    }
+    let out = cloud.select(&kept);
     Some(out)
 }
 

@@ -11,6 +11,16 @@ use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
 use crate::load::{Format, LoadOptions, load_bytes};
 
+/// Which splats of a file the viewer keeps: those inside the crop box, then at most
+/// `max_splats` of them.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Keep {
+    /// `--crop`.
+    pub crop: Option<crate::cull::CropBox>,
+    /// `--max-splats`.
+    pub max_splats: Option<usize>,
+}
+
 /// A scene ready to show.
 #[derive(Debug)]
 pub struct Loaded {
@@ -79,11 +89,11 @@ pub fn spawn(
     id: u64,
     path: Option<PathBuf>,
     opts: Arc<LoadOptions>,
-    max_splats: Option<usize>,
+    keep: Keep,
     send: impl Fn(LoadEvent) + Send + 'static,
 ) {
     let body = move || {
-        let result = load(id, path, &opts, max_splats, &send);
+        let result = load(id, path, &opts, keep, &send);
         send(LoadEvent::Done { id, result });
     };
     if let Err(e) = std::thread::Builder::new()
@@ -98,7 +108,7 @@ fn load(
     id: u64,
     path: Option<PathBuf>,
     opts: &LoadOptions,
-    max_splats: Option<usize>,
+    keep: Keep,
     send: &impl Fn(LoadEvent),
 ) -> Result<Box<Loaded>, String> {
     let (cloud, format, cameras, warnings, trained_antialiased) = match &path {
@@ -130,7 +140,20 @@ fn load(
         ));
     }
     let file_len = cloud.len();
-    let cloud = match max_splats.and_then(|n| super::budget::subset(&cloud, n)) {
+    let cloud = match keep.crop.and_then(|b| b.apply(&cloud)) {
+        Some(c) if c.is_empty() => {
+            return Err(format!(
+                "{}: no splat inside the crop box",
+                display_name(path.as_deref())
+            ));
+        }
+        Some(c) => c,
+        None => cloud,
+    };
+    let cloud = match keep
+        .max_splats
+        .and_then(|n| super::budget::subset(&cloud, n))
+    {
         Some(s) => s,
         None => cloud,
     };

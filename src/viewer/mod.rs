@@ -88,8 +88,11 @@ pub struct ViewerOptions {
     pub vsync: bool,
     /// Render at this fraction of the window's pixels (stretched to the window).
     pub resolution_scale: f32,
-    /// Draw at most this many splats (the opacity × area ranking of `budget.rs`).
+    /// Draw at most this many splats (the opacity × area ranking of `budget.rs`), after the
+    /// crop.
     pub max_splats: Option<usize>,
+    /// Draw only the splats whose mean is inside this box (`--crop`).
+    pub crop: Option<crate::cull::CropBox>,
     /// Every frame waits for the sort of its own camera.
     pub sort_sync: bool,
     /// The staleness bound.
@@ -122,6 +125,7 @@ impl Default for ViewerOptions {
             vsync: true,
             resolution_scale: 1.0,
             max_splats: None,
+            crop: None,
             sort_sync: false,
             stale: StaleBound::Auto,
             target: TargetChoice::Float,
