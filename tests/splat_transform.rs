@@ -500,3 +500,35 @@ fn ksplat(f: &dyn Fn(&str) -> PathBuf, ply: &SplatCloud) {
         );
     }
 }
+
+/// `--crop` keeps what splat-transform's `--filter-box` keeps: the same splats, in the same
+/// order. splat-transform's box is in its engine coordinates, which for a PLY are the file's
+/// turned 180° about Z ((x, y, z) → (−x, −y, z)); splatgl's is in the file's own coordinates.
+#[test]
+fn crop_box_keeps_what_splat_transform_filter_box_keeps() {
+    let Some(st) = tool("SPLAT_TRANSFORM", ".bin/splat-transform") else {
+        common::skip("splat-transform not installed (run .ci/run or scripts/test.sh)");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("splatgl-st-crop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cloud = random_cloud(3000, 1, 3.0, 77);
+    let input = dir.join("in.ply");
+    std::fs::write(&input, to_inria_ply(&cloud)).unwrap();
+    let ply = load(&input);
+    let (lo, hi) = ([-2.0f32, -1.5, -2.5], [1.8, 2.2, 1.0]);
+    let arg = format!("{},{},{},{},{},{}", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    let out = dir.join("cropped.ply");
+    convert(&st, &input, &out, &["-B", &arg]);
+    let theirs = load(&out);
+    let ours = splatgl::cull::CropBox {
+        min: [-hi[0], -hi[1], lo[2]],
+        max: [-lo[0], -lo[1], hi[2]],
+    }
+    .apply(&ply)
+    .expect("the box leaves some splats out");
+    assert!(ours.len() > 100 && ours.len() < ply.len() - 100, "{}", ours.len());
+    assert_eq!(theirs.len(), ours.len(), "splats kept");
+    assert_eq!(theirs.positions, ours.positions, "the same splats, in order");
+    eprintln!("crop: {} of {} kept by both", ours.len(), ply.len());
+}
