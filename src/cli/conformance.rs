@@ -3,6 +3,7 @@
 
 use splatgl::conformance::manifest::Manifest;
 use splatgl::conformance::render::{Backend, render_suite};
+use splatgl::conformance::runner::AssetResult;
 use splatgl::conformance::{generate, report, runner};
 use splatgl::image::Image;
 use std::collections::HashMap;
@@ -64,55 +65,111 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
     let out = a.out.clone().unwrap_or_else(|| a.dir.join("report"));
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let (results, source) = if let Some(images) = &a.images {
-        if !images.is_dir() {
-            return Err(format!("--images {}: not a folder", images.display()));
-        }
-        let r = runner::run(&a.dir, &m, |c| {
-            runner::find_image(images, c).map(|p| Image::read(&p).map_err(|e| e.to_string()))
-        })?;
-        (r, images.display().to_string())
+        (
+            run_images(&a.dir, &m, images)?,
+            images.display().to_string(),
+        )
     } else {
-        let backend = match a.backend {
-            Some(BackendArg::Gl) => Backend::Gl,
-            _ => Backend::Reference,
-        };
-        let imgs: HashMap<String, Image> = render_suite(&a.dir, &m, backend)?.into_iter().collect();
-        // Keep the rendered images beside the report, laid out like --images expects.
-        for (name, img) in &imgs {
-            let (ext, bytes) = match backend {
-                Backend::Gl => ("png", img.encode_png(Default::default(), false)),
-                Backend::Reference => ("pfm", Ok(img.encode_pfm())),
-            };
-            let p = out.join("images").join(format!("{name}.{ext}"));
-            std::fs::create_dir_all(p.parent().expect("has a parent"))
-                .map_err(|e| format!("{}: {e}", p.display()))?;
-            let reference = a.dir.join("reference").join(format!("{name}.{ext}"));
-            write(
-                &p,
-                &[&manifest, &reference],
-                &bytes.map_err(|e| e.to_string())?,
-            )?;
-        }
-        let r = runner::run(&a.dir, &m, |c| imgs.get(&c.image).cloned().map(Ok))?;
-        let name = match backend {
-            Backend::Gl => "splatgl --backend gl",
-            Backend::Reference => "splatgl --backend reference",
-        };
-        (r, name.to_owned())
+        run_backend(a, &m, &manifest, &out)?
     };
-    let json = report::to_json(&results, &source);
+    write_reports(&results, &source, &out, &manifest)?;
+    let s = report::summary(&results);
+    print_failures(&results);
+    println!(
+        "{} passed, {} failed, {} skipped (RC rules); profile: {} match, {} differ -> {}",
+        s.passed,
+        s.failed,
+        s.skipped,
+        s.profile_matched,
+        s.profile_differ,
+        out.join("report.html").display()
+    );
+    Ok(s.failed == 0)
+}
+
+/// Compares another renderer's images, found in the folder `images`, with the suite's.
+fn run_images(dir: &Path, m: &Manifest, images: &Path) -> Result<Vec<AssetResult>, String> {
+    if !images.is_dir() {
+        return Err(format!("--images {}: not a folder", images.display()));
+    }
+    runner::run(dir, m, |c| {
+        runner::find_image(images, c).map(|p| Image::read(&p).map_err(|e| e.to_string()))
+    })
+}
+
+/// Renders the suite with `--backend`'s renderer, keeps the images under `out/images`, and
+/// compares them; returns the results and the source's name for the report.
+fn run_backend(
+    a: &RunArgs,
+    m: &Manifest,
+    manifest: &Path,
+    out: &Path,
+) -> Result<(Vec<AssetResult>, String), String> {
+    let backend = match a.backend {
+        Some(BackendArg::Gl) => Backend::Gl,
+        _ => Backend::Reference,
+    };
+    let imgs: HashMap<String, Image> = render_suite(&a.dir, m, backend)?.into_iter().collect();
+    save_images(&a.dir, &imgs, backend, manifest, out)?;
+    let r = runner::run(&a.dir, m, |c| imgs.get(&c.image).cloned().map(Ok))?;
+    let name = match backend {
+        Backend::Gl => "splatgl --backend gl",
+        Backend::Reference => "splatgl --backend reference",
+    };
+    Ok((r, name.to_owned()))
+}
+
+/// Keeps the rendered images beside the report, laid out like --images expects (PNG for GL,
+/// PFM for the reference), never over the suite's files.
+fn save_images(
+    dir: &Path,
+    imgs: &HashMap<String, Image>,
+    backend: Backend,
+    manifest: &Path,
+    out: &Path,
+) -> Result<(), String> {
+    for (name, img) in imgs {
+        let (ext, bytes) = match backend {
+            Backend::Gl => ("png", img.encode_png(Default::default(), false)),
+            Backend::Reference => ("pfm", Ok(img.encode_pfm())),
+        };
+        let p = out.join("images").join(format!("{name}.{ext}"));
+        std::fs::create_dir_all(p.parent().expect("has a parent"))
+            .map_err(|e| format!("{}: {e}", p.display()))?;
+        let reference = dir.join("reference").join(format!("{name}.{ext}"));
+        write(
+            &p,
+            &[manifest, &reference],
+            &bytes.map_err(|e| e.to_string())?,
+        )?;
+    }
+    Ok(())
+}
+
+/// Writes report.json and report.html into `out`.
+fn write_reports(
+    results: &[AssetResult],
+    source: &str,
+    out: &Path,
+    manifest: &Path,
+) -> Result<(), String> {
+    let json = report::to_json(results, source);
     write(
         &out.join("report.json"),
-        &[&manifest],
+        &[manifest],
         &serde_json::to_vec_pretty(&json).unwrap_or_default(),
     )?;
     write(
         &out.join("report.html"),
-        &[&manifest],
-        report::to_html(&results, &source).as_bytes(),
-    )?;
-    let s = report::summary(&results);
-    for d in splatgl::conformance::runner::diagnosis(&results) {
+        &[manifest],
+        report::to_html(results, source).as_bytes(),
+    )
+}
+
+/// Prints the run's diagnosis, then one line per failing camera (FAIL, or DIFFERS for a
+/// profile asset).
+fn print_failures(results: &[AssetResult]) {
+    for d in splatgl::conformance::runner::diagnosis(results) {
         println!(
             "DIAGNOSIS {}: {} [{}] — assets: {}",
             d.deviation.name(),
@@ -135,16 +192,6 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
             );
         }
     }
-    println!(
-        "{} passed, {} failed, {} skipped (RC rules); profile: {} match, {} differ -> {}",
-        s.passed,
-        s.failed,
-        s.skipped,
-        s.profile_matched,
-        s.profile_differ,
-        out.join("report.html").display()
-    );
-    Ok(s.failed == 0)
 }
 
 /// Runs a subcommand.

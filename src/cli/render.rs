@@ -1,15 +1,17 @@
 //! `splatgl render`: one image of a scene (or of the bundled default scene).
 
-use super::camera_args::{Pick, background, camera_json_line, look_at_line};
+mod steps;
+
+use super::camera_args::{Pick, background};
 use super::progress::Progress;
 use super::render_backend::Wanted;
 use super::render_out::{Kind, Outputs};
 use splatgl::camera::{Camera, SceneView};
 use splatgl::load::Scene;
-use splatgl::reference::{RenderOptions, SortMode};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
+use steps::{check_image_sizes, describe_target, load_scene, render_options, render_views};
 
 /// Rendering backends.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -115,6 +117,13 @@ impl Args {
             .chain(&self.cam.camera)
             .map(PathBuf::as_path)
             .collect()
+    }
+
+    /// Prints `s` to stderr unless `--quiet`.
+    fn say(&self, s: String) {
+        if !self.quiet {
+            eprintln!("{s}");
+        }
     }
 
     fn batch(&self) -> bool {
@@ -275,114 +284,38 @@ fn preflight(a: &Args) -> Result<(Outputs, Wanted, [f32; 3]), String> {
     Ok((out, wanted, bg))
 }
 
+/// The `render` command: preflight, load, frame the views, render and write each, then the
+/// summary line.
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
     let batch = a.batch();
     let (out, wanted, bg) = preflight(a)?;
     let inputs = a.inputs();
-    let say = |s: String| {
-        if !a.quiet {
-            eprintln!("{s}");
-        }
-    };
     let progress = Progress::new(a.quiet, a.progress);
-
-    let (cloud, format, cameras) = match &a.scene {
-        Some(p) => {
-            progress.stage(&format!("loading {}", p.display()));
-            let s = load(p, a, progress)?;
-            (s.cloud, Some(s.report.format), s.cameras)
-        }
-        None => (splatgl::synthetic::default_scene(), None, Vec::new()),
-    };
-    let file = a
-        .scene
-        .as_ref()
-        .map_or(String::new(), |p| p.display().to_string());
-    a.load.common.check_applies(&file, format)?;
+    let (cloud, format, cameras) = load_scene(a, progress)?;
     let scene = SceneView {
         cloud: &cloud,
         format,
         cameras: &cameras,
     };
     let views = views(a, scene)?;
-    for (cam, _) in &views {
-        // cameras.json sizes and derived sizes are bounded like the flags (an image is 16
-        // bytes per pixel in f32).
-        if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
-            return Err(format!(
-                "image size {}x{} is outside 1..=16384 per side; give --width/--height",
-                cam.width, cam.height
-            ));
-        }
-    }
+    check_image_sizes(&views)?;
     out.check_files(views.len(), &inputs, a.force)?;
-    let opts = RenderOptions {
-        sh_degree: a.sh_degree,
-        background: bg,
-        sort: match a.sort {
-            SortArg::Distance => SortMode::Distance,
-            SortArg::ViewDepth => SortMode::ViewDepth,
-        },
-        ..Default::default()
-    };
+    let opts = render_options(a, bg);
     let t1 = Instant::now();
     let (mut engine, why) = wanted.engine(&cloud, &opts)?;
     if a.verbose {
         eprintln!("backend: {} ({why})", engine.name());
     }
-    let mut visible = None;
-    let mut entries = Vec::new();
-    for (i, (cam, distance)) in views.iter().enumerate() {
-        if batch {
-            progress.step("rendering", i, views.len());
-        } else {
-            progress.stage("rendering");
-        }
-        let (img, v) = engine.render(&cloud, cam, &opts)?;
-        visible = v;
-        out.write(&img, i)?;
-        progress.clear();
-        let index = if batch {
-            format!("[{i}] ")
-        } else {
-            String::new()
-        };
-        say(format!("camera: {index}{}", look_at_line(cam, *distance)));
-        if a.cam.print_camera_json && !batch {
-            println!("{}", camera_json_line(cam));
-        } else if a.cam.print_camera_json {
-            let name = out
-                .path(i)
-                .and_then(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()));
-            entries.push(cam.to_3dgs_json(i as i64, &name.unwrap_or_default()));
-        }
-    }
-    if batch {
-        progress.step("rendering", views.len(), views.len());
-        progress.clear();
-        if a.cam.print_camera_json {
-            // One cameras.json for the batch: `--camera` on it with `--view all` renders it again.
-            println!("{}", serde_json::Value::Array(entries));
-        }
-    }
+    let visible = render_views(a, &out, &mut engine, &cloud, &views, &opts, progress)?;
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;
     let visible = match (visible, batch) {
         (Some(v), false) => format!(" ({v} visible)"),
         _ => String::new(),
     };
     let (w, h) = (views[0].0.width, views[0].0.height);
-    let target = if batch {
-        format!(
-            "{} images -> {} .. {}",
-            views.len(),
-            out.describe(0),
-            out.describe(views.len() - 1)
-        )
-    } else {
-        out.describe(0)
-    };
-    say(format!(
+    let target = describe_target(&out, views.len(), batch);
+    a.say(format!(
         "splatgl render: {} splats{visible}, {w}x{h}, backend {}: render {render_ms:.1} ms, \
          total {:.1} ms -> {target}",
         cloud.len(),

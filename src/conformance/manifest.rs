@@ -177,80 +177,9 @@ impl Manifest {
 
     /// Parses a manifest; the error names the key.
     pub fn from_json(v: &Value) -> Result<Manifest, String> {
-        let s = |v: &Value, k: &str| -> Result<String, String> {
-            v[k].as_str()
-                .map(str::to_owned)
-                .ok_or_else(|| format!("manifest: `{k}` missing or not a string"))
-        };
-        let f = |v: &Value, k: &str| -> Result<f64, String> {
-            v[k].as_f64()
-                .ok_or_else(|| format!("manifest: `{k}` missing or not a number"))
-        };
-        let list = |v: &Value, k: &str| -> Result<Vec<Value>, String> {
-            v[k].as_array()
-                .cloned()
-                .ok_or_else(|| format!("manifest: `{k}` missing or not an array"))
-        };
         let mut assets = Vec::new();
         for a in list(v, "assets")? {
-            let mut cameras = Vec::new();
-            for c in list(&a, "cameras")? {
-                let t = &c["tolerance"];
-                cameras.push(CameraEntry {
-                    name: s(&c, "name")?,
-                    gltf_camera: f(&c, "gltf_camera")? as usize,
-                    width: f(&c, "width")? as u32,
-                    height: f(&c, "height")? as u32,
-                    image: s(&c, "image")?,
-                    reference_png: s(&c, "reference_png")?,
-                    reference_pfm: s(&c, "reference_pfm")?,
-                    bound_pfm: s(&c, "bound_pfm")?,
-                    tolerance: Tolerance {
-                        max_abs: f(t, "max_abs")?,
-                        min_psnr: f(t, "min_psnr")?,
-                        terms: terms_from_json(&t["terms"]),
-                    },
-                });
-            }
-            let catches = list(&a, "catches")?
-                .iter()
-                .map(|e| {
-                    e.as_str()
-                        .and_then(Erratum::from_letter)
-                        .ok_or_else(|| format!("manifest: unknown erratum {e}"))
-                })
-                .collect::<Result<_, _>>()?;
-            let checks = match a["checks"].as_str() {
-                None | Some("rc") => Checks::Rc,
-                Some("profile") => Checks::Profile,
-                Some(other) => {
-                    return Err(format!(
-                        "manifest: `checks` is {other:?}, expected \"rc\" or \"profile\""
-                    ));
-                }
-            };
-            let detects = a["detects"]
-                .as_array()
-                .map(|l| {
-                    l.iter()
-                        .filter_map(|x| x.as_str().map(str::to_owned))
-                        .collect()
-                })
-                .unwrap_or_default();
-            assets.push(AssetEntry {
-                checks,
-                detects,
-                name: s(&a, "name")?,
-                file: s(&a, "file")?,
-                cameras_json: s(&a, "cameras_json")?,
-                rule: s(&a, "rule")?,
-                rc_section: s(&a, "rc_section")?,
-                failure_means: s(&a, "failure_means")?,
-                catches,
-                optional: a["optional"].as_bool().unwrap_or(false),
-                rc_valid: a["rc_valid"].as_bool().unwrap_or(true),
-                cameras,
-            });
+            assets.push(asset_from_json(&a)?);
         }
         let bg = list(v, "background")?;
         let bgv: Vec<f64> = bg.iter().filter_map(Value::as_f64).collect();
@@ -258,7 +187,7 @@ impl Manifest {
             return Err("manifest: `background` must be 3 numbers".into());
         }
         Ok(Manifest {
-            generator: s(v, "generator")?,
+            generator: string(v, "generator")?,
             background: [bgv[0], bgv[1], bgv[2]],
             assets,
         })
@@ -284,4 +213,94 @@ impl Manifest {
 pub fn suite_path(dir: &std::path::Path, rel: &str) -> Result<std::path::PathBuf, String> {
     crate::files::contained_path(dir, std::path::Path::new(rel), false)
         .map_err(|e| format!("{rel}: {e}"))
+}
+
+/// The string at key `k` of `v`.
+fn string(v: &Value, k: &str) -> Result<String, String> {
+    v[k].as_str()
+        .map(str::to_owned)
+        .ok_or_else(|| format!("manifest: `{k}` missing or not a string"))
+}
+
+/// The number at key `k` of `v`.
+fn number(v: &Value, k: &str) -> Result<f64, String> {
+    v[k].as_f64()
+        .ok_or_else(|| format!("manifest: `{k}` missing or not a number"))
+}
+
+/// The array at key `k` of `v`.
+fn list(v: &Value, k: &str) -> Result<Vec<Value>, String> {
+    v[k].as_array()
+        .cloned()
+        .ok_or_else(|| format!("manifest: `{k}` missing or not an array"))
+}
+
+/// One asset of the manifest, its cameras first (the error names the key).
+fn asset_from_json(a: &Value) -> Result<AssetEntry, String> {
+    let mut cameras = Vec::new();
+    for c in list(a, "cameras")? {
+        cameras.push(camera_from_json(&c)?);
+    }
+    let catches = list(a, "catches")?
+        .iter()
+        .map(|e| {
+            e.as_str()
+                .and_then(Erratum::from_letter)
+                .ok_or_else(|| format!("manifest: unknown erratum {e}"))
+        })
+        .collect::<Result<_, _>>()?;
+    let checks = checks_from_json(a)?;
+    let detects = a["detects"]
+        .as_array()
+        .map(|l| {
+            l.iter()
+                .filter_map(|x| x.as_str().map(str::to_owned))
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok(AssetEntry {
+        checks,
+        detects,
+        name: string(a, "name")?,
+        file: string(a, "file")?,
+        cameras_json: string(a, "cameras_json")?,
+        rule: string(a, "rule")?,
+        rc_section: string(a, "rc_section")?,
+        failure_means: string(a, "failure_means")?,
+        catches,
+        optional: a["optional"].as_bool().unwrap_or(false),
+        rc_valid: a["rc_valid"].as_bool().unwrap_or(true),
+        cameras,
+    })
+}
+
+/// An asset's `checks`: `rc` (also when absent) or `profile`.
+fn checks_from_json(a: &Value) -> Result<Checks, String> {
+    match a["checks"].as_str() {
+        None | Some("rc") => Ok(Checks::Rc),
+        Some("profile") => Ok(Checks::Profile),
+        Some(other) => Err(format!(
+            "manifest: `checks` is {other:?}, expected \"rc\" or \"profile\""
+        )),
+    }
+}
+
+/// One camera of an asset, with its tolerance.
+fn camera_from_json(c: &Value) -> Result<CameraEntry, String> {
+    let t = &c["tolerance"];
+    Ok(CameraEntry {
+        name: string(c, "name")?,
+        gltf_camera: number(c, "gltf_camera")? as usize,
+        width: number(c, "width")? as u32,
+        height: number(c, "height")? as u32,
+        image: string(c, "image")?,
+        reference_png: string(c, "reference_png")?,
+        reference_pfm: string(c, "reference_pfm")?,
+        bound_pfm: string(c, "bound_pfm")?,
+        tolerance: Tolerance {
+            max_abs: number(t, "max_abs")?,
+            min_psnr: number(t, "min_psnr")?,
+            terms: terms_from_json(&t["terms"]),
+        },
+    })
 }

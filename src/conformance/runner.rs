@@ -196,17 +196,7 @@ fn camera_result(
 ) -> Result<CameraResult, String> {
     let c = &m.assets[ai].cameras[ci];
     let (want, bound) = reference_and_bound(dir, c)?;
-    let mut r = CameraResult {
-        camera: c.clone(),
-        comparison: None,
-        pass: false,
-        cause: None,
-        explained_by: Vec::new(),
-        against_reference: None,
-        expected: want.clone(),
-        actual: None,
-        missing: false,
-    };
+    let mut r = not_compared(c, &want);
     let img = match got {
         None => {
             r.missing = true;
@@ -235,29 +225,7 @@ fn camera_result(
     r.comparison = Some(cmp);
     if !r.pass {
         let l = loaded.get_or_insert_with(|| render::load_asset(dir, m, ai).ok());
-        let work = l.as_ref().map_or(u64::MAX, |l| {
-            (c.width as u64 * c.height as u64).saturating_mul(l.0.cloud.len() as u64)
-        });
-        let mut note = "";
-        match l.as_ref() {
-            Some(l) if work <= MAX_MODEL_WORK => {
-                if let Some(d) = allowed_choice(l, ci, c, &img, &bound) {
-                    r.pass = true;
-                    r.cause = Some(format!(
-                        "passes as a renderer that {} (the RC allows it: {})",
-                        d.describe().to_lowercase(),
-                        d.rc_section()
-                    ));
-                } else if budget.cameras_left > 0 {
-                    budget.cameras_left -= 1;
-                    r.explained_by = diagnosis::explain(&l.0.cloud, &l.1[ci], c, &img, &bound);
-                } else {
-                    note = "not diagnosed (the run's diagnosis budget is spent); ";
-                }
-            }
-            Some(_) => note = "not diagnosed (too large for the models); ",
-            None => note = "not diagnosed (the asset does not load); ",
-        }
+        let note = allow_or_explain(l.as_ref(), ci, &img, &bound, budget, &mut r);
         if !r.pass {
             r.cause = Some(format!(
                 "{} pixels over their bound (worst {ratio:.2}×); {note}",
@@ -267,6 +235,59 @@ fn camera_result(
     }
     r.actual = Some(img);
     Ok(r)
+}
+
+/// The result of camera `c` before any comparison: not passing, nothing explained.
+fn not_compared(c: &CameraEntry, want: &Image) -> CameraResult {
+    CameraResult {
+        camera: c.clone(),
+        comparison: None,
+        pass: false,
+        cause: None,
+        explained_by: Vec::new(),
+        against_reference: None,
+        expected: want.clone(),
+        actual: None,
+        missing: false,
+    }
+}
+
+/// A failing camera `ci` (of result `r`) with the image `img`, and the asset loaded as `l`:
+/// passed when it matches an RC-allowed SH cap, else explained with the models while the
+/// budget and the model's work allow; returns the note for the cause when it is not
+/// diagnosed (else empty).
+fn allow_or_explain(
+    l: Option<&(crate::load::Scene, Vec<crate::camera::Camera>)>,
+    ci: usize,
+    img: &Image,
+    bound: &[f64],
+    budget: &mut Budget,
+    r: &mut CameraResult,
+) -> &'static str {
+    let c = &r.camera;
+    let work = l.map_or(u64::MAX, |l| {
+        (c.width as u64 * c.height as u64).saturating_mul(l.0.cloud.len() as u64)
+    });
+    match l {
+        Some(l) if work <= MAX_MODEL_WORK => {
+            if let Some(d) = allowed_choice(l, ci, c, img, bound) {
+                r.pass = true;
+                r.cause = Some(format!(
+                    "passes as a renderer that {} (the RC allows it: {})",
+                    d.describe().to_lowercase(),
+                    d.rc_section()
+                ));
+            } else if budget.cameras_left > 0 {
+                budget.cameras_left -= 1;
+                r.explained_by = diagnosis::explain(&l.0.cloud, &l.1[ci], c, img, bound);
+            } else {
+                return "not diagnosed (the run's diagnosis budget is spent); ";
+            }
+            ""
+        }
+        Some(_) => "not diagnosed (too large for the models); ",
+        None => "not diagnosed (the asset does not load); ",
+    }
 }
 
 /// The failing cameras that had an image to explain.

@@ -209,6 +209,17 @@ pub(crate) fn encode(
     frame: Frame,
 ) -> Result<Vec<u8>, SpzWriteError> {
     check(cloud, o)?;
+    let blocks = attribute_blocks(cloud, o, frame);
+    let header = header(cloud, o);
+    if o.version != SpzVersion::V4 {
+        return Ok(gzip_file(header, &blocks));
+    }
+    Ok(zstd_file(header, &blocks))
+}
+
+/// The six attribute blocks of the splats, quantised in SPZ's axes: positions, opacities,
+/// colours, scales, rotations, higher SH.
+fn attribute_blocks(cloud: &SplatCloud, o: &SpzWriteOptions, frame: Frame) -> [Vec<u8>; 6] {
     let n = cloud.len();
     let flip = match o.axes {
         SpzAxes::Rub | SpzAxes::Auto => axis_flips(frame.code(), RUB),
@@ -237,14 +248,7 @@ pub(crate) fn encode(
             None => [0.0, 0.0, 0.0, 1.0],
         };
         let q = [q[0] * qs[0], q[1] * qs[1], q[2] * qs[2], q[3]];
-        if o.version != SpzVersion::V2 {
-            blocks[4].extend_from_slice(&smallest_three(q));
-        } else {
-            let w = if q[3] < 0.0 { -1.0 } else { 1.0 };
-            for c in &q[..3] {
-                blocks[4].push(byte(c * w * 127.5 + 127.5));
-            }
-        }
+        push_rotation(&mut blocks[4], q, o.version);
         for (j, c) in sh[1..].iter().enumerate() {
             let bits = if j < 3 { o.sh1_bits } else { o.sh_rest_bits };
             for v in c {
@@ -252,24 +256,51 @@ pub(crate) fn encode(
             }
         }
     }
+    debug_assert_eq!(blocks[5].len(), n * k * 3);
+    blocks
+}
+
+/// Appends the unit quaternion `q` (x, y, z, w): smallest three from version 3, else the
+/// first three bytes with `w` made positive.
+fn push_rotation(block: &mut Vec<u8>, q: [f32; 4], version: SpzVersion) {
+    if version != SpzVersion::V2 {
+        block.extend_from_slice(&smallest_three(q));
+    } else {
+        let w = if q[3] < 0.0 { -1.0 } else { 1.0 };
+        for c in &q[..3] {
+            block.push(byte(c * w * 127.5 + 127.5));
+        }
+    }
+}
+
+/// The header up to the flags byte: magic, version, splat count, SH degree, fractional
+/// bits, flags.
+fn header(cloud: &SplatCloud, o: &SpzWriteOptions) -> Vec<u8> {
     let mut header = Vec::with_capacity(32);
     header.extend_from_slice(MAGIC);
     header.extend_from_slice(&o.version.number().to_le_bytes());
-    header.extend_from_slice(&(n as u32).to_le_bytes());
+    header.extend_from_slice(&(cloud.len() as u32).to_le_bytes());
     let degree = cloud.sh_degree;
     let flags = if o.antialiased { FLAG_ANTIALIASED } else { 0 };
     header.extend_from_slice(&[degree, o.fractional_bits, flags]);
-    debug_assert_eq!(blocks[5].len(), n * k * 3);
-    if o.version != SpzVersion::V4 {
-        header.push(0);
-        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
-        let io = |r: std::io::Result<()>| r.expect("writing to a Vec cannot fail");
-        io(e.write_all(&header));
-        for b in &blocks {
-            io(e.write_all(b));
-        }
-        return Ok(e.finish().expect("writing to a Vec cannot fail"));
+    header
+}
+
+/// Versions 2 and 3: the header (with its reserved byte) and the blocks, gzipped.
+fn gzip_file(mut header: Vec<u8>, blocks: &[Vec<u8>; 6]) -> Vec<u8> {
+    header.push(0);
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    let io = |r: std::io::Result<()>| r.expect("writing to a Vec cannot fail");
+    io(e.write_all(&header));
+    for b in blocks {
+        io(e.write_all(b));
     }
+    e.finish().expect("writing to a Vec cannot fail")
+}
+
+/// Version 4: the 32-byte header, the table of (compressed, raw) sizes, then one zstd stream
+/// per non-empty block.
+fn zstd_file(mut header: Vec<u8>, blocks: &[Vec<u8>; 6]) -> Vec<u8> {
     let streams: Vec<Vec<u8>> = blocks
         .iter()
         .filter(|b| !b.is_empty())
@@ -291,5 +322,5 @@ pub(crate) fn encode(
     for z in streams {
         out.extend_from_slice(&z);
     }
-    Ok(out)
+    out
 }

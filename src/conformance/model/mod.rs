@@ -183,6 +183,29 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
     if t.z <= (NEAR_CULL).max(cam.near as f64) {
         return None;
     }
+    let (q, scale) = rotation_and_scale(cloud, i, view);
+    let ([a, b, cc, det], det0) = screen_covariance(view, t, scale, q)?;
+    let (fx, fy, cx, cy) = (cam.fx as f64, cam.fy as f64, cam.cx as f64, cam.cy as f64);
+    let (u, v) = (fx * t.x / t.z + cx, fy * t.y / t.z + cy);
+    let dir = (mean - view.eye).normalize().to_array();
+    let (color, f16_err) = colour(cloud, i, dir, view.on(Erratum::E), view.vars);
+    let opacity = model_opacity(cloud, i, view, det0, det);
+    let box_axes = view.var(Variant::BoxCut).then(|| box_half_axes(a, b, cc));
+    let (centre, rect) = centre_and_rect(view, [a, cc, det], [u, v], t.z, box_axes);
+    Some(Layer {
+        centre,
+        conic: [cc / det, -b / det, a / det],
+        opacity,
+        color,
+        f16_err,
+        rect,
+        box_axes,
+    })
+}
+
+/// Splat `i`'s rotation and scale as the deviations read them (`QuatWxyz`, erratum a,
+/// `LogScale`).
+fn rotation_and_scale(cloud: &SplatCloud, i: usize, view: &View) -> ([f32; 4], [f32; 3]) {
     let mut q = cloud.rotations[i];
     if view.var(Variant::QuatWxyz) {
         q = [q[1], q[2], q[3], q[0]]; // the stored x taken as w
@@ -196,7 +219,19 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
     } else {
         cloud.scales[i]
     };
-    let (fx, fy, cx, cy) = (cam.fx as f64, cam.fy as f64, cam.cx as f64, cam.cy as f64);
+    (q, scale)
+}
+
+/// The dilated screen covariance `[a, b, c, det]` of a splat at camera point `t` (after the
+/// `EigenvalueFloor` variant), and the undilated determinant; `None` when degenerate.
+fn screen_covariance(
+    view: &View,
+    t: DVec3,
+    scale: [f32; 3],
+    q: [f32; 4],
+) -> Option<([f64; 4], f64)> {
+    let cam = view.cam;
+    let (fx, fy) = (cam.fx as f64, cam.fy as f64);
     let txtz = (t.x / t.z).clamp(-view.lim[0], view.lim[0]);
     let tytz = (t.y / t.z).clamp(-view.lim[1], view.lim[1]);
     let j0 = DVec3::new(fx / t.z, 0.0, -fx * txtz / t.z);
@@ -216,20 +251,35 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
     if view.var(Variant::EigenvalueFloor) {
         [a, b, cc, det] = eigenvalue_floor(a, b, cc, det)?;
     }
-    let (u, v) = (fx * t.x / t.z + cx, fy * t.y / t.z + cy);
-    let dir = (mean - view.eye).normalize().to_array();
-    let (color, f16_err) = colour(cloud, i, dir, view.on(Erratum::E), view.vars);
+    Some(([a, b, cc, det], p0.cross(p1).length_squared()))
+}
+
+/// Splat `i`'s opacity as the variants store it (`Colour8Bit`) and compensate it
+/// (`AaCompensation`, by the undilated over the dilated determinant).
+fn model_opacity(cloud: &SplatCloud, i: usize, view: &View, det0: f64, det: f64) -> f64 {
     let mut opacity = cloud.opacities[i] as f64;
     if view.var(Variant::Colour8Bit) {
         opacity = (opacity * 255.0).floor() / 255.0;
     }
     if view.var(Variant::AaCompensation) {
-        let det0 = p0.cross(p1).length_squared();
         opacity *= (det0 / det).max(0.0).sqrt();
     }
-    let box_axes = view.var(Variant::BoxCut).then(|| box_half_axes(a, b, cc));
+    opacity
+}
+
+/// Where the Gaussian is evaluated and the pixels it may touch, for the projected centre
+/// `[u, v]` at depth `tz`: erratum d's quad, the box cut's, or the 3σ ellipse's bounds.
+fn centre_and_rect(
+    view: &View,
+    [a, cc, det]: [f64; 3],
+    [u, v]: [f64; 2],
+    tz: f64,
+    box_axes: Option<[[f64; 2]; 2]>,
+) -> ([f64; 2], [f64; 4]) {
+    let cam = view.cam;
+    let (fx, fy) = (cam.fx as f64, cam.fy as f64);
     let (rx, ry) = (3.0 * a.sqrt(), 3.0 * cc.sqrt());
-    let (centre, rect) = if view.on(Erratum::D) {
+    if view.on(Erratum::D) {
         // Quad ± radius/focal in NDC around the mean; centre (ndc/2 + 1/2)·w/P·2.
         let mid = 0.5 * (a + cc);
         let r = (9.0 * (mid + (mid * mid - det).max(0.1).sqrt()))
@@ -240,23 +290,14 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
             r * cam.height as f64 / (2.0 * fy),
         );
         let h = cam.height as f64;
-        let centre = [u * t.z / fx, h - (h - v) * t.z / fy];
+        let centre = [u * tz / fx, h - (h - v) * tz / fy];
         (centre, [u - hx, u + hx, v - hy, v + hy])
     } else if let Some([e1, e2]) = box_axes {
         let (hx, hy) = (e1[0].abs() + e2[0].abs(), e1[1].abs() + e2[1].abs());
         ([u, v], [u - hx, u + hx, v - hy, v + hy])
     } else {
         ([u, v], [u - rx, u + rx, v - ry, v + ry])
-    };
-    Some(Layer {
-        centre,
-        conic: [cc / det, -b / det, a / det],
-        opacity,
-        color,
-        f16_err,
-        rect,
-        box_axes,
-    })
+    }
 }
 
 /// Renders `cloud` (global space, as loaded) from `cam` over a black background with the

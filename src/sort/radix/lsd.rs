@@ -28,22 +28,60 @@ pub(super) unsafe fn sort_bucket(
     };
     // Below about an eighth of the table entries a comparison sort beats clearing and
     // prefix-summing the radix tables.
-    let entries: usize = (0..digits.passes)
-        .map(|p| digits.mask[p] as usize + 1)
-        .sum();
+    let entries: usize = (0..digits.passes).map(|p| table_len(digits, p)).sum();
     if m <= TINY.max(entries / 8) {
         // Items are distinct (the index is in the low bits): any sort is the stable one.
         a.sort_unstable();
-        for (o, &e) in out.iter_mut().zip(a.iter()) {
-            *o = e as u32;
-        }
+        copy_indices(out, a);
         return;
     }
+    count_digits(a, digits, h);
+    let (live, n_live) = live_passes(h, digits, m);
+    if n_live == 0 {
+        copy_indices(out, a);
+        return;
+    }
+    for (k, &p) in live[..n_live].iter().enumerate() {
+        let off = &mut h[p];
+        exclusive_prefix_sum(&mut off[..table_len(digits, p)]);
+        let (src, dst) = if k % 2 == 0 {
+            (&*a, &mut *b)
+        } else {
+            (&*b, &mut *a)
+        };
+        // SAFETY: the offsets come from counting these very items (`src` holds the same `m`
+        // items as `a`), and `out` and `dst` are `m` long.
+        unsafe {
+            if k + 1 == n_live {
+                scatter(src, out, off, digits, p, |e| e as u32);
+            } else {
+                scatter(src, dst, off, digits, p, |e| e);
+            }
+        }
+    }
+}
+
+/// Entries of pass `p`'s table that are used: `mask + 1`.
+#[inline(always)]
+fn table_len(digits: &Digits, p: usize) -> usize {
+    digits.mask[p] as usize + 1
+}
+
+/// Writes the indices (low 32 bits) of the items `a` to `out`, in order.
+#[inline(always)]
+fn copy_indices(out: &mut [u32], a: &[u64]) {
+    for (o, &e) in out.iter_mut().zip(a.iter()) {
+        *o = e as u32;
+    }
+}
+
+/// Clears the used part of every pass's table in `h` and counts the digits of the items `a`
+/// (both digits in one sweep for two passes).
+#[inline(always)]
+fn count_digits(a: &[u64], digits: &Digits, h: &mut [Hist]) {
     let passes = digits.passes;
-    // Only the first `mask + 1` entries of each table are used.
-    let size = |p: usize| digits.mask[p] as usize + 1;
     for (p, table) in h[..passes].iter_mut().enumerate() {
-        table[..size(p)].fill(0);
+        table[..table_len(digits, p)].fill(0);
     }
     if let [h0, h1, ..] = h {
         if passes == 2 {
@@ -62,53 +100,59 @@ pub(super) unsafe fn sort_bucket(
             }
         }
     }
+}
+
+/// The passes whose digit is not the same for all `m` items (the others are skipped), and
+/// how many there are.
+#[inline(always)]
+fn live_passes(h: &[Hist], digits: &Digits, m: usize) -> ([usize; MAX_PASSES], usize) {
     let mut live = [0usize; MAX_PASSES];
     let mut n_live = 0;
-    for p in 0..passes {
-        if !h[p][..size(p)].iter().any(|&c| c as usize == m) {
+    for p in 0..digits.passes {
+        if !h[p][..table_len(digits, p)]
+            .iter()
+            .any(|&c| c as usize == m)
+        {
             live[n_live] = p;
             n_live += 1;
         }
     }
-    if n_live == 0 {
-        for (o, &e) in out.iter_mut().zip(a.iter()) {
-            *o = e as u32;
-        }
-        return;
+    (live, n_live)
+}
+
+/// Turns the counts `off` into exclusive prefix sums: each digit's first position.
+#[inline(always)]
+fn exclusive_prefix_sum(off: &mut [u32]) {
+    let mut sum = 0;
+    for c in off.iter_mut() {
+        let count = *c;
+        *c = sum;
+        sum += count;
     }
-    for (k, &p) in live[..n_live].iter().enumerate() {
-        let off = &mut h[p];
-        let mut sum = 0;
-        for c in off[..size(p)].iter_mut() {
-            let count = *c;
-            *c = sum;
-            sum += count;
-        }
-        let (src, dst) = if k % 2 == 0 {
-            (&*a, &mut *b)
-        } else {
-            (&*b, &mut *a)
-        };
-        // The offsets come from counting these very items, so every position is `< m`.
-        if k + 1 == n_live {
-            for &e in src {
-                let d = digits.digit(e, p);
-                let pos = off[d] as usize;
-                off[d] += 1;
-                debug_assert!(pos < m);
-                // SAFETY: `pos < m = out.len()` (see above).
-                unsafe { *out.get_unchecked_mut(pos) = e as u32 };
-            }
-        } else {
-            for &e in src {
-                let d = digits.digit(e, p);
-                let pos = off[d] as usize;
-                off[d] += 1;
-                debug_assert!(pos < m);
-                // SAFETY: `pos < m = dst.len()` (see above).
-                unsafe { *dst.get_unchecked_mut(pos) = e };
-            }
-        }
+}
+
+/// One scatter of an LSD pass: each item `e` of `src` in order goes to `dst` as `item(e)` at
+/// the running offset `off` of its digit `p`.
+///
+/// # Safety
+/// `off` holds the exclusive prefix sums of the digit-`p` counts of exactly the items of
+/// `src` (so every position is `< src.len()`), and `dst` is at least `src.len()` long.
+#[inline(always)]
+unsafe fn scatter<T>(
+    src: &[u64],
+    dst: &mut [T],
+    off: &mut Hist,
+    digits: &Digits,
+    p: usize,
+    item: impl Fn(u64) -> T,
+) {
+    for &e in src {
+        let d = digits.digit(e, p);
+        let pos = off[d] as usize;
+        off[d] += 1;
+        debug_assert!(pos < dst.len());
+        // SAFETY: `pos < src.len() <= dst.len()` (see the contract).
+        unsafe { *dst.get_unchecked_mut(pos) = item(e) };
     }
 }
 

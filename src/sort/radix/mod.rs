@@ -203,35 +203,50 @@ impl RadixBuffers {
     /// visible splats) `ids[position]` — carried through the passes instead of a remap after.
     pub(crate) fn sort(&mut self, n: usize, t: usize, max_digit: u32, ids: Option<&[u32]>) {
         let ids = ids.map(|v| &v[..n]);
-        let id = |j: usize| ids.map_or(j as u32, |v| v[j]);
         let (kmin, kmax) = self.minmax[..t]
             .iter()
             .fold((u32::MAX, 0), |(a, b), &(l, h)| (a.min(l), b.max(h)));
-        let out = &mut self.out[..n];
         if n == 0 || kmin == kmax {
-            for (i, o) in out.iter_mut().enumerate() {
-                *o = id(i);
+            for (i, o) in self.out[..n].iter_mut().enumerate() {
+                *o = id(ids, i);
             }
             return;
         }
         let rbits = 32 - (kmax - kmin).leading_zeros();
         let msd_bits = rbits.min(MSD_BITS);
         let low = rbits - msd_bits;
+        let msd = |k: u32| msd_digit(k, kmin, low);
+        msd_offsets(
+            &self.keys[..n],
+            &mut self.hist[..t * STRIDE],
+            &mut self.starts[..=BUCKETS],
+            t,
+            msd,
+        );
+        self.msd_scatter(n, t, kmin, low, ids);
+        if low == 0 {
+            return;
+        }
+        let digits = Digits::new(low, max_digit);
+        let big = if t > 1 { n / (2 * t) } else { usize::MAX };
+        self.sort_small_buckets(n, t, big, &digits);
+        self.sort_big_buckets(n, t, big, &digits);
+    }
+
+    /// Step 3, the MSD scatter: every chunk writes its items to its own offsets (from
+    /// [`msd_offsets`]), as `((k − kmin) << 32) | id` into A, or with no `low` bits left as
+    /// the ids straight into `out`.
+    fn msd_scatter(&mut self, n: usize, t: usize, kmin: u32, low: u32, ids: Option<&[u32]>) {
         let keys = &self.keys[..n];
         let hist = &mut self.hist[..t * STRIDE];
-        let msd = |k: u32| ((k - kmin) >> low) as usize & (BUCKETS - 1);
-        let starts = &mut self.starts[..=BUCKETS];
-        msd_offsets(keys, hist, starts, t, msd);
-
-        // MSD scatter.
         let a = SharedMut(self.a.as_mut_ptr());
-        let o = SharedMut(out.as_mut_ptr());
+        let o = SharedMut(self.out[..n].as_mut_ptr());
         hist.par_chunks_mut(STRIDE).enumerate().for_each(|(c, h)| {
             let off = &mut h[MAX_PASSES];
             let range = chunk_range(c, t, n);
             let base = range.start;
             for (i, &k) in keys[range].iter().enumerate() {
-                let d = msd(k);
+                let d = msd_digit(k, kmin, low);
                 let pos = off[d] as usize;
                 off[d] += 1;
                 // SAFETY: chunk `c` owns positions `[start_d + Σ_{c'<c} count[c'][d], … +
@@ -240,32 +255,33 @@ impl RadixBuffers {
                 debug_assert!(pos < n);
                 unsafe {
                     if low == 0 {
-                        o.get().add(pos).write(id(base + i));
+                        o.get().add(pos).write(id(ids, base + i));
                     } else {
                         a.get()
                             .add(pos)
-                            .write((u64::from(k - kmin) << 32) | u64::from(id(base + i)));
+                            .write((u64::from(k - kmin) << 32) | u64::from(id(ids, base + i)));
                     }
                 }
             }
         });
-        if low == 0 {
-            return;
-        }
+    }
 
-        // Buckets: small ones in `t` groups of about equal element count, big ones after.
-        let digits = Digits::new(low, max_digit);
-        let big = if t > 1 { n / (2 * t) } else { usize::MAX };
+    /// Step 4, small buckets (at most `big` items): in `t` groups of about equal element
+    /// count, one task per group, each bucket sorted by [`sort_bucket`] into `out`.
+    fn sort_small_buckets(&mut self, n: usize, t: usize, big: usize, digits: &Digits) {
+        let starts = &self.starts[..=BUCKETS];
         let size = |d: usize| (starts[d + 1] - starts[d]) as usize;
         let small_total: usize = (0..BUCKETS).map(size).filter(|&m| m <= big).sum();
         let groups = &mut self.groups[..=t];
         group_buckets(groups, small_total, big, t, size);
-        let starts = &*starts;
         let groups = &*groups;
+        let a = SharedMut(self.a.as_mut_ptr());
+        let o = SharedMut(self.out[..n].as_mut_ptr());
         // Each task's scratch for the middle passes: its own slice of B (B is free until the
         // big buckets), reused bucket after bucket so it stays in L1/L2.
         let cap = big.min(n).max(1);
-        hist.par_chunks_mut(STRIDE)
+        self.hist[..t * STRIDE]
+            .par_chunks_mut(STRIDE)
             .zip(self.b[..t * cap].par_chunks_mut(cap))
             .enumerate()
             .for_each(|(c, (h, tmp))| {
@@ -275,18 +291,37 @@ impl RadixBuffers {
                         // SAFETY: bucket `d` is the range `s..e` of A and `out`; buckets are
                         // disjoint and each is handled by exactly one task (its group), so
                         // this task has exclusive access to those ranges.
-                        unsafe { sort_bucket(a, &mut tmp[..e - s], o, s, &digits, h) };
+                        unsafe { sort_bucket(a, &mut tmp[..e - s], o, s, digits, h) };
                     }
                 }
             });
+    }
+
+    /// Step 4, big buckets (more than `big` items): each sorted with parallel chunked LSD
+    /// passes ([`parallel_lsd`]) into `out`.
+    fn sort_big_buckets(&mut self, n: usize, t: usize, big: usize, digits: &Digits) {
+        let out = &mut self.out[..n];
+        let hist = &mut self.hist[..t * STRIDE];
         for d in 0..BUCKETS {
-            let (s, e) = (starts[d] as usize, starts[d + 1] as usize);
+            let (s, e) = (self.starts[d] as usize, self.starts[d + 1] as usize);
             if e - s > big {
                 let (a, b) = (&mut self.a[s..e], &mut self.b[s..e]);
-                parallel_lsd(a, b, &mut out[s..e], hist, t, &digits);
+                parallel_lsd(a, b, &mut out[s..e], hist, t, digits);
             }
         }
     }
+}
+
+/// The id of position `j`: `ids[j]`, or `j` itself without `ids`.
+#[inline(always)]
+fn id(ids: Option<&[u32]>, j: usize) -> u32 {
+    ids.map_or(j as u32, |v| v[j])
+}
+
+/// The MSD digit of key `k`: the top bits of `k − kmin` above its `low` bits.
+#[inline(always)]
+fn msd_digit(k: u32, kmin: u32, low: u32) -> usize {
+    ((k - kmin) >> low) as usize & (BUCKETS - 1)
 }
 
 /// MSD counts per chunk (`h[MAX_PASSES]` of every chunk's tables, counted over four

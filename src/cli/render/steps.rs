@@ -1,0 +1,140 @@
+//! The steps of [`super::go`], the `render` command's main path: the scene, the size check,
+//! the render options, the render loop with its camera lines, the summary's target.
+
+use super::super::camera_args::{camera_json_line, look_at_line};
+use super::super::progress::Progress;
+use super::super::render_out::Outputs;
+use super::{Args, SortArg, load};
+use splatgl::SplatCloud;
+use splatgl::camera::{Camera, GltfPerspective};
+use splatgl::engine::Engine;
+use splatgl::load::Format;
+use splatgl::reference::{RenderOptions, SortMode};
+
+/// The scene to render (the file's cloud, format and camera nodes, or the bundled default
+/// scene), with the load options checked against its format.
+pub(super) fn load_scene(
+    a: &Args,
+    progress: Progress,
+) -> Result<(SplatCloud, Option<Format>, Vec<GltfPerspective>), String> {
+    let (cloud, format, cameras) = match &a.scene {
+        Some(p) => {
+            progress.stage(&format!("loading {}", p.display()));
+            let s = load(p, a, progress)?;
+            (s.cloud, Some(s.report.format), s.cameras)
+        }
+        None => (splatgl::synthetic::default_scene(), None, Vec::new()),
+    };
+    let file = a
+        .scene
+        .as_ref()
+        .map_or(String::new(), |p| p.display().to_string());
+    a.load.common.check_applies(&file, format)?;
+    Ok((cloud, format, cameras))
+}
+
+/// Refuses views whose image size is outside `1..=16384` per side.
+pub(super) fn check_image_sizes(views: &[(Camera, f32)]) -> Result<(), String> {
+    for (cam, _) in views {
+        // cameras.json sizes and derived sizes are bounded like the flags (an image is 16
+        // bytes per pixel in f32).
+        if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
+            return Err(format!(
+                "image size {}x{} is outside 1..=16384 per side; give --width/--height",
+                cam.width, cam.height
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The reference's render options from the flags and the parsed background.
+pub(super) fn render_options(a: &Args, bg: [f32; 3]) -> RenderOptions {
+    RenderOptions {
+        sh_degree: a.sh_degree,
+        background: bg,
+        sort: match a.sort {
+            SortArg::Distance => SortMode::Distance,
+            SortArg::ViewDepth => SortMode::ViewDepth,
+        },
+        ..Default::default()
+    }
+}
+
+/// Renders and writes every view with its progress and camera lines (a batch's cameras.json
+/// printed at the end); returns the last image's visible count.
+pub(super) fn render_views(
+    a: &Args,
+    out: &Outputs,
+    engine: &mut Engine,
+    cloud: &SplatCloud,
+    views: &[(Camera, f32)],
+    opts: &RenderOptions,
+    progress: Progress,
+) -> Result<Option<usize>, String> {
+    let batch = a.batch();
+    let mut visible = None;
+    let mut entries = Vec::new();
+    for (i, (cam, distance)) in views.iter().enumerate() {
+        if batch {
+            progress.step("rendering", i, views.len());
+        } else {
+            progress.stage("rendering");
+        }
+        let (img, v) = engine.render(cloud, cam, opts)?;
+        visible = v;
+        out.write(&img, i)?;
+        progress.clear();
+        report_view(a, out, i, cam, *distance, &mut entries);
+    }
+    if batch {
+        progress.step("rendering", views.len(), views.len());
+        progress.clear();
+        if a.cam.print_camera_json {
+            // One cameras.json for the batch: `--camera` on it with `--view all` renders it again.
+            println!("{}", serde_json::Value::Array(entries));
+        }
+    }
+    Ok(visible)
+}
+
+/// View `i`'s camera line, and its `--print-camera-json` line (one image) or cameras.json
+/// entry (a batch, pushed to `entries`).
+fn report_view(
+    a: &Args,
+    out: &Outputs,
+    i: usize,
+    cam: &Camera,
+    distance: f32,
+    entries: &mut Vec<serde_json::Value>,
+) {
+    let batch = a.batch();
+    let index = if batch {
+        format!("[{i}] ")
+    } else {
+        String::new()
+    };
+    a.say(format!("camera: {index}{}", look_at_line(cam, distance)));
+    if a.cam.print_camera_json && !batch {
+        println!("{}", camera_json_line(cam));
+    } else if a.cam.print_camera_json {
+        let name = out
+            .path(i)
+            .and_then(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()));
+        entries.push(cam.to_3dgs_json(i as i64, &name.unwrap_or_default()));
+    }
+}
+
+/// Where the summary says the images went: the one output, or a batch's count and range.
+pub(super) fn describe_target(out: &Outputs, n: usize, batch: bool) -> String {
+    if batch {
+        format!(
+            "{} images -> {} .. {}",
+            n,
+            out.describe(0),
+            out.describe(n - 1)
+        )
+    } else {
+        out.describe(0)
+    }
+}
