@@ -20,7 +20,6 @@
 //!
 //! Every comparison is written so that NaN keeps the splat (the backends decide).
 
-
 mod crop;
 pub use crop::CropBox;
 

@@ -517,7 +517,10 @@ fn crop_box_keeps_what_splat_transform_filter_box_keeps() {
     std::fs::write(&input, to_inria_ply(&cloud)).unwrap();
     let ply = load(&input);
     let (lo, hi) = ([-2.0f32, -1.5, -2.5], [1.8, 2.2, 1.0]);
-    let arg = format!("{},{},{},{},{},{}", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    let arg = format!(
+        "{},{},{},{},{},{}",
+        lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
+    );
     let out = dir.join("cropped.ply");
     convert(&st, &input, &out, &["-B", &arg]);
     let theirs = load(&out);
@@ -527,8 +530,15 @@ fn crop_box_keeps_what_splat_transform_filter_box_keeps() {
     }
     .apply(&ply)
     .expect("the box leaves some splats out");
-    assert!(ours.len() > 100 && ours.len() < ply.len() - 100, "{}", ours.len());
+    assert!(
+        ours.len() > 100 && ours.len() < ply.len() - 100,
+        "{}",
+        ours.len()
+    );
     assert_eq!(theirs.len(), ours.len(), "splats kept");
-    assert_eq!(theirs.positions, ours.positions, "the same splats, in order");
+    assert_eq!(
+        theirs.positions, ours.positions,
+        "the same splats, in order"
+    );
     eprintln!("crop: {} of {} kept by both", ours.len(), ply.len());
 }

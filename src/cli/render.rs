@@ -57,6 +57,14 @@ pub struct Args {
     /// Highest SH degree to evaluate, 0..=3 (the file's degree caps it).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(0..=3))]
     pub sh_degree: u8,
+    /// The kernel: `auto` is antialiased when the file says it was trained so (SPZ flag 0x1);
+    /// `on` scales each opacity by √(det Σ' / det(Σ' + 0.3 I)) (docs/rendering-profile.md).
+    #[arg(long, value_enum, default_value_t = super::kernel::AntialiasArg::Auto)]
+    pub antialiased: super::kernel::AntialiasArg,
+    /// Draw only the splats whose mean lies in this box (scene coordinates, both ends
+    /// included; splat-transform's --filter-box order). The default view frames what is left.
+    #[arg(long, value_name = "minx,miny,minz,maxx,maxy,maxz", value_parser = splatgl::cull::CropBox::parse, allow_hyphen_values = true)]
+    pub crop: Option<splatgl::cull::CropBox>,
     /// Background colour as it appears in the output image (display values in [0, 1]; for
     /// lin_rec709_display clouds it is decoded before blending so it comes out unchanged).
     #[arg(
@@ -292,20 +300,27 @@ fn go(a: &Args) -> Result<(), String> {
     let (out, wanted, bg) = preflight(a)?;
     let inputs = a.inputs();
     let progress = Progress::new(a.quiet, a.progress);
-    let (cloud, format, cameras) = load_scene(a, progress)?;
+    let loaded = load_scene(a, progress)?;
+    let cloud = loaded.cloud;
     let scene = SceneView {
         cloud: &cloud,
-        format,
-        cameras: &cameras,
+        format: loaded.format,
+        cameras: &loaded.cameras,
     };
     let views = views(a, scene)?;
     check_image_sizes(&views)?;
     out.check_files(views.len(), &inputs, a.force)?;
-    let opts = render_options(a, bg);
+    let opts = render_options(a, bg, loaded.trained_antialiased);
     let t1 = Instant::now();
     let (mut engine, why) = wanted.engine(&cloud, &opts)?;
     if a.verbose {
         eprintln!("backend: {} ({why})", engine.name());
+        let kernel = if opts.antialiased {
+            "antialiased"
+        } else {
+            "plain"
+        };
+        eprintln!("kernel: {kernel} (--antialiased {:?})", a.antialiased);
     }
     let visible = render_views(a, &out, &mut engine, &cloud, &views, &opts, progress)?;
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;

@@ -273,7 +273,11 @@ impl App {
             l.cloud.len(),
             l.cloud.sh_degree,
             up.name(),
-            if self.settings.antialiased { "antialiased" } else { "plain" }
+            if self.settings.antialiased {
+                "antialiased"
+            } else {
+                "plain"
+            }
         );
         self.shown = Some(Shown {
             name,

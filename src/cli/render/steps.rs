@@ -13,24 +13,49 @@ use splatgl::reference::{RenderOptions, SortMode};
 
 /// The scene to render (the file's cloud, format and camera nodes, or the bundled default
 /// scene), with the load options checked against its format.
-pub(super) fn load_scene(
-    a: &Args,
-    progress: Progress,
-) -> Result<(SplatCloud, Option<Format>, Vec<GltfPerspective>), String> {
-    let (cloud, format, cameras) = match &a.scene {
+pub(super) fn load_scene(a: &Args, progress: Progress) -> Result<LoadedScene, String> {
+    let (cloud, format, cameras, trained_antialiased) = match &a.scene {
         Some(p) => {
             progress.stage(&format!("loading {}", p.display()));
             let s = load(p, a, progress)?;
-            (s.cloud, Some(s.report.format), s.cameras)
+            let trained = s.report.trained_antialiased();
+            (s.cloud, Some(s.report.format), s.cameras, trained)
         }
-        None => (splatgl::synthetic::default_scene(), None, Vec::new()),
+        None => (splatgl::synthetic::default_scene(), None, Vec::new(), false),
     };
     let file = a
         .scene
         .as_ref()
         .map_or(String::new(), |p| p.display().to_string());
     a.load.common.check_applies(&file, format)?;
-    Ok((cloud, format, cameras))
+    let cloud = match a.crop.and_then(|b| b.apply(&cloud)) {
+        Some(c) if c.is_empty() => {
+            return Err(format!(
+                "--crop: none of the {} splats is inside the box",
+                cloud.len()
+            ));
+        }
+        Some(c) => c,
+        None => cloud,
+    };
+    Ok(LoadedScene {
+        cloud,
+        format,
+        cameras,
+        trained_antialiased,
+    })
+}
+
+/// The scene `render` draws: the file's splats (inside `--crop`), format and cameras.
+pub(super) struct LoadedScene {
+    /// The splats inside the crop box.
+    pub(super) cloud: SplatCloud,
+    /// The file's format (`None`: the default scene).
+    pub(super) format: Option<Format>,
+    /// The file's glTF cameras.
+    pub(super) cameras: Vec<GltfPerspective>,
+    /// The file's SPZ antialiasing flag (`--antialiased auto`).
+    pub(super) trained_antialiased: bool,
 }
 
 /// Refuses views whose image size is outside `1..=16384` per side.
@@ -49,9 +74,10 @@ pub(super) fn check_image_sizes(views: &[(Camera, f32)]) -> Result<(), String> {
 }
 
 /// The reference's render options from the flags and the parsed background.
-pub(super) fn render_options(a: &Args, bg: [f32; 3]) -> RenderOptions {
+pub(super) fn render_options(a: &Args, bg: [f32; 3], trained_antialiased: bool) -> RenderOptions {
     RenderOptions {
         sh_degree: a.sh_degree,
+        antialiased: a.antialiased.mode().resolve(trained_antialiased),
         background: bg,
         sort: match a.sort {
             SortArg::Distance => SortMode::Distance,
