@@ -53,8 +53,10 @@ fn info_auto(file: &Path) -> bool {
 fn antialiased_auto_follows_the_spz_flag_and_on_changes_the_image() {
     let d = dir("aa");
     let cloud = splatgl::synthetic::random_cloud(400, 1, 0.6, 12);
-    let mut o = splatgl::write::SpzWriteOptions::default();
-    o.antialiased = true;
+    let mut o = splatgl::write::SpzWriteOptions {
+        antialiased: true,
+        ..Default::default()
+    };
     let flagged = d.join("flagged.spz");
     std::fs::write(&flagged, splatgl::write::to_spz_with(&cloud, &o).unwrap()).unwrap();
     o.antialiased = false;
