@@ -5,9 +5,9 @@
 //! **Budget rule** (one for every compressed format): for an input of `L` bytes, the data it
 //! decompresses or decodes to plus the cloud built from it take at most the smaller of
 //! [`BUDGET_BASE`] + [`BUDGET_PER_INPUT_BYTE`] × `L` bytes (16 MiB + 64 × L) and
-//! [`Limits::max_decompressed_bytes`] (4 GiB by default, the embedder's cap) — [`budget_for`].
+//! [`Limits::max_decompressed_bytes`](crate::files::Limits::max_decompressed_bytes) (4 GiB by default, the embedder's cap) — [`budget_for`].
 //! Sizes claimed by headers are checked against it (and splat counts against
-//! [`Limits::max_splats`]) before anything is allocated, and decompression stops as soon as it
+//! [`Limits::max_splats`](crate::files::Limits::max_splats)) before anything is allocated, and decompression stops as soon as it
 //! would pass it, so a gzip bomb or a header that lies about its count costs at most that much
 //! memory. The input is the file (SPZ, SOG bundle), the meta.json and textures of an unbundled
 //! SOG together, or one glTF SPZ payload.
