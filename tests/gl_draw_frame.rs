@@ -60,14 +60,20 @@ fn context() -> Option<HeadlessContext> {
     Some(ctx)
 }
 
+/// A renderer with `cloud` uploaded, drawing without a depth test (the targets have none).
+fn uploaded(gl: &glow::Context, cloud: &SplatCloud) -> SplatRenderer {
+    let mut r = SplatRenderer::new(gl).unwrap();
+    r.settings_mut().depth_test = false;
+    r.upload(gl, cloud).unwrap();
+    r
+}
+
 #[test]
 fn draw_frame_draws_what_the_full_order_draws() {
     let Some(ctx) = context() else { return };
     let gl = ctx.gl();
     let (cloud, cam) = scene();
-    let mut r = SplatRenderer::new(gl).unwrap();
-    r.settings_mut().depth_test = false;
-    r.upload(gl, &cloud).unwrap();
+    let mut r = uploaded(gl, &cloud);
     let view = cam.gl_view();
     let eye = cam.eye().to_array();
     let full = Sorter::new()
@@ -97,9 +103,7 @@ fn draw_frame_in_the_background_draws_exact_or_bounded_orders() {
     let Some(ctx) = context() else { return };
     let gl = ctx.gl();
     let (cloud, cam) = scene();
-    let mut r = SplatRenderer::new(gl).unwrap();
-    r.settings_mut().depth_test = false;
-    r.upload(gl, &cloud).unwrap();
+    let mut r = uploaded(gl, &cloud);
     let (view, proj) = (cam.gl_view(), cam.gl_projection());
     let want = image(gl, &mut r, |r| r.draw_frame(gl, view, proj, VIEWPORT));
     // Strict: only provably exact orders are drawn, so the image is the synchronous one.

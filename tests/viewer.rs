@@ -290,14 +290,24 @@ impl Viewer {
     }
 }
 
-/// `splatgl render --backend gl --target rgba16f` of the default scene from [`CAMERA`]
+/// `splatgl render --backend gl --target rgba16f` of the default scene from [`CAMERA`] (and
+/// `extra` options)
 /// (None when there is no EGL here).
-fn reference(cwd: &Path) -> Option<Image> {
+fn reference(cwd: &Path, extra: &[&str]) -> Option<Image> {
     let out = cwd.join("reference.png");
     let o = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args(["render", "--backend", "gl", "--target", "rgba16f", "-o"])
+        .args([
+            "render",
+            "--backend",
+            "gl",
+            "--target",
+            "rgba16f",
+            "-f",
+            "-o",
+        ])
         .arg(&out)
         .args(CAMERA)
+        .args(extra)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
@@ -330,7 +340,7 @@ fn viewer_shows_the_render_and_mouse_input_moves_the_camera() {
         return;
     }
     let cwd = dir("render");
-    let Some(want) = reference(&cwd) else {
+    let Some(want) = reference(&cwd, &[]) else {
         return;
     };
     let x = x_server();
@@ -426,7 +436,7 @@ fn failed_drop_keeps_the_previous_scene() {
         return;
     }
     let cwd = dir("drop");
-    let Some(want) = reference(&cwd) else {
+    let Some(want) = reference(&cwd, &[]) else {
         return;
     };
     let ply = splatgl::write::to_inria_ply(&splatgl::synthetic::default_scene());
@@ -448,6 +458,31 @@ fn failed_drop_keeps_the_previous_scene() {
         p >= 40.0,
         "after the failed load: {p} dB against the previous scene"
     );
+    v.quit();
+    std::fs::remove_dir_all(&cwd).ok();
+}
+
+/// `view --crop` shows what `render --crop` renders with the same options (≥ 40 dB), and the
+/// box removes splats that show (the cropped render is far from the whole one).
+#[test]
+fn crop_box_removes_the_same_splats_in_view_and_render() {
+    let _x = X_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    if !tools_or_skip() {
+        return;
+    }
+    let cwd = dir("crop");
+    let crop = ["--crop", "0,-100,-100,100,100,100"]; // the half x ≥ 0
+    let Some(whole) = reference(&cwd, &[]) else {
+        return;
+    };
+    let want = reference(&cwd, &crop).unwrap();
+    let x = x_server();
+    let mut v = Viewer::start(&x, &cwd, &[&CAMERA[..], &crop, &["--sort-sync"]].concat());
+    let shot = v.screenshot(&cwd);
+    let (p_view, p_whole) = (psnr(&shot, &want), psnr(&want, &whole));
+    eprintln!("view --crop vs render --crop: {p_view:.1} dB; cropped vs whole: {p_whole:.1} dB");
+    assert!(p_view >= 40.0, "view --crop vs render --crop: {p_view} dB");
+    assert!(p_whole < 30.0, "the crop removed little: {p_whole} dB");
     v.quit();
     std::fs::remove_dir_all(&cwd).ok();
 }
