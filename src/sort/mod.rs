@@ -41,6 +41,7 @@ pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
 pub use quantize::quantized_bucket_width;
 pub use reuse::Outcome;
+#[cfg(feature = "gl")]
 pub(crate) use stale::StaleOrders;
 pub use stale::{Freshness, StaleBound};
 

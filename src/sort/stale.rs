@@ -93,6 +93,7 @@ pub enum Freshness {
 
 /// The decision for one frame: the order's eye moved `moved` from the request it was sorted
 /// for, which has exact radius `exact`; tolerance `tau`.
+#[cfg_attr(not(feature = "gl"), allow(dead_code))] // the users are GL's
 pub(crate) fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
     if moved <= exact {
         Some(Freshness::Exact)
@@ -108,6 +109,7 @@ pub(crate) fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
 /// Orders from a background sorter: an [`AsyncSorter`] over the cloud's positions with
 /// [`Reuse::MotionBound`], and the staleness rule.
 #[derive(Debug)]
+#[cfg_attr(not(feature = "gl"), allow(dead_code))] // the users are GL's
 pub(crate) struct StaleOrders {
     sorter: AsyncSorter,
     tau: f32,
@@ -116,6 +118,7 @@ pub(crate) struct StaleOrders {
     generation: u64,
 }
 
+#[cfg_attr(not(feature = "gl"), allow(dead_code))]
 impl StaleOrders {
     /// A sorter thread for `positions`; `tau` from [`StaleBound::tolerance`]; `sync` makes
     /// every frame wait (`--sort-sync`).
