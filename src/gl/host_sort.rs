@@ -102,6 +102,34 @@ impl SplatRenderer {
         self.host_sort.as_ref().and_then(|h| h.last)
     }
 
+    /// Sorts the uploaded cloud back to front for `camera` drawn into a viewport of its own
+    /// size — only the splats its frustum may see when `cull` (the same image) — and uploads
+    /// the order: what the headless renderer draws. Uses the positions and cull radii kept by
+    /// [`SplatRenderer::upload`].
+    pub(crate) fn sort_for_camera(
+        &mut self,
+        gl: &glow::Context,
+        camera: &crate::camera::Camera,
+        cull: bool,
+    ) -> Result<(), GlError> {
+        let Some(mut host) = self.host_sort.take() else {
+            return Err(GlError::NotUploaded);
+        };
+        let eye = camera.eye().to_array();
+        let order = if cull && camera.width > 0 && camera.height > 0 {
+            let viewport = [0, 0, camera.width as i32, camera.height as i32];
+            let frustum = super::frustum_for_camera(camera, viewport);
+            let request = SortRequest::distance(eye);
+            host.sorter
+                .sort_visible(&host.positions, &host.bounds, &frustum, &request)
+        } else {
+            host.sorter.sort_by_distance(&host.positions, eye)
+        };
+        let result = self.set_order(gl, order);
+        self.host_sort = Some(host);
+        result
+    }
+
     fn sort_and_upload(
         &mut self,
         gl: &glow::Context,

@@ -4,11 +4,9 @@
 use super::{HeadlessContext, HeadlessError};
 use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
-use crate::cull::CullBounds;
 use crate::gl::frame::{Blend, FrameTargets, Output};
-use crate::gl::{DrawPath, DrawSettings, Errata, SplatRenderer, frustum_for_camera};
+use crate::gl::{DrawPath, DrawSettings, Errata, SplatRenderer};
 use crate::image::Image;
-use crate::sort::{SortRequest, Sorter};
 use glow::HasContext;
 
 /// Which framebuffer the splats are blended in.
@@ -42,7 +40,8 @@ pub struct HeadlessOptions {
 
 /// A headless context with a [`SplatRenderer`], an uploaded cloud and cached framebuffers.
 ///
-/// The sorter works on the positions of the cloud given to [`HeadlessRenderer::upload`], the
+/// The renderer sorts the cloud given to [`HeadlessRenderer::upload`] (its own copy of the
+/// positions and cull radii, as for [`SplatRenderer::draw_frame`]), the
 /// only way to upload: the renderer is reachable read-only ([`HeadlessRenderer::renderer`]),
 /// so the order can never be computed for another cloud than the one drawn. Each render
 /// passes its own [`DrawSettings`]; the renderer's settings are never changed.
@@ -52,13 +51,9 @@ pub struct HeadlessOptions {
 pub struct HeadlessRenderer {
     renderer: SplatRenderer,
     targets: FrameTargets,
-    /// Means and cull radii of the uploaded cloud, for the sorter.
-    positions: Vec<[f32; 3]>,
-    bounds: CullBounds,
     /// Sort only the splats the camera may see (off for erratum variants, which must draw
     /// exactly as before the cull).
     cull: bool,
-    sorter: Sorter,
     // Declared last: dropped after the GL objects above are deleted in `Drop`.
     ctx: HeadlessContext,
 }
@@ -91,10 +86,7 @@ impl HeadlessRenderer {
         Ok(HeadlessRenderer {
             renderer,
             targets: FrameTargets::default(),
-            positions: Vec::new(),
-            bounds: CullBounds::default(),
             cull: errata == Errata::default(),
-            sorter: Sorter::new(),
             ctx,
         })
     }
@@ -113,9 +105,6 @@ impl HeadlessRenderer {
     pub fn upload(&mut self, cloud: &SplatCloud) -> Result<(), HeadlessError> {
         self.ctx.make_current()?;
         self.renderer.upload(self.ctx.gl(), cloud)?;
-        self.positions.clear();
-        self.positions.extend_from_slice(&cloud.positions);
-        self.bounds = CullBounds::new(cloud);
         Ok(())
     }
 
@@ -136,21 +125,13 @@ impl HeadlessRenderer {
         camera: &Camera,
         opts: &HeadlessOptions,
     ) -> Result<Image, HeadlessError> {
-        // The sorter is taken out while its order is drawn (a move, no allocation).
-        let mut sorter = std::mem::take(&mut self.sorter);
-        let eye = camera.eye().to_array();
-        // (A 0-sized camera renders no pixel: nothing to cull for.)
-        let order = if self.cull && camera.width > 0 && camera.height > 0 {
-            let viewport = [0, 0, camera.width as i32, camera.height as i32];
-            let frustum = frustum_for_camera(camera, viewport);
-            let request = SortRequest::distance(eye);
-            sorter.sort_visible(&self.positions, &self.bounds, &frustum, &request)
-        } else {
-            sorter.sort_by_distance(&self.positions, eye)
-        };
-        let result = self.render_with_order(camera, opts, order);
-        self.sorter = sorter;
-        result
+        self.ctx.make_current()?;
+        if camera.width > 0 && camera.height > 0 {
+            // The renderer's own sort of the cloud it holds (no copy of it here).
+            self.renderer
+                .sort_for_camera(self.ctx.gl(), camera, self.cull)?;
+        }
+        self.draw_uploaded_order(camera, opts)
     }
 
     /// Renders the uploaded cloud in the given order (first index drawn first).
@@ -161,6 +142,18 @@ impl HeadlessRenderer {
         order: &[u32],
     ) -> Result<Image, HeadlessError> {
         self.ctx.make_current()?;
+        if camera.width > 0 && camera.height > 0 {
+            self.renderer.set_order(self.ctx.gl(), order)?;
+        }
+        self.draw_uploaded_order(camera, opts)
+    }
+
+    /// Draws the order last uploaded into the cached target and reads it back.
+    fn draw_uploaded_order(
+        &mut self,
+        camera: &Camera,
+        opts: &HeadlessOptions,
+    ) -> Result<Image, HeadlessError> {
         let (w, h) = (camera.width, camera.height);
         if w == 0 || h == 0 {
             return Ok(Image::filled(w, h, [0.0; 4])); // no pixels (a 0-sized FBO is incomplete)
@@ -177,7 +170,6 @@ impl HeadlessRenderer {
             TargetKind::Rgba16fResolve => Blend::Rgba16f,
         };
         let gl = self.ctx.gl();
-        self.renderer.set_order(gl, order)?;
         let image = self.targets.draw(
             gl,
             &self.renderer,
