@@ -15,6 +15,9 @@ use std::time::{Duration, Instant};
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("splatgl-access-{}-{name}", std::process::id()));
+    // Fresh each time: a folder left by an earlier run with the same process id would hold
+    // its FIFO and socket, and mkfifo / bind fail on existing names.
+    let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
 }
