@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering as AtOrd};
 
 use glam::Vec3;
 use splatgl::camera::Camera;
-use splatgl::cull::{CullBounds, Frustum};
+use splatgl::cull::{CropBox, CullBounds, Frustum};
 use splatgl::sort::{
     AsyncSorter, Outcome, Precision, Reuse, SortMode, SortRequest, Sorter, quantized_bucket_width,
     squared_distance, view_depth,
@@ -524,6 +524,52 @@ fn async_sorter_delivers_newest_order() {
         assert_eq!(f.order(), Sorter::new().sort_by_distance(&positions, eye));
     }
     assert!(asorter.wait_for(1000).is_none(), "never issued");
+}
+
+/// A crop box cuts the orders of the requests posted after it is set, and only those: the
+/// cut order is the full order with the splats outside removed (same relative order, every
+/// splat inside kept), also when the sorter reuses an earlier order.
+#[test]
+fn async_crop_cuts_later_orders_to_the_splats_inside() {
+    let mut rng = Rng::new(31);
+    let positions: Arc<[[f32; 3]]> = random_positions(&mut rng, 20_000, 10.0).into();
+    let sorter = Sorter::new().with_reuse(Reuse::MotionBound);
+    let mut a = AsyncSorter::new(Arc::clone(&positions), sorter).expect("thread");
+    let eye = [3.0, -20.0, 4.0];
+    let before = a.request(SortRequest::distance(eye));
+    let crop = CropBox {
+        min: [-2.0, -5.0, -10.0],
+        max: [6.0, 1.0, 10.0],
+    };
+    a.set_crop(Some(crop));
+    let after = a.request(SortRequest::distance(eye));
+    let full = Sorter::new().sort_by_distance(&positions, eye).to_vec();
+    let want: Vec<u32> = full
+        .iter()
+        .copied()
+        .filter(|&i| crop.contains(positions[i as usize]))
+        .collect();
+    assert!(
+        want.len() > 1000 && want.len() < full.len() / 2,
+        "{}",
+        want.len()
+    );
+    let f = a.wait_for(after).expect("finished");
+    assert_eq!(f.generation(), after);
+    assert_eq!(f.crop(), Some(crop));
+    assert_eq!(f.order(), want.as_slice());
+    // A request posted before the crop keeps its full order.
+    let mut b = AsyncSorter::new(Arc::clone(&positions), Sorter::new()).expect("thread");
+    let g = b.request(SortRequest::distance(eye));
+    let f = b.wait_for(g).expect("finished");
+    assert_eq!((f.crop(), f.order().len()), (None, full.len()));
+    assert!(before < after);
+    // Reused order (same eye, MotionBound), cut again; then no crop: everything.
+    let g = a.request(SortRequest::distance([3.0, -20.0, 4.000_001]));
+    assert_eq!(a.wait_for(g).unwrap().order(), want.as_slice());
+    a.set_crop(None);
+    let g = a.request(SortRequest::distance(eye));
+    assert_eq!(a.wait_for(g).unwrap().order(), full.as_slice());
 }
 
 /// `SortedFrame::exact_radius` (the viewer's staleness bound) is sound for sorted and for

@@ -11,7 +11,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::{Outcome, SortMode, Sorter};
-use crate::cull::{CullBounds, Frustum};
+use crate::cull::{CropBox, CullBounds, Frustum};
 
 /// A camera to sort for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +50,7 @@ pub struct SortedFrame {
     order: Vec<u32>,
     request: Option<SortRequest>,
     frustum: Option<Frustum>,
+    crop: Option<CropBox>,
     generation: u64,
     outcome: Outcome,
     exact_radius: f64,
@@ -62,6 +63,7 @@ impl SortedFrame {
             order: Vec::new(),
             request: None,
             frustum: None,
+            crop: None,
             generation: 0,
             outcome: Outcome::None,
             exact_radius: 0.0,
@@ -99,6 +101,11 @@ impl SortedFrame {
         self.frustum
     }
 
+    /// The crop box the order was cut to ([`AsyncSorter::set_crop`]); `None`: not cropped.
+    pub fn crop(&self) -> Option<CropBox> {
+        self.crop
+    }
+
     /// The generation [`AsyncSorter::request`] returned for that request.
     pub fn generation(&self) -> u64 {
         self.generation
@@ -113,6 +120,8 @@ impl SortedFrame {
 #[derive(Debug)]
 struct State {
     pending: Option<(u64, SortRequest, Option<Frustum>)>,
+    /// Cuts the orders of the requests posted from now on.
+    crop: Option<CropBox>,
     ready: Option<SortedFrame>,
     spare: Option<SortedFrame>,
     finished: u64,
@@ -189,6 +198,7 @@ impl AsyncSorter {
         let shared = Arc::new(Shared {
             state: Mutex::new(State {
                 pending: None,
+                crop: None,
                 ready: None,
                 spare: None,
                 finished: 0,
@@ -205,14 +215,14 @@ impl AsyncSorter {
                 let _stop = StopOnExit(Arc::clone(&sh));
                 let mut back = SortedFrame::empty();
                 loop {
-                    let (generation, req, frustum) = {
+                    let (generation, req, frustum, crop) = {
                         let mut st = sh.lock();
                         loop {
                             if st.stop {
                                 return;
                             }
-                            if let Some(p) = st.pending.take() {
-                                break p;
+                            if let Some((g, r, f)) = st.pending.take() {
+                                break (g, r, f, st.crop);
                             }
                             st = sh.wake.wait(st).unwrap_or_else(PoisonError::into_inner);
                         }
@@ -227,9 +237,15 @@ impl AsyncSorter {
                         }
                     };
                     back.order.clear();
-                    back.order.extend_from_slice(order);
+                    match crop {
+                        Some(c) => back
+                            .order
+                            .extend(order.iter().filter(|&&i| c.contains(positions[i as usize]))),
+                        None => back.order.extend_from_slice(order),
+                    }
                     back.request = Some(req);
                     back.frustum = culled.map(|(f, _)| f);
+                    back.crop = crop;
                     back.generation = generation;
                     back.outcome = sorter.last_outcome();
                     back.exact_radius = match back.outcome {
@@ -266,6 +282,13 @@ impl AsyncSorter {
     /// ([`AsyncSorter::new`]) the frustum is ignored and every splat is sorted.
     pub fn request_visible(&self, request: SortRequest, frustum: Frustum) -> u64 {
         self.post(request, Some(frustum))
+    }
+
+    /// Cuts the orders of every request posted from now on to the splats whose mean lies
+    /// inside `crop` (the viewer's crop box; `None`: no cut). Orders already posted or finished
+    /// keep the crop they were posted with ([`SortedFrame::crop`]).
+    pub fn set_crop(&self, crop: Option<CropBox>) {
+        self.shared.lock().crop = crop;
     }
 
     fn post(&self, request: SortRequest, frustum: Option<Frustum>) -> u64 {

@@ -116,6 +116,8 @@ pub(crate) struct StaleOrders {
     sync: bool,
     requested: Option<[f32; 3]>,
     generation: u64,
+    /// Orders older than this generation were posted before the last crop change.
+    first_valid: u64,
 }
 
 #[cfg_attr(not(feature = "gl"), allow(dead_code))]
@@ -130,7 +132,16 @@ impl StaleOrders {
             sync,
             requested: None,
             generation: 0,
+            first_valid: 0,
         })
+    }
+
+    /// Cuts every order from now on to `crop` ([`AsyncSorter::set_crop`]); the next frame
+    /// waits for an order with the new crop.
+    pub(crate) fn set_crop(&mut self, crop: Option<crate::cull::CropBox>) {
+        self.sorter.set_crop(crop);
+        self.requested = None;
+        self.first_valid = self.generation + 1;
     }
 
     /// Posts a sort for `eye` unless it is the last one posted (never waits).
@@ -145,8 +156,9 @@ impl StaleOrders {
     /// The order to draw from `eye`: the newest finished one if the bound allows it, else
     /// (waiting) the order sorted for `eye`. `None` only if the sorter thread died.
     pub(crate) fn for_frame(&mut self, eye: Vec3) -> Option<(&SortedFrame, Freshness)> {
+        let first_valid = self.first_valid;
         let decision = match self.sorter.latest() {
-            Some(f) if !self.sync => f.request().and_then(|req| {
+            Some(f) if !self.sync && f.generation() >= first_valid => f.request().and_then(|req| {
                 let moved = (eye - Vec3::from_array(req.eye)).length() as f64;
                 decide(moved, f.exact_radius(), self.tau as f64)
             }),
