@@ -76,20 +76,29 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     pub background: String,
-    /// Render N frames (along one orbit with --orbit, else from the initial camera), print
-    /// frame time min/median/p99, sort ms and the GL driver, and exit.
     /// Draw only the splats whose mean lies in this box (scene coordinates, both ends
-    /// included; splat-transform's --filter-box order).
+    /// included; splat-transform's --filter-box order). The panel's crop box starts as this
+    /// box and can be edited (numbers, or drag its faces).
     #[arg(long, value_name = "minx,miny,minz,maxx,maxy,maxz", value_parser = splatgl::cull::CropBox::parse, allow_hyphen_values = true)]
     pub crop: Option<splatgl::cull::CropBox>,
     /// The kernel: `auto` is antialiased when the file says it was trained so (SPZ flag 0x1).
     #[arg(long, value_enum, default_value_t = AntialiasArg::Auto)]
     pub antialiased: AntialiasArg,
+    /// Start with the on-screen panel hidden (G shows and hides it).
+    #[arg(long)]
+    pub no_ui: bool,
+    /// Render N frames (along one orbit with --orbit, else from the initial camera), print
+    /// frame time min/median/p99, sort ms and the GL driver, and exit. The panel is not
+    /// drawn in these frames (unless --bench-panel).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub bench_frames: Option<u32>,
     /// With --bench-frames: one full orbit around the initial pivot.
     #[arg(long, requires = "bench_frames")]
     pub orbit: bool,
+    /// With --bench-frames: draw the panel in the measured frames too and report its CPU time
+    /// per frame (layout, tessellation and GL calls).
+    #[arg(long, requires = "bench_frames")]
+    pub bench_panel: bool,
     /// Test hook: deliver FILE as a dropped file once the first scene is shown.
     #[arg(long, hide = true, value_name = "FILE")]
     pub test_drop: Option<PathBuf>,
@@ -132,8 +141,10 @@ fn go(a: Args) -> Result<(), String> {
         bench: a.bench_frames.map(|n| splatgl::viewer::Bench {
             frames: n as usize,
             orbit: a.orbit,
+            panel: a.bench_panel,
         }),
         print_camera_json: a.cam.print_camera_json,
+        no_ui: a.no_ui,
         test_drop: a.test_drop,
     };
     splatgl::viewer::run(opts).map_err(|e| e.to_string())

@@ -16,10 +16,12 @@ use winit::window::{Fullscreen, Window, WindowId};
 
 mod commands;
 mod frame;
+mod interface;
 
 use super::controls::Controls;
 use super::draw::Targets;
 use super::loading::{LoadEvent, Loaded, display_name, spawn};
+use super::panel::{Action, Facts, Live, Panel};
 use super::rig::Rig;
 use super::stats::Stats;
 use super::surface::GlSurfaceWindow;
@@ -56,6 +58,8 @@ pub(super) struct Shown {
     uploaded: Option<u64>,
     up: UpAxis,
     home: Rig,
+    /// What the panel says about the scene.
+    facts: Facts,
 }
 
 /// The viewer's state.
@@ -88,6 +92,20 @@ pub(super) struct App {
     /// The last frame wants a next one without new input.
     animating: bool,
     dialog_open: Arc<AtomicBool>,
+    /// The interface (`None` where its painter could not be made).
+    panel: Option<Panel>,
+    /// The panel's statistics.
+    live: Live,
+    /// The crop box applied in the sort (splats outside are not drawn).
+    crop: Option<crate::cull::CropBox>,
+    /// Show the crop box's wireframe and handles.
+    show_crop: bool,
+    /// The panel changed the crop box since it was last printed.
+    crop_edited: bool,
+    /// The panel's `--max-splats` field (applied by reloading).
+    budget_edit: Option<usize>,
+    /// What the panel asked for in the last frame.
+    actions: Vec<Action>,
     result: Result<(), ViewerError>,
 }
 
@@ -97,6 +115,7 @@ pub(super) fn run(opts: ViewerOptions) -> Result<(), ViewerError> {
         .build()
         .map_err(|e| ViewerError::Window(e.to_string()))?;
     event_loop.set_control_flow(ControlFlow::Wait);
+    let (crop, budget_edit) = (opts.crop, opts.max_splats);
     let mut app = App {
         load_opts: Arc::new(opts.load),
         // (Struct update: DrawSettings may gain fields, e.g. state restoring.)
@@ -130,6 +149,13 @@ pub(super) fn run(opts: ViewerOptions) -> Result<(), ViewerError> {
         prev_eye: None,
         animating: false,
         dialog_open: Arc::new(AtomicBool::new(false)),
+        panel: None,
+        live: Live::default(),
+        crop,
+        show_crop: true,
+        crop_edited: false,
+        budget_edit,
+        actions: Vec::new(),
         result: Ok(()),
     };
     app.settings.depth_test = false; // the viewer has no depth buffer to test against
@@ -181,7 +207,6 @@ impl App {
         };
         let opts = Arc::clone(&self.load_opts);
         let keep = super::loading::Keep {
-            crop: self.opts.crop,
             max_splats: self.opts.max_splats,
         };
         spawn(self.load_id, path, opts, keep, send);
@@ -242,10 +267,11 @@ impl App {
         };
         let positions: Arc<[[f32; 3]]> = l.cloud.positions.as_slice().into();
         let tau = self.opts.stale.tolerance(&l.cloud);
-        let orders = match Orders::new(positions, tau, self.opts.sort_sync) {
+        let mut orders = match Orders::new(positions, tau, self.opts.sort_sync) {
             Ok(o) => o,
             Err(e) => return self.load_failed(el, format!("{name}: sorter thread: {e}")),
         };
+        orders.set_crop(self.crop);
         let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
             return;
         };
@@ -262,7 +288,7 @@ impl App {
         self.controls.fly_speed = extent.map_or(1.0, |e| (0.5 * e.radius()).max(0.05));
         self.controls.stop();
         let budget = if l.cloud.len() < l.file_len {
-            format!(" (of {}, --crop / --max-splats)", l.file_len)
+            format!(" (of {}, --max-splats)", l.file_len)
         } else {
             String::new()
         };
@@ -279,7 +305,9 @@ impl App {
                 "plain"
             }
         );
+        let facts = self.facts_of(&l, &name);
         self.shown = Some(Shown {
+            facts,
             name,
             path: l.path,
             len: l.cloud.len(),
@@ -312,6 +340,13 @@ impl App {
 
     /// A window event (also the test hook's injected `DroppedFile`).
     pub fn handle(&mut self, el: &ActiveEventLoop, event: WindowEvent) {
+        if let (Some(panel), Some(w)) = (&mut self.panel, &self.win)
+            && !matches!(event, WindowEvent::RedrawRequested)
+            && panel.on_event(&w.window, &event)
+        {
+            self.request_redraw();
+            return;
+        }
         match event {
             WindowEvent::CloseRequested => el.exit(),
             WindowEvent::Resized(_) => {
@@ -390,6 +425,10 @@ impl ApplicationHandler<UserEvent> for App {
             Err(e) => return self.fail(el, e.into()),
         }
         eprintln!("GL: {}", win.info());
+        match Panel::new(&win.window, Arc::clone(&win.gl), !self.opts.no_ui) {
+            Ok(p) => self.panel = Some(p),
+            Err(e) => eprintln!("warning: no on-screen panel: {e}"),
+        }
         self.win = Some(win);
         self.start_load(self.opts.file.clone());
     }
@@ -425,7 +464,11 @@ impl ApplicationHandler<UserEvent> for App {
 
     fn about_to_wait(&mut self, _el: &ActiveEventLoop) {
         let hook = self.opts.test_drop.is_some() && self.shown.is_some();
-        if self.animating || self.bench.is_some() || self.screenshot || hook {
+        let ui = self
+            .panel
+            .as_ref()
+            .is_some_and(|p| p.visible && p.wants_repaint);
+        if self.animating || self.bench.is_some() || self.screenshot || hook || ui {
             self.request_redraw();
         }
     }
@@ -434,6 +477,9 @@ impl ApplicationHandler<UserEvent> for App {
         if let (Some(win), Some(r)) = (&self.win, &mut self.renderer) {
             r.destroy(&win.gl);
             self.targets.destroy(&win.gl);
+        }
+        if let Some(p) = &mut self.panel {
+            p.destroy();
         }
     }
 }

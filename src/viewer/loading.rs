@@ -1,6 +1,7 @@
 //! Loading scenes on a background thread: the file is read in 1 MiB chunks (progress in
 //! bytes), then decoded by [`load_bytes`] (reported as "decoding"), then cut to the
-//! `--max-splats` budget. The window keeps drawing the previous scene meanwhile.
+//! `--max-splats` budget. (The crop box is not applied here: it is a cull, editable while the
+//! scene is shown.) The window keeps drawing the previous scene meanwhile.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -11,12 +12,9 @@ use crate::camera::GltfPerspective;
 use crate::cloud::SplatCloud;
 use crate::load::{Format, LoadOptions, load_bytes};
 
-/// Which splats of a file the viewer keeps: those inside the crop box, then at most
-/// `max_splats` of them.
+/// Which splats of a file the viewer keeps: at most `max_splats` of them.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Keep {
-    /// `--crop`.
-    pub crop: Option<crate::cull::CropBox>,
     /// `--max-splats`.
     pub max_splats: Option<usize>,
 }
@@ -38,6 +36,8 @@ pub struct Loaded {
     pub warnings: Vec<String>,
     /// The file says it was trained with antialiasing (`--antialiased auto`).
     pub trained_antialiased: bool,
+    /// Container, version and compression of a quantized format (`spz 3, gzip`).
+    pub container: Option<String>,
 }
 
 impl Loaded {
@@ -111,25 +111,34 @@ fn load(
     keep: Keep,
     send: &impl Fn(LoadEvent),
 ) -> Result<Box<Loaded>, String> {
-    let (cloud, format, cameras, warnings, trained_antialiased) = match &path {
+    let (cloud, format, cameras, warnings, trained_antialiased, container) = match &path {
         None => (
             crate::synthetic::default_scene(),
             None,
             Vec::new(),
             Vec::new(),
             false,
+            None,
         ),
         Some(p) => {
             let bytes = read_with_progress(id, p, opts.limits.max_bytes, send)?;
             send(LoadEvent::Decoding { id });
             let scene = load_bytes(&bytes, Some(p), opts).map_err(|e| e.to_string())?;
             let warnings = scene.report.summarized_warnings();
+            let container = scene.report.details.as_ref().map(|d| {
+                let mut c = d.container.to_owned();
+                if !d.version.is_empty() {
+                    c += &format!(" {}", d.version);
+                }
+                c + &format!(", {}", d.compression)
+            });
             (
                 scene.cloud,
                 Some(scene.report.format),
                 scene.cameras,
                 warnings,
                 scene.report.trained_antialiased(),
+                container,
             )
         }
     };
@@ -140,16 +149,6 @@ fn load(
         ));
     }
     let file_len = cloud.len();
-    let cloud = match keep.crop.and_then(|b| b.apply(&cloud)) {
-        Some(c) if c.is_empty() => {
-            return Err(format!(
-                "{}: no splat inside the crop box",
-                display_name(path.as_deref())
-            ));
-        }
-        Some(c) => c,
-        None => cloud,
-    };
     let cloud = match keep
         .max_splats
         .and_then(|n| super::budget::subset(&cloud, n))
@@ -165,6 +164,7 @@ fn load(
         cameras,
         warnings,
         trained_antialiased,
+        container,
     }))
 }
 
@@ -227,6 +227,8 @@ mod tests {
         let e = read_with_progress(0, Path::new("/dev/zero"), 1 << 30, &quiet).unwrap_err();
         assert!(e.contains("character device"), "{e}");
         let d = std::env::temp_dir().join(format!("splatgl-viewer-load-{}", std::process::id()));
+        // Empty first: a folder left by an earlier run with the same pid holds the FIFO.
+        std::fs::remove_dir_all(&d).ok();
         std::fs::create_dir_all(&d).unwrap();
         let e = read_with_progress(0, &d, 1 << 30, &quiet).unwrap_err();
         assert!(e.contains("directory"), "{e}");

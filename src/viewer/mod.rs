@@ -25,6 +25,7 @@ mod budget;
 mod controls;
 mod draw;
 mod loading;
+mod panel;
 mod rig;
 mod stats;
 mod surface;
@@ -52,6 +53,7 @@ splatgl view controls
   V            print the camera as a splatgl render line (+ cameras.json with --print-camera-json)
   P            screenshot (PNG of the framebuffer, timestamped, in the current directory)
   O            open a file (zenity / kdialog, else type a path on stdin); or drop a file
+  G            show / hide the panel (scene, statistics, settings, cameras, crop box)
   F11          fullscreen        H / F1       this help        Esc  quit";
 
 /// The framebuffer the viewer blends in.
@@ -71,6 +73,9 @@ pub struct Bench {
     pub frames: usize,
     /// Move along one full orbit around the initial pivot (else a still camera).
     pub orbit: bool,
+    /// Draw the interface in the measured frames too (`--bench-panel`) and report its CPU
+    /// time; without it benchmark frames never draw it.
+    pub panel: bool,
 }
 
 /// Everything `splatgl view` takes.
@@ -88,10 +93,11 @@ pub struct ViewerOptions {
     pub vsync: bool,
     /// Render at this fraction of the window's pixels (stretched to the window).
     pub resolution_scale: f32,
-    /// Draw at most this many splats (the opacity × area ranking of `budget.rs`), after the
-    /// crop.
+    /// Keep at most this many of the file's splats (the opacity × area ranking of
+    /// `budget.rs`); the crop box then hides those outside it.
     pub max_splats: Option<usize>,
-    /// Draw only the splats whose mean is inside this box (`--crop`).
+    /// Draw only the splats whose mean is inside this box (`--crop`): a cull, not a cut at
+    /// load time, so the panel can move the box's faces over the whole file.
     pub crop: Option<crate::cull::CropBox>,
     /// Every frame waits for the sort of its own camera.
     pub sort_sync: bool,
@@ -109,6 +115,8 @@ pub struct ViewerOptions {
     pub bench: Option<Bench>,
     /// `V` also prints a cameras.json entry.
     pub print_camera_json: bool,
+    /// Start with the interface hidden (`--no-ui`; `G` shows it).
+    pub no_ui: bool,
     /// Test hook: after the first scene has been shown for a few frames, deliver this path as
     /// a `DroppedFile` window event (the drag-and-drop code path).
     #[doc(hidden)]
@@ -134,6 +142,7 @@ impl Default for ViewerOptions {
             antialiased: crate::load::AntialiasMode::Auto,
             bench: None,
             print_camera_json: false,
+            no_ui: false,
             test_drop: None,
         }
     }

@@ -55,17 +55,36 @@ impl Stats {
         (1e3 / mean.max(1e-3), mean, p99, sort)
     }
 
-    /// The title's statistics part: `12.3 fps (81.2 ms, p99 95.0 ms) · sort 1.2 ms · exact`.
+    /// How the last frame's order was obtained: `exact`, `stale (0.012 moved)`, `waited`.
+    pub fn order_text(&self) -> String {
+        match self.last {
+            Some(Freshness::Exact) => "exact".to_owned(),
+            Some(Freshness::Waited) => "waited".to_owned(),
+            Some(Freshness::Stale { moved }) => format!("stale ({moved:.3} moved)"),
+            None => String::new(),
+        }
+    }
+
+    /// The title's statistics part: `12.3 fps (81.2 ms, p99 95.0 ms) · sort 1.2 ms · order
+    /// exact`.
     pub fn title_part(&mut self) -> String {
         let (fps, mean, p99, sort) = self.summary();
-        let fresh = match self.last {
-            Some(Freshness::Exact) => "order exact".to_owned(),
-            Some(Freshness::Waited) => "order waited".to_owned(),
-            Some(Freshness::Stale { moved }) => format!("order stale ({moved:.3} moved)"),
-            None => String::new(),
-        };
-        format!("{fps:.1} fps ({mean:.1} ms, p99 {p99:.1} ms) · sort {sort:.2} ms · {fresh}")
+        let fresh = self.order_text();
+        format!("{fps:.1} fps ({mean:.1} ms, p99 {p99:.1} ms) · sort {sort:.2} ms · order {fresh}")
     }
+}
+
+/// Thousands separators: 152746 → "152,746".
+pub fn thousands(n: usize) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }
 
 /// What `--bench-frames` measured.
@@ -81,6 +100,8 @@ pub struct BenchLog {
     pub stale: usize,
     /// See `exact`.
     pub waited: usize,
+    /// CPU time of the interface pass, ms (`--bench-panel`).
+    pub ui: Vec<f32>,
 }
 
 impl BenchLog {
@@ -103,9 +124,15 @@ impl BenchLog {
         let p99 = quantile(&mut self.frames, 0.99);
         let smed = quantile(&mut self.sorts, 0.5);
         let sp99 = quantile(&mut self.sorts, 0.99);
+        let ui = if self.ui.is_empty() {
+            String::new()
+        } else {
+            let (umed, up99) = (quantile(&mut self.ui, 0.5), quantile(&mut self.ui, 0.99));
+            format!("; panel CPU ms median {umed:.3} p99 {up99:.3}")
+        };
         format!(
             "bench: {what}: {n} frames: frame ms min {min:.2} median {med:.2} p99 {p99:.2}; \
-             sort ms median {smed:.2} p99 {sp99:.2}; orders exact {} stale {} waited {}\n\
+             sort ms median {smed:.2} p99 {sp99:.2}; orders exact {} stale {} waited {}{ui}\n\
              bench: GL: {gl_info}",
             self.exact, self.stale, self.waited
         )
@@ -115,6 +142,13 @@ impl BenchLog {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn thousands_separators() {
+        assert_eq!(thousands(152_746), "152,746");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1_000_000), "1,000,000");
+    }
 
     #[test]
     fn quantiles_use_nearest_rank() {

@@ -19,8 +19,8 @@ use winit::window::{Window, WindowAttributes};
 ///
 /// Fields drop in declaration order: functions, context and surface before the window.
 pub struct GlSurfaceWindow {
-    /// The context's functions.
-    pub gl: glow::Context,
+    /// The context's functions (shared with the interface's painter).
+    pub gl: std::sync::Arc<glow::Context>,
     context: PossiblyCurrentContext,
     surface: Surface<WindowSurface>,
     /// The window.
@@ -126,7 +126,7 @@ impl GlSurfaceWindow {
             glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s).cast())
         };
         Ok(GlSurfaceWindow {
-            gl,
+            gl: std::sync::Arc::new(gl),
             context,
             surface,
             window,

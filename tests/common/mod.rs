@@ -15,6 +15,8 @@ pub mod cli;
 #[cfg(feature = "gl")]
 pub mod gl;
 pub mod packed;
+#[cfg(all(feature = "viewer", feature = "cli"))]
+pub mod viewer;
 
 /// Reports that the calling test cannot run here because `what` is missing. Under
 /// `SPLATGL_REQUIRE=all` (`.ci/run` sets it) that is a failure naming what is missing, so a

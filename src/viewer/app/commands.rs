@@ -1,5 +1,6 @@
 //! The command keys: views (F, Home/0, C, U), SH degree (1–4), modes (Tab, I, F11), output
-//! (V, P), files (O), help (H/F1), quit (Esc).
+//! (V, P), files (O), the panel (G), help (H/F1), quit (Esc); and the view changes the panel
+//! asks for through the same functions.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -10,7 +11,7 @@ use winit::keyboard::{Key, KeyCode};
 use winit::window::Fullscreen;
 
 use super::{App, UserEvent};
-use crate::camera::Camera;
+use crate::camera::{Camera, UpAxis};
 use crate::viewer::controls::Mode;
 use crate::viewer::rig::Rig;
 
@@ -51,12 +52,7 @@ impl App {
                         .set_fullscreen((!full).then_some(Fullscreen::Borderless(None)));
                 }
             }
-            (KeyCode::Home | KeyCode::Numpad0, _) | (_, Some('0')) => {
-                if let (Some(s), Some(r)) = (&self.shown, &mut self.rig) {
-                    *r = s.home;
-                    self.controls.stop();
-                }
-            }
+            (KeyCode::Home | KeyCode::Numpad0, _) | (_, Some('0')) => self.reset_view(),
             (_, Some(c @ '1'..='4')) => {
                 let d = c as u8 - b'1';
                 self.settings.sh_degree = Some(d);
@@ -70,9 +66,19 @@ impl App {
                     if self.controls.inertia { "on" } else { "off" }
                 );
             }
-            (_, Some('f')) => self.frame_cloud(false),
-            (_, Some('u')) => self.frame_cloud(true),
+            (_, Some('f')) => self.frame_cloud(None),
+            (_, Some('u')) => {
+                if let Some(s) = &self.shown {
+                    self.frame_cloud(Some(s.up.next()));
+                }
+            }
             (_, Some('c')) => self.next_camera(),
+            (_, Some('g')) => {
+                if let Some(p) = &mut self.panel {
+                    p.visible = !p.visible;
+                    println!("panel {}", if p.visible { "shown" } else { "hidden" });
+                }
+            }
             (_, Some('v')) => self.print_camera(),
             (_, Some('p')) => self.screenshot = true,
             (_, Some('o')) => self.open_dialog(),
@@ -82,9 +88,17 @@ impl App {
         self.request_redraw();
     }
 
-    /// `F`: frames the cloud along the current view direction; `U` (`next_up`): switches to
-    /// the next up axis and frames from its default direction.
-    fn frame_cloud(&mut self, next_up: bool) {
+    /// `Home` / `0`: back to the scene's initial view.
+    pub(super) fn reset_view(&mut self) {
+        if let (Some(s), Some(r)) = (&self.shown, &mut self.rig) {
+            *r = s.home;
+            self.controls.stop();
+        }
+    }
+
+    /// `F` (`up` `None`): frames the cloud along the current view direction; `U` and the
+    /// panel (`Some(axis)`): switches to that up axis and frames from its default direction.
+    pub(super) fn frame_cloud(&mut self, up: Option<UpAxis>) {
         let (w, h) = self.render_size();
         let (Some(s), Some(r)) = (&mut self.shown, &mut self.rig) else {
             return;
@@ -92,8 +106,9 @@ impl App {
         let (Some(extent), Some(fit)) = (s.extent, s.fit) else {
             return;
         };
-        if next_up {
-            s.up = s.up.next();
+        let next_up = up.is_some();
+        if let Some(a) = up {
+            s.up = a;
             println!("up: {}", s.up.name());
         }
         let up = s.up.vector();
@@ -110,16 +125,29 @@ impl App {
 
     /// `C`: the next of the scene's glTF camera nodes, then the --camera cameras.json views.
     fn next_camera(&mut self) {
+        let Some(s) = &self.shown else {
+            return;
+        };
+        let n = s.cameras.len() + self.json_cameras.len();
+        if n == 0 {
+            println!("camera: the scene has no glTF camera nodes and there is no --camera list");
+            return;
+        }
+        let i = self.camera_index % n;
+        self.go_to_camera(i);
+    }
+
+    /// Camera `i` of the list (the scene's glTF camera nodes, then the cameras.json views),
+    /// as `C` and the panel's camera list go to it.
+    pub(super) fn go_to_camera(&mut self, i: usize) {
         let (w, h) = self.render_size();
         let (Some(s), Some(r)) = (&self.shown, &mut self.rig) else {
             return;
         };
         let (ng, nj) = (s.cameras.len(), self.json_cameras.len());
-        if ng + nj == 0 {
-            println!("camera: the scene has no glTF camera nodes and there is no --camera list");
+        if i >= ng + nj {
             return;
         }
-        let i = self.camera_index % (ng + nj);
         self.camera_index = i + 1;
         let (cam, what) = if i < ng {
             (
@@ -143,7 +171,7 @@ impl App {
     }
 
     /// `V`: the current camera as a `splatgl render` line (and a cameras.json entry).
-    fn print_camera(&self) {
+    pub(super) fn print_camera(&self) {
         let (w, h) = self.render_size();
         let (Some(s), Some(r)) = (&self.shown, &self.rig) else {
             return;
@@ -174,7 +202,7 @@ impl App {
 
     /// `O`: asks for a file with zenity or kdialog when installed, else reads a path typed on
     /// stdin; the answer arrives as [`UserEvent::Open`]. One question at a time.
-    fn open_dialog(&self) {
+    pub(super) fn open_dialog(&self) {
         if self.dialog_open.swap(true, Ordering::SeqCst) {
             return;
         }

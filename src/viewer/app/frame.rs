@@ -10,7 +10,7 @@ use winit::event_loop::ActiveEventLoop;
 use super::App;
 use crate::sort::Freshness;
 use crate::viewer::rig::Rig;
-use crate::viewer::stats::BenchLog;
+use crate::viewer::stats::{BenchLog, thousands};
 use crate::viewer::{Bench, ViewerError};
 
 /// Frames drawn before `--bench-frames` starts measuring (upload, first sort, shader warm-up).
@@ -52,19 +52,6 @@ impl BenchRun {
     }
 }
 
-/// Thousands separators: 152746 → "152,746".
-pub fn thousands(n: usize) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
 /// Clears the default framebuffer to `bg` (the window before anything is loaded).
 fn clear_window(gl: &glow::Context, window: (u32, u32), bg: [f32; 3]) {
     // SAFETY: clearing the default framebuffer.
@@ -86,10 +73,24 @@ fn screenshot(gl: &glow::Context, window: (u32, u32)) {
     }
 }
 
+/// What [`App::draw_splats`] drew.
+struct DrawnFrame {
+    camera: crate::camera::Camera,
+    fresh: Freshness,
+    sort_time: Duration,
+    moving: bool,
+}
+
 impl BenchRun {
     /// Times the frame just drawn (after `glFinish`; warm-up frames are not logged); whether
     /// the run has all its frames.
-    fn record(&mut self, gl: &glow::Context, sort_time: Duration, fresh: Freshness) -> bool {
+    fn record(
+        &mut self,
+        gl: &glow::Context,
+        sort_time: Duration,
+        fresh: Freshness,
+        ui: Duration,
+    ) -> bool {
         // SAFETY: glFinish has no preconditions: the frame is complete when timed.
         unsafe { gl.finish() };
         let end = Instant::now();
@@ -97,6 +98,9 @@ impl BenchRun {
             && let Some(last) = self.last_end
         {
             self.log.push(end - last, sort_time, fresh);
+            if self.spec.panel {
+                self.log.ui.push(ui.as_secs_f32() * 1e3);
+            }
         }
         self.last_end = Some(end);
         self.done += 1;
@@ -119,20 +123,72 @@ impl App {
             .last_frame
             .map_or(0.0, |t| now.duration_since(t).as_secs_f32());
         self.last_frame = Some(now);
-        let render = self.render_size();
-        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+        let Some(window) = self.win.as_ref().map(|w| w.window.inner_size()) else {
             return Ok(());
         };
-        let size = win.window.inner_size();
-        if size.width == 0 || size.height == 0 {
+        if window.width == 0 || window.height == 0 {
             return Ok(());
         }
-        let window = (size.width, size.height);
+        let window = (window.width, window.height);
+        let Some(drawn) = self.draw_splats(dt, window)? else {
+            // Nothing loaded yet: the background, and the title says what is loading.
+            let win = self.win.as_ref().expect("checked above");
+            clear_window(&win.gl, window, self.opts.background);
+            return win.swap().map_err(ViewerError::Window);
+        };
+        if std::mem::take(&mut self.screenshot)
+            && let Some(win) = &self.win
+        {
+            screenshot(&win.gl, window);
+        }
+        if self.bench.as_ref().is_none_or(|b| b.spec.panel) {
+            self.interface_pass(&drawn.camera, window);
+        }
+        let win = self.win.as_ref().expect("checked above");
+        win.swap().map_err(ViewerError::Window)?;
+        self.frames_shown += 1;
+        self.animating = drawn.moving || matches!(drawn.fresh, Freshness::Stale { .. });
+        self.stats.push(
+            now,
+            Duration::from_secs_f32(dt),
+            drawn.sort_time,
+            drawn.fresh,
+        );
+        let ui_time = self.panel.as_ref().map_or(Duration::ZERO, |p| p.cpu);
+        let render = self.render_size();
+        if let (Some(b), Some(shown)) = (&mut self.bench, &self.shown)
+            && b.record(&win.gl, drawn.sort_time, drawn.fresh, ui_time)
+        {
+            let what = format!(
+                "{} ({} splats, {}x{}{}{})",
+                shown.name,
+                thousands(shown.len),
+                render.0,
+                render.1,
+                if b.spec.orbit { ", orbit" } else { ", still" },
+                if b.spec.panel { ", with the panel" } else { "" }
+            );
+            println!("{}", b.log.report(&what, &win.info()));
+            el.exit();
+        }
+        self.update_title(false);
+        Ok(())
+    }
+
+    /// Moves the camera, takes the order to draw (uploading it if it changed), posts the next
+    /// sort and draws the splats into the window's back buffer. `None`: no scene yet.
+    fn draw_splats(
+        &mut self,
+        dt: f32,
+        window: (u32, u32),
+    ) -> Result<Option<DrawnFrame>, ViewerError> {
+        let render = self.render_size();
+        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+            return Ok(None);
+        };
         let gl = &win.gl;
         let (Some(shown), Some(rig)) = (&mut self.shown, &mut self.rig) else {
-            // Nothing loaded yet: the background, and the title says what is loading.
-            clear_window(gl, window, self.opts.background);
-            return win.swap().map_err(ViewerError::Window);
+            return Ok(None);
         };
         let moving = match &self.bench {
             Some(b) => {
@@ -141,15 +197,20 @@ impl App {
             }
             None => self.controls.update(rig, dt, render),
         };
-        let cam = rig.camera(render.0, render.1);
-        let eye = cam.eye();
+        let camera = rig.camera(render.0, render.1);
+        let eye = camera.eye();
         let Some((order, fresh)) = shown.orders.for_frame(eye) else {
             return Err(ViewerError::Window("the sorter thread stopped".into()));
         };
         let sort_time = order.sort_time();
+        self.live.drawn = order.order().len();
         if shown.uploaded != Some(order.generation()) {
+            let t = Instant::now();
             renderer.set_order(gl, order.order())?;
+            self.live.upload_ms = t.elapsed().as_secs_f32() * 1e3;
             shown.uploaded = Some(order.generation());
+        } else {
+            self.live.upload_ms = 0.0;
         }
         // Prefetch, before drawing so the sort overlaps the draw: sort for where the camera
         // will be next frame (linear prediction), so the next frame finds a close order.
@@ -161,31 +222,13 @@ impl App {
         self.prev_eye = Some(eye);
         let bg = self.opts.background;
         self.targets
-            .draw(gl, renderer, &cam, &self.settings, bg, window)?;
-        if std::mem::take(&mut self.screenshot) {
-            screenshot(gl, window);
-        }
-        win.swap().map_err(ViewerError::Window)?;
-        self.frames_shown += 1;
-        self.animating = moving || matches!(fresh, Freshness::Stale { .. });
-        let frame_time = Duration::from_secs_f32(dt);
-        self.stats.push(now, frame_time, sort_time, fresh);
-        if let Some(b) = &mut self.bench
-            && b.record(gl, sort_time, fresh)
-        {
-            let what = format!(
-                "{} ({} splats, {}x{}{})",
-                shown.name,
-                thousands(shown.len),
-                render.0,
-                render.1,
-                if b.spec.orbit { ", orbit" } else { ", still" }
-            );
-            println!("{}", b.log.report(&what, &win.info()));
-            el.exit();
-        }
-        self.update_title(false);
-        Ok(())
+            .draw(gl, renderer, &camera, &self.settings, bg, window)?;
+        Ok(Some(DrawnFrame {
+            camera,
+            fresh,
+            sort_time,
+            moving,
+        }))
     }
 
     /// Sets the title (at most every 250 ms unless `now`): file, splats, SH degree, frame
@@ -259,14 +302,4 @@ fn screenshot_name() -> std::path::PathBuf {
     let (hh, mm, ss) = (rem / 3600, rem / 60 % 60, rem % 60);
     let ms = t.subsec_millis();
     format!("splatgl-{y:04}{m:02}{d:02}-{hh:02}{mm:02}{ss:02}-{ms:03}.png").into()
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn thousands_separators() {
-        assert_eq!(super::thousands(152_746), "152,746");
-        assert_eq!(super::thousands(999), "999");
-        assert_eq!(super::thousands(1_000_000), "1,000,000");
-    }
 }
