@@ -13,8 +13,8 @@ use common::viewer::*;
 use glam::Vec3;
 use splatgl::camera::Camera;
 
-const W: u32 = 640;
-const H: u32 = 400;
+const W: u32 = 800;
+const H: u32 = 450;
 
 /// Two views of the default scene in a cameras.json: its own view, and one from the other
 /// side.

@@ -100,8 +100,13 @@ pub struct BenchLog {
     pub stale: usize,
     /// See `exact`.
     pub waited: usize,
-    /// CPU time of the interface pass, ms (`--bench-panel`).
+    /// CPU time of the interface per frame, ms (`--bench-panel`).
     pub ui: Vec<f32>,
+    /// Of these, the layout times of the frames that laid it out (the others reused the
+    /// last layout), and the painting times of every frame.
+    pub ui_layout: Vec<f32>,
+    /// See `ui_layout`.
+    pub ui_paint: Vec<f32>,
 }
 
 impl BenchLog {
@@ -113,6 +118,16 @@ impl BenchLog {
             Freshness::Exact => self.exact += 1,
             Freshness::Stale { .. } => self.stale += 1,
             Freshness::Waited => self.waited += 1,
+        }
+    }
+
+    /// Records the interface's CPU time of one frame (layout zero: a reused layout).
+    pub fn push_panel(&mut self, layout: Duration, paint: Duration) {
+        let ms = |d: Duration| d.as_secs_f32() * 1e3;
+        self.ui.push(ms(layout + paint));
+        self.ui_paint.push(ms(paint));
+        if !layout.is_zero() {
+            self.ui_layout.push(ms(layout));
         }
     }
 
@@ -128,7 +143,14 @@ impl BenchLog {
             String::new()
         } else {
             let (umed, up99) = (quantile(&mut self.ui, 0.5), quantile(&mut self.ui, 0.99));
-            format!("; panel CPU ms median {umed:.3} p99 {up99:.3}")
+            let (n, laid) = (self.ui.len(), self.ui_layout.len());
+            let lmed = quantile(&mut self.ui_layout, 0.5);
+            let lp99 = quantile(&mut self.ui_layout, 0.99);
+            let pmed = quantile(&mut self.ui_paint, 0.5);
+            format!(
+                "; panel CPU ms median {umed:.3} p99 {up99:.3}: layout in {laid} of {n} frames \
+                 (median {lmed:.3} p99 {lp99:.3}), paint median {pmed:.3}"
+            )
         };
         format!(
             "bench: {what}: {n} frames: frame ms min {min:.2} median {med:.2} p99 {p99:.2}; \

@@ -89,7 +89,7 @@ impl BenchRun {
         gl: &glow::Context,
         sort_time: Duration,
         fresh: Freshness,
-        ui: Duration,
+        ui: crate::viewer::panel::Cpu,
     ) -> bool {
         // SAFETY: glFinish has no preconditions: the frame is complete when timed.
         unsafe { gl.finish() };
@@ -99,7 +99,7 @@ impl BenchRun {
         {
             self.log.push(end - last, sort_time, fresh);
             if self.spec.panel {
-                self.log.ui.push(ui.as_secs_f32() * 1e3);
+                self.log.push_panel(ui.layout, ui.paint);
             }
         }
         self.last_end = Some(end);
@@ -154,7 +154,7 @@ impl App {
             drawn.sort_time,
             drawn.fresh,
         );
-        let ui_time = self.panel.as_ref().map_or(Duration::ZERO, |p| p.cpu);
+        let ui_time = self.panel.as_ref().map_or(Default::default(), |p| p.cpu);
         let render = self.render_size();
         if let (Some(b), Some(shown)) = (&mut self.bench, &self.shown)
             && b.record(&win.gl, drawn.sort_time, drawn.fresh, ui_time)

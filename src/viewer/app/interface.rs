@@ -76,7 +76,8 @@ impl App {
         self.live.frame_ms = (mean, p99);
         self.live.sort_ms = sort;
         self.live.order = self.stats.order_text();
-        self.live.ui_ms = panel.cpu.as_secs_f32() * 1e3;
+        let ms = |d: std::time::Duration| d.as_secs_f32() * 1e3;
+        self.live.ui_ms = (ms(panel.cpu.layout), ms(panel.cpu.paint));
         let before = Settings {
             sh_degree: self.settings.sh_degree.unwrap_or(3).min(shown.sh_degree),
             background: self.opts.background,

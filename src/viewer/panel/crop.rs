@@ -99,11 +99,17 @@ pub fn handle_rect(centre: Pos2) -> Rect {
     Rect::from_center_size(centre, egui::vec2(2.5 * RADIUS, 2.5 * RADIUS))
 }
 
-/// Draws `crop` seen by `cam` on `ui` (the area outside the panel) and lets its face handles
-/// be dragged.
-pub fn show(ui: &mut Ui, cam: &Camera, px_to_points: f32, crop: &mut CropBox) -> Overlay {
+/// Draws `crop` seen by `cam` on `ui`, clipped to `area` (the window outside the panel), and
+/// lets its face handles there be dragged.
+pub fn show(
+    ui: &mut Ui,
+    area: Rect,
+    cam: &Camera,
+    px_to_points: f32,
+    crop: &mut CropBox,
+) -> Overlay {
     let pt = |p: Vec2| Pos2::new(p.x * px_to_points, p.y * px_to_points);
-    let painter = ui.painter().clone();
+    let painter = ui.painter().with_clip_rect(area);
     for (i, j) in edges() {
         if let Some((a, b)) = project_segment(cam, corner(crop, i), corner(crop, j)) {
             painter.line_segment([pt(a), pt(b)], Stroke::new(1.5, EDGE));
@@ -116,6 +122,9 @@ pub fn show(ui: &mut Ui, cam: &Camera, px_to_points: f32, crop: &mut CropBox) ->
             continue;
         };
         let centre = pt(p);
+        if !area.contains(centre) {
+            continue;
+        }
         out.handles[f] = Some(centre);
         let rect = handle_rect(centre);
         let resp = ui.interact(

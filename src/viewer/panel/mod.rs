@@ -65,11 +65,60 @@ pub struct Panel {
     handle_rects: Vec<egui::Rect>,
     /// `SPLATGL_VIEWER_LAYOUT` is set: print where the camera buttons are.
     layout_log: bool,
-    last_layout: Vec<String>,
+    logged: Vec<String>,
     /// egui asked for another frame (an animation, a tooltip).
     pub wants_repaint: bool,
-    /// CPU time of the last [`Panel::run`] plus [`Panel::paint`].
-    pub cpu: Duration,
+    /// An event reached egui since the last layout.
+    fed: bool,
+    /// When the interface was last laid out, and what it showed then.
+    laid_out: Option<(Instant, Seen)>,
+    /// CPU time of the last frame's layout (zero when the previous one was reused) and
+    /// painting.
+    pub cpu: Cpu,
+}
+
+/// CPU time of the interface in one frame.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Cpu {
+    /// egui's pass and tessellation (zero when the last layout was reused).
+    pub layout: Duration,
+    /// Texture updates and the GL calls of painting.
+    pub paint: Duration,
+}
+
+/// How often the statistics are refreshed on screen (and so, without input, the interface
+/// laid out again): the rate of the title bar.
+const REFRESH: Duration = Duration::from_millis(250);
+
+/// What a layout showed besides the statistics: when it changes the interface is laid out
+/// again at once.
+#[derive(Debug, Clone, PartialEq)]
+struct Seen {
+    settings: Settings,
+    up: UpAxis,
+    scene: (String, usize, usize),
+    /// The camera and image size, when the crop box is drawn over the scene.
+    camera: Option<([f32; 16], u32, u32, f32)>,
+}
+
+impl Seen {
+    fn of(view: &FrameView<'_>, settings: &Settings) -> Self {
+        let c = view.camera;
+        let overlay = settings.show_crop && settings.crop.is_some();
+        Seen {
+            settings: settings.clone(),
+            up: view.up,
+            scene: (
+                view.facts.name.clone(),
+                view.facts.splats,
+                view.facts.cameras.len(),
+            ),
+            camera: overlay.then(|| {
+                let m = c.world_to_camera.to_cols_array();
+                (m, c.width, c.height, c.fx)
+            }),
+        }
+    }
 }
 
 impl std::fmt::Debug for Panel {
@@ -108,9 +157,11 @@ impl Panel {
             panel_rect: egui::Rect::NOTHING,
             handle_rects: Vec::new(),
             layout_log: std::env::var_os("SPLATGL_VIEWER_LAYOUT").is_some(),
-            last_layout: Vec::new(),
+            logged: Vec::new(),
             wants_repaint: false,
-            cpu: Duration::ZERO,
+            fed: true,
+            laid_out: None,
+            cpu: Cpu::default(),
         })
     }
 
@@ -123,6 +174,7 @@ impl Panel {
         }
         let resp = self.input.on_window_event(window, event);
         self.wants_repaint |= resp.repaint;
+        self.fed = true;
         match event {
             WindowEvent::CursorMoved { position, .. } => {
                 let k = self.pixels_per_point.max(1e-3) as f64;
@@ -149,7 +201,9 @@ impl Panel {
     }
 
     /// Lays out one frame of the interface (and the crop box over the scene); edits
-    /// `settings` in place and pushes what the viewer must do to `actions`.
+    /// `settings` in place and pushes what the viewer must do to `actions`. Without input,
+    /// a change of what it shows, or an animation, the last layout is reused for
+    /// [`REFRESH`] (only the statistics would change).
     pub fn run(
         &mut self,
         window: &Window,
@@ -158,6 +212,16 @@ impl Panel {
         actions: &mut Vec<Action>,
     ) {
         let started = Instant::now();
+        let seen = Seen::of(&view, settings);
+        let fresh = self
+            .laid_out
+            .as_ref()
+            .is_some_and(|(t, s)| t.elapsed() < REFRESH && *s == seen);
+        if fresh && !self.fed && !self.wants_repaint {
+            self.cpu.layout = Duration::ZERO;
+            return;
+        }
+        self.fed = false;
         let raw = self.input.take_egui_input(window);
         let mut rects = ui::CameraRects::new();
         let mut overlay = crop::Overlay::default();
@@ -170,7 +234,7 @@ impl Panel {
             asked.clear();
             overlay = crop::Overlay::default();
             panel_rect = egui::Panel::left("splatgl-panel")
-                .default_size(300.0)
+                .default_size(280.0)
                 .show(root, |ui| {
                     ui::contents(
                         ui, view.facts, view.live, view.up, settings, &mut asked, &mut rects,
@@ -182,7 +246,8 @@ impl Panel {
             if settings.show_crop
                 && let Some(b) = &mut settings.crop
             {
-                overlay = crop::show(root, view.camera, px_to_points, b);
+                let area = root.available_rect_before_wrap();
+                overlay = crop::show(root, area, view.camera, px_to_points, b);
             }
         });
         actions.append(&mut asked);
@@ -203,7 +268,9 @@ impl Panel {
             .get(&ViewportId::ROOT)
             .is_some_and(|v| v.repaint_delay.is_zero());
         self.log_layout(panel_rect, &rects, &overlay.handles);
-        self.cpu = started.elapsed();
+        // What the pass may have edited counts as seen: no second layout for it.
+        self.laid_out = Some((Instant::now(), Seen::of(&view, settings)));
+        self.cpu.layout = started.elapsed();
     }
 
     /// Paints the last [`Panel::run`] into the bound framebuffer of `size` physical pixels.
@@ -221,7 +288,7 @@ impl Panel {
         for id in self.textures.free.drain() {
             self.painter.free_texture(id);
         }
-        self.cpu += started.elapsed();
+        self.cpu.paint = started.elapsed();
     }
 
     /// With `SPLATGL_VIEWER_LAYOUT` set: prints `layout: panel X Y W H`, `layout: camera I X
@@ -253,11 +320,11 @@ impl Panel {
         now.extend(handles.iter().enumerate().filter_map(|(f, p)| {
             p.map(|p| format!("layout: crop-face {f} {} {}", px(p.x), px(p.y)))
         }));
-        if now != self.last_layout {
+        if now != self.logged {
             for l in &now {
                 println!("{l}");
             }
-            self.last_layout = now;
+            self.logged = now;
         }
     }
 

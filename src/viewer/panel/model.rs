@@ -49,8 +49,9 @@ pub struct Live {
     pub order: String,
     /// Splats in the order drawn (after the crop).
     pub drawn: usize,
-    /// CPU time of the last interface pass (layout, tessellation, GL calls), ms.
-    pub ui_ms: f32,
+    /// CPU time of the interface in the last frame, ms: layout (egui's pass and
+    /// tessellation; 0 when the previous layout was reused) and painting (GL calls).
+    pub ui_ms: (f32, f32),
 }
 
 /// The settings the panel edits in place; the viewer applies what changed.

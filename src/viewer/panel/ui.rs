@@ -66,7 +66,9 @@ fn scene(ui: &mut Ui, f: &Facts) {
                 }
             });
             if !f.warnings.is_empty() {
-                ui.collapsing(format!("{} warnings", f.warnings.len()), |ui| {
+                let n = f.warnings.len();
+                let title = format!("{n} warning{}", if n == 1 { "" } else { "s" });
+                ui.collapsing(title, |ui| {
                     for w in &f.warnings {
                         ui.label(w);
                     }
@@ -99,7 +101,10 @@ fn statistics(ui: &mut Ui, l: &Live, resident: usize) {
                 row("order", l.order.clone());
                 row("resident", thousands(resident));
                 row("drawn", thousands(l.drawn));
-                row("interface", format!("{:.2} ms CPU", l.ui_ms));
+                row(
+                    "interface CPU",
+                    format!("{:.2} ms layout, {:.2} ms paint", l.ui_ms.0, l.ui_ms.1),
+                );
             });
         });
 }
