@@ -7,7 +7,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 npm_tools=(@playcanvas/splat-transform@3.7.0 @mkkellogg/gaussian-splats-3d@0.4.7 three@0.170.0
-  gltf-validator@2.0.0-dev.3.10)
+  gltf-validator@2.0.0-dev.3.10
+  # Spark 2.2 (scripts/conformance/spark.mjs) needs three >= 0.180 (a peer), GS3D's pin is 0.170:
+  # Spark's three is the alias three-spark (spark.html maps "three" to it); --force lets npm
+  # install Spark beside the unmet peer instead of refusing (ERESOLVE).
+  @sparkjsdev/spark@2.2.0 three-spark@npm:three@0.180.0 --force)
 if [ "$(cat .npm-tools/ci-installed 2>/dev/null)" = "${npm_tools[*]}" ]; then
   exit 0
 fi
