@@ -105,6 +105,8 @@ fn subpixel() -> AssetSpec {
         vec![cam("front", [0.0, 0.0, 4.0])],
     )
     .catches(&[Erratum::I])
+    // GaussianSplats3D's floor drops these splats (their smaller eigenvalue is ≤ 0).
+    .detects(&[Variant::EigenvalueFloor])
     // The RC leaves Σ' to "the same forward pass algorithm used during training".
     .profile()
 }

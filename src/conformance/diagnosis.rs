@@ -255,7 +255,15 @@ pub struct Failure<'a> {
 /// explains most of the cameras not yet explained is taken (a pair brings both its
 /// deviations), until no candidate explains another; ties go to the earlier deviation.
 /// Returns the entries and, per failure, the candidate chosen for it (`None`: unexplained).
-pub fn diagnose(failures: &[Failure]) -> (Vec<Diagnosis>, Vec<Option<Explanation>>) {
+///
+/// Deviations in `contradicted` (those an asset that *passed* is known to catch or detect: a
+/// renderer with them would have failed it) are chosen only after every consistent
+/// explanation: a tiny sub-pixel asset cannot tell erratum d from an eigenvalue floor, the
+/// passing assets can.
+pub fn diagnose(
+    failures: &[Failure],
+    contradicted: &[Deviation],
+) -> (Vec<Diagnosis>, Vec<Option<Explanation>>) {
     let mut chosen: Vec<Deviation> = Vec::new();
     let mut assigned: Vec<Option<Explanation>> = vec![None; failures.len()];
     loop {
@@ -271,20 +279,33 @@ pub fn diagnose(failures: &[Failure]) -> (Vec<Diagnosis>, Vec<Option<Explanation
             .collect();
         candidates.sort();
         candidates.dedup();
-        let mut best: Option<(usize, Vec<Deviation>)> = None;
+        // Key: consistent with the passing assets, cameras explained, then how closely (the
+        // sum of the best PSNRs, capped at 200 dB each).
+        let mut best: Option<((bool, usize, f64), Vec<Deviation>)> = None;
         for devs in candidates {
             let mut with = chosen.clone();
             with.extend(devs.iter().copied());
-            let n = failures
-                .iter()
-                .zip(&assigned)
-                .filter(|(g, a)| a.is_none() && g.explained_by.iter().any(|x| covered(x, &with)))
-                .count();
-            if best.as_ref().is_none_or(|(m, _)| n > *m) {
-                best = Some((n, devs.clone()));
+            let mut n = 0;
+            let mut fit = 0.0;
+            for (g, _) in failures.iter().zip(&assigned).filter(|(_, a)| a.is_none()) {
+                let psnr = g
+                    .explained_by
+                    .iter()
+                    .filter(|x| covered(x, &with))
+                    .map(|x| x.psnr.min(200.0))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                if psnr > f64::NEG_INFINITY {
+                    n += 1;
+                    fit += psnr;
+                }
+            }
+            let consistent = !devs.iter().any(|d| contradicted.contains(d));
+            let key = (consistent && n > 0, n, fit);
+            if best.as_ref().is_none_or(|(m, _)| key > *m) {
+                best = Some((key, devs.clone()));
             }
         }
-        let Some((n, devs)) = best else { break };
+        let Some(((_, n, _), devs)) = best else { break };
         if n == 0 {
             break;
         }

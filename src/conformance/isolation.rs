@@ -6,6 +6,7 @@ use super::Erratum;
 use super::assets::AssetSpec;
 use super::model::{self, Variant};
 use crate::camera::Camera;
+use crate::image::Image;
 
 /// A deviation an asset's bound can admit: an erratum or an implementation variant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,9 +27,13 @@ type TermField = fn(&mut model::Terms) -> &mut f64;
 ///   detected by `cutoff_three_sigma` alone;
 /// - the order by view depth instead of camera distance: an RC rule, detected by the sorting
 ///   assets;
-/// - 8-bit storage of the DC colour and the opacity (rounded down): a precision the RC does
-///   not specify, admitted everywhere (no asset detects it).
-const ISOLATED: [(Admitted, TermField); 5] = [
+/// - 8-bit storage of the DC colour and the opacity (rounded down), and half-float storage
+///   of the 3D covariance: precisions the RC does not specify, admitted everywhere (no asset
+///   detects them);
+/// - Σ' rebuilt from eigenvalues floored at mid ± √0.1 (GaussianSplats3D's numerical
+///   safeguard): like the dilation, a choice about Σ' at the scale of a pixel, detected by
+///   `subpixel_dilation` (a profile asset) alone.
+const ISOLATED: [(Admitted, TermField); 7] = [
     (Admitted::Erratum(Erratum::I), |t| &mut t.dilation),
     (Admitted::Erratum(Erratum::F), |t| &mut t.cutoff_shape),
     (Admitted::Variant(Variant::BoxCut), |t| &mut t.cutoff_shape),
@@ -37,6 +42,12 @@ const ISOLATED: [(Admitted, TermField); 5] = [
     }),
     (Admitted::Variant(Variant::Colour8Bit), |t| {
         &mut t.colour_8bit
+    }),
+    (Admitted::Variant(Variant::HalfCovariance), |t| {
+        &mut t.covariance_f16
+    }),
+    (Admitted::Variant(Variant::EigenvalueFloor), |t| {
+        &mut t.eigenvalue_floor
     }),
 ];
 
@@ -60,8 +71,38 @@ pub(crate) fn admitted_errata(spec: &AssetSpec) -> Vec<Erratum> {
         .collect()
 }
 
+/// The model image with the deviations `ds` at once.
+fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> Image {
+    let errata: Vec<Erratum> = ds
+        .iter()
+        .filter_map(|d| match d {
+            Admitted::Erratum(e) => Some(*e),
+            Admitted::Variant(_) => None,
+        })
+        .collect();
+    let variants: Vec<Variant> = ds
+        .iter()
+        .filter_map(|d| match d {
+            Admitted::Variant(v) => Some(*v),
+            Admitted::Erratum(_) => None,
+        })
+        .collect();
+    model::render_with(cloud, cam, &errata, &variants).image
+}
+
+/// The largest channel difference of two images at pixel `i`.
+fn diff_at(a: &Image, b: &Image, i: usize) -> f64 {
+    let (p, q) = (a.pixels[i], b.pixels[i]);
+    (0..3)
+        .map(|k| (p[k] as f64 - q[k] as f64).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Widens the bound by every deviation `spec` admits: per pixel, the largest channel
-/// difference between the model with and without it, added to its term.
+/// difference between the model with and without it, added to its term; then by what two or
+/// three of them do together beyond the sum of their terms (`combined`), so a renderer that
+/// makes several of the admitted choices at once (GaussianSplats3D: the 2.83σ cut, the
+/// eigenvalue floor, 8-bit colour, half-float covariances) passes as one that makes one.
 pub(crate) fn admit(
     exact: &mut model::ModelImage,
     spec: &AssetSpec,
@@ -69,11 +110,13 @@ pub(crate) fn admit(
     cam: &Camera,
 ) {
     let mut worst = model::Terms::default();
-    for (d, field) in ISOLATED.iter().filter(|(d, _)| !detects(spec, *d)) {
-        let other = match d {
-            Admitted::Erratum(e) => model::render(cloud, cam, &[*e]).image,
-            Admitted::Variant(v) => model::render_with(cloud, cam, &[], &[*v]).image,
-        };
+    let admitted: Vec<(Admitted, TermField)> = ISOLATED
+        .iter()
+        .copied()
+        .filter(|(d, _)| !detects(spec, *d))
+        .collect();
+    for (d, field) in &admitted {
+        let other = render_admitted(cloud, cam, &[*d]);
         // Terms of one field (the two cut-off shapes) take the larger difference.
         let mut per_field = model::Terms::default();
         for (i, (p, q)) in exact.image.pixels.iter().zip(&other.pixels).enumerate() {
@@ -88,5 +131,55 @@ pub(crate) fn admit(
         }
         worst = worst.max(per_field);
     }
+    worst.combined = admit_combined(exact, &admitted, cloud, cam);
     exact.worst = exact.worst.max(worst);
+}
+
+/// The `combined` term: per pixel, the most that any two or three admitted deviations
+/// together change the image beyond the sum of their own terms there. Pairs of the same term
+/// (the two cut-off shapes) are alternatives, not a combination, and are skipped.
+fn admit_combined(
+    exact: &mut model::ModelImage,
+    admitted: &[(Admitted, TermField)],
+    cloud: &crate::SplatCloud,
+    cam: &Camera,
+) -> f64 {
+    let n = admitted.len();
+    let mut sets: Vec<Vec<usize>> = Vec::new();
+    for i in 0..n {
+        for j in i + 1..n {
+            sets.push(vec![i, j]);
+            for k in j + 1..n {
+                sets.push(vec![i, j, k]);
+            }
+        }
+    }
+    let same_term = |a: usize, b: usize| {
+        let mut t = model::Terms::default();
+        *(admitted[a].1)(&mut t) = 1.0;
+        *(admitted[b].1)(&mut t) == 1.0
+    };
+    sets.retain(|s| {
+        s.iter()
+            .enumerate()
+            .all(|(x, &a)| s[x + 1..].iter().all(|&b| !same_term(a, b)))
+    });
+    let mut worst = 0.0f64;
+    for s in sets {
+        let ds: Vec<Admitted> = s.iter().map(|&i| admitted[i].0).collect();
+        let other = render_admitted(cloud, cam, &ds);
+        for i in 0..exact.bound.len() {
+            let mut own: f64 = 0.0;
+            for &k in &s {
+                own += *(admitted[k].1)(&mut exact.extra[i]);
+            }
+            let beyond = diff_at(&exact.image, &other, i) - own - exact.extra[i].combined;
+            if beyond > 0.0 {
+                exact.extra[i].combined += beyond;
+                exact.bound[i] += beyond;
+            }
+            worst = worst.max(exact.extra[i].combined);
+        }
+    }
+    worst
 }

@@ -108,7 +108,8 @@ fn terms_json(t: &Terms) -> Value {
         "alpha_threshold": t.threshold, "alpha_cap": t.cap, "sh_f16": t.sh_f16,
         "overbright": t.overbright, "float": t.float, "dilation": t.dilation,
         "cutoff_shape": t.cutoff_shape, "sort_order": t.sort_order,
-        "colour_8bit": t.colour_8bit,
+        "colour_8bit": t.colour_8bit, "covariance_f16": t.covariance_f16,
+        "eigenvalue_floor": t.eigenvalue_floor, "combined": t.combined,
     })
 }
 
@@ -128,6 +129,9 @@ fn terms_from_json(v: &Value) -> Terms {
         cutoff_shape: f("cutoff_shape"),
         sort_order: f("sort_order"),
         colour_8bit: f("colour_8bit"),
+        covariance_f16: f("covariance_f16"),
+        eigenvalue_floor: f("eigenvalue_floor"),
+        combined: f("combined"),
     }
 }
 

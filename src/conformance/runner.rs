@@ -308,16 +308,35 @@ fn failures(results: &[AssetResult]) -> Vec<Failure<'_>> {
         .collect()
 }
 
+/// The deviations that an asset which passed catches (its `catches` errata) or detects (its
+/// `detects` variants): a renderer with one of them would have failed it.
+fn contradicted(results: &[AssetResult]) -> Vec<diagnosis::Deviation> {
+    use diagnosis::Deviation;
+    let mut out = Vec::new();
+    for r in results.iter().filter(|r| !r.skipped && r.pass()) {
+        out.extend(r.asset.catches.iter().map(|&e| Deviation::Erratum(e)));
+        out.extend(
+            super::model::Variant::ALL
+                .into_iter()
+                .filter(|v| r.asset.detects.iter().any(|n| n == v.name()))
+                .map(Deviation::Variant),
+        );
+    }
+    out.sort();
+    out.dedup();
+    out
+}
+
 /// The smallest set of deviations that explains every failing camera of a run (see
 /// [`diagnosis::diagnose`]).
 pub fn diagnosis(results: &[AssetResult]) -> Vec<Diagnosis> {
-    diagnosis::diagnose(&failures(results)).0
+    diagnosis::diagnose(&failures(results), &contradicted(results)).0
 }
 
 /// Completes each explained failure's `cause` with the deviation the diagnosis attributes it
 /// to, or `unexplained` and the asset's stock hint.
 fn name_causes(results: &mut [AssetResult]) {
-    let (_, assigned) = diagnosis::diagnose(&failures(results));
+    let (_, assigned) = diagnosis::diagnose(&failures(results), &contradicted(results));
     let mut it = assigned.into_iter();
     for r in results.iter_mut().filter(|r| !r.skipped) {
         let hint = r.asset.failure_means.clone();

@@ -237,6 +237,9 @@ fn screen_covariance(
     let j0 = DVec3::new(fx / t.z, 0.0, -fx * txtz / t.z);
     let j1 = DVec3::new(0.0, fy / t.z, -fy * tytz / t.z);
     let m = c_matrix(scale, q).transpose() * view.w.transpose();
+    if view.var(Variant::HalfCovariance) {
+        return half_covariance(view, m, [j0, j1]);
+    }
     let (p0, p1) = (m * j0, m * j1);
     let d = if view.on(Erratum::I) {
         0.0
@@ -252,6 +255,38 @@ fn screen_covariance(
         [a, b, cc, det] = eigenvalue_floor(a, b, cc, det)?;
     }
     Some(([a, b, cc, det], p0.cross(p1).length_squared()))
+}
+
+/// [`screen_covariance`] with the world covariance Σ = Cᵀ… rounded to half floats first
+/// ([`Variant::HalfCovariance`]): `m` is `Cᵀ Wᵀ`, `j` the rows of J.
+fn half_covariance(view: &View, m: DMat3, [j0, j1]: [DVec3; 2]) -> Option<([f64; 4], f64)> {
+    use crate::load::codec::{f16_to_f32, f32_to_f16};
+    let h = |v: f64| f64::from(f16_to_f32(f32_to_f16(v as f32)));
+    let c = m * view.w; // Cᵀ
+    let sigma = c.transpose() * c; // Σ = C Cᵀ, world
+    let q = crate::covariance::pack_sym(sigma).map(h);
+    let sq = DMat3::from_cols(
+        DVec3::new(q[0], q[1], q[2]),
+        DVec3::new(q[1], q[3], q[4]),
+        DVec3::new(q[2], q[4], q[5]),
+    );
+    let wt = view.w.transpose();
+    let (u0, u1) = (wt * j0, wt * j1);
+    let (a0, b, c0) = (u0.dot(sq * u0), u0.dot(sq * u1), u1.dot(sq * u1));
+    let d = if view.on(Erratum::I) {
+        0.0
+    } else {
+        DILATION_PX2
+    };
+    let (mut a, mut b, mut cc) = (a0 + d, b, c0 + d);
+    let mut det = a * cc - b * b;
+    if !(det > 0.0 && det.is_finite()) {
+        return None;
+    }
+    if view.var(Variant::EigenvalueFloor) {
+        [a, b, cc, det] = eigenvalue_floor(a, b, cc, det)?;
+    }
+    Some(([a, b, cc, det], (a0 * c0 - b * b).max(0.0)))
 }
 
 /// Splat `i`'s opacity as the variants store it (`Colour8Bit`) and compensate it

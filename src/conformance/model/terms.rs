@@ -26,8 +26,15 @@ pub struct Terms {
     pub cutoff_shape: f64,
     /// …with splats ordered by view depth,
     pub sort_order: f64,
-    /// …and with the DC colour and the opacity stored in 8 bits (rounded down).
+    /// …with the DC colour and the opacity stored in 8 bits (rounded down),
     pub colour_8bit: f64,
+    /// …with the 3D covariance stored as half floats,
+    pub covariance_f16: f64,
+    /// …with Σ' rebuilt from floored eigenvalues (GaussianSplats3D's safeguard),
+    pub eigenvalue_floor: f64,
+    /// …and with two or three of them at once, beyond the sum of their own terms (a
+    /// footprint a little smaller *and* cut at 2.83σ loses pixels neither does alone).
+    pub combined: f64,
 }
 
 impl Terms {
@@ -45,6 +52,9 @@ impl Terms {
             + self.cutoff_shape
             + self.sort_order
             + self.colour_8bit
+            + self.covariance_f16
+            + self.eigenvalue_floor
+            + self.combined
     }
     pub(crate) fn max(self, o: Terms) -> Terms {
         Terms {
@@ -60,6 +70,9 @@ impl Terms {
             cutoff_shape: self.cutoff_shape.max(o.cutoff_shape),
             sort_order: self.sort_order.max(o.sort_order),
             colour_8bit: self.colour_8bit.max(o.colour_8bit),
+            covariance_f16: self.covariance_f16.max(o.covariance_f16),
+            eigenvalue_floor: self.eigenvalue_floor.max(o.eigenvalue_floor),
+            combined: self.combined.max(o.combined),
         }
     }
 }

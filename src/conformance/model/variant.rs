@@ -30,11 +30,14 @@ pub enum Variant {
     /// is ≤ 0 (GaussianSplats3D's vertex shader): near-round footprints come out slightly
     /// anisotropic, sub-pixel splats vanish.
     EigenvalueFloor,
+    /// The 3D covariance Σ stored as half floats (GaussianSplats3D's covariance textures,
+    /// Spark's packed splats): footprints off by up to ~0.05 % of their size.
+    HalfCovariance,
 }
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 11] = [
+    pub const ALL: [Variant; 12] = [
         Variant::BoxCut,
         Variant::ViewDepthOrder,
         Variant::AaCompensation,
@@ -46,6 +49,7 @@ impl Variant {
         Variant::SigmoidColour,
         Variant::Colour8Bit,
         Variant::EigenvalueFloor,
+        Variant::HalfCovariance,
     ];
     /// A short identifier (the diagnosis's `rule`).
     pub fn name(self) -> &'static str {
@@ -61,6 +65,7 @@ impl Variant {
             Variant::SigmoidColour => "sigmoid_colour",
             Variant::Colour8Bit => "colour_and_opacity_8bit",
             Variant::EigenvalueFloor => "eigenvalue_floor",
+            Variant::HalfCovariance => "covariance_f16",
         }
     }
     /// What a renderer with this variant does, for reports.
@@ -85,6 +90,7 @@ impl Variant {
             Variant::EigenvalueFloor => {
                 "Σ' rebuilt from eigenvalues mid ± √max(0.1, mid² − det) (near-round footprints anisotropic, sub-pixel splats dropped)"
             }
+            Variant::HalfCovariance => "3D covariance stored as half floats (lossy storage)",
         }
     }
     /// The RC section whose rule the variant departs from.
@@ -103,6 +109,9 @@ impl Variant {
                 "RC Attributes (float SH, OPACITY); the RC does not specify a renderer's precision"
             }
             Variant::EigenvalueFloor => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
+            Variant::HalfCovariance => {
+                "RC Splat Reconstruction (Σ = R S Sᵀ Rᵀ); the RC does not specify a renderer's precision"
+            }
         }
     }
     /// Whether the RC allows it: an image that matches it passes.
@@ -112,10 +121,10 @@ impl Variant {
             Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2
         )
     }
-    /// Whether it is only a precision the RC does not specify (8-bit storage): every asset's
-    /// bound admits it, so an image with it passes.
+    /// Whether it is only a precision the RC does not specify (8-bit colour, half-float
+    /// covariance): every asset's bound admits it, so an image with it passes.
     pub fn precision_only(self) -> bool {
-        self == Variant::Colour8Bit
+        matches!(self, Variant::Colour8Bit | Variant::HalfCovariance)
     }
     /// The highest SH degree evaluated (3: all).
     pub(super) fn sh_cap(v: &[Variant]) -> usize {
