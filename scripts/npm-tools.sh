@@ -11,7 +11,8 @@ npm_tools=(@playcanvas/splat-transform@3.7.0 @mkkellogg/gaussian-splats-3d@0.4.7
   # Spark 2.2 (scripts/conformance/spark.mjs) needs three >= 0.180 (a peer), GS3D's pin is 0.170:
   # Spark's three is the alias three-spark (spark.html maps "three" to it); --force lets npm
   # install Spark beside the unmet peer instead of refusing (ERESOLVE).
-  @sparkjsdev/spark@2.2.0 three-spark@npm:three@0.180.0 --force)
+  @sparkjsdev/spark@2.2.0 three-spark@npm:three@0.180.0 --force
+  cesium@1.145.0)
 if [ "$(cat .npm-tools/ci-installed 2>/dev/null)" = "${npm_tools[*]}" ]; then
   exit 0
 fi

@@ -1,0 +1,290 @@
+#!/usr/bin/env node
+// Renders a splatgl conformance suite with CesiumJS 1.145 (npm `cesium`) in headless Chromium,
+// so `splatgl conformance run SUITE --images OUT` grades a renderer splatgl did not write.
+//
+//   node scripts/conformance/cesium.mjs SUITE OUT [--splatgl target/debug/splatgl] [--only ASSET]
+//
+// CesiumJS 1.145 draws Gaussian splats only as the content of a 3D Tiles tileset, and only
+// SPZ-compressed ones: GltfLoader.js marks a primitive for splat processing only when it
+// carries KHR_gaussian_splatting_compression_spz_2 (fetchSpzExtensionFrom, line 2158-2168 and
+// 2358-2363), and Cesium3DTileContentFactory.js (lines 98-102, 115-119) routes glTF content to
+// GaussianSplat3DTileContent only when the tileset lists both extensions as required. So each
+// asset is
+//
+//  1. converted with `splatgl convert ASSET content.glb --spz-compress` (SPZ v2; node
+//     transforms baked into one primitive, as the RC's math allows; lossy, see docs/formats.md);
+//  2. given the COLOR_0 placeholder CesiumJS reads the SPZ colours and alphas into
+//     (GltfVertexBufferLoader.js line 444: only the semantic COLOR_0) in place of the RC's
+//     KHR_gaussian_splatting:SH_DEGREE_0_COEF_0 and :OPACITY placeholders (which CesiumJS would
+//     count as SH coefficients: GaussianSplat3DTileContent.js line 646-661) — the SPZ payload is
+//     not touched — and an identity node matrix (it multiplies nodes[0].matrix unconditionally,
+//     GaussianSplatPrimitive.js line 1245-1249);
+//  3. made the one content of a tileset.json (3D Tiles 1.1, 3DTILES_content_gltf listing both
+//     extensions as used and required; root tile: bounding sphere around the decoded positions
+//     plus a margin, geometricError 0, refine ADD; the tileset's own geometricError large so the
+//     root is traversed at all) whose root transform makes Cesium's world
+//     frame the glTF's world frame, placed on the ellipsoid, exactly (WORLD, TILE_TRANSFORM
+//     below).
+//
+// Each camera of the asset's cameras.json is then set on Cesium's camera, mapped by WORLD
+// (position; direction = R·(0, 0, 1) and up = −R·(0, 1, 0) from the OpenCV camera → world
+// rotation R; PerspectiveFrustum fov and aspect from fy, width, height; near = the glTF
+// camera's znear), a fresh tileset is loaded for it (so Cesium's one sort is made for exactly
+// that camera), and the canvas is read back as PNG: OUT/ASSET/CAMERA.png. The npm packages come
+// from .npm-tools/ (scripts/npm-tools.sh); the page and Cesium's static files (Build/Cesium)
+// are served from 127.0.0.1 only; no Ion token, imagery, terrain, globe, sky or credits are
+// requested; chromium is killed after the last image or after the time limit.
+//
+// Like gs3d.mjs, it rolls each camera by CESIUM_ROLL = 1e-4 rad about its view axis by
+// default, and also moves it sideways by CESIUM_SHIFT = 1e-4 (about 0.003 px), which keeps
+// Cesium's vertex shader off its degenerate eigenvector case (exactly axis-aligned footprints
+// wider than tall, and exactly round ones, vanish or turn; cesium.html explains).
+// CESIUM_ROLL=0 CESIUM_SHIFT=0 renders the cameras exactly, and that bug with them.
+//
+// Environment: CESIUM_ROLL (radians, default 1e-4), CESIUM_SHIFT (glTF units, default 1e-4),
+// CESIUM_VIEW=ASSET/CAMERA (one view), CESIUM_DEBUG=1 (page logs on stderr),
+// CESIUM_GL=1 (ANGLE on GL instead of SwiftShader), SPLATGL_ROOT (the splatgl checkout with
+// target/debug/splatgl and .npm-tools/; default: the checkout this script is in).
+import { spawn, execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import http from 'node:http';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const root = process.env.SPLATGL_ROOT || path.resolve(here, '../..');
+const args = process.argv.slice(2);
+const opt = (name, dflt) => {
+  const i = args.indexOf(name);
+  return i >= 0 ? args.splice(i, 2)[1] : dflt;
+};
+const splatgl = opt('--splatgl', path.join(root, 'target/debug/splatgl'));
+const only = opt('--only', null);
+const limitS = Number(opt('--timeout', '600'));
+const [suite, out] = args;
+if (!suite || !out) {
+  console.error('usage: cesium.mjs SUITE OUT [--splatgl PATH] [--only ASSET] [--timeout S]');
+  process.exit(2);
+}
+const cesiumBuild = path.join(root, '.npm-tools/node_modules/cesium/Build/Cesium');
+if (!fs.existsSync(path.join(cesiumBuild, 'Cesium.js'))) {
+  console.error(`cesium.mjs: ${cesiumBuild}/Cesium.js not installed (scripts/npm-tools.sh)`);
+  process.exit(2);
+}
+
+// A GLB's JSON (first chunk) and BIN (second chunk, if any); .gltf: the JSON alone.
+const readGlb = (d) => {
+  if (d.length >= 20 && d.readUInt32LE(0) === 0x46546c67) {
+    const len = d.readUInt32LE(12);
+    const json = JSON.parse(d.subarray(20, 20 + len).toString('utf8'));
+    const at = 20 + len;
+    const bin = d.length >= at + 8 ? d.subarray(at + 8, at + 8 + d.readUInt32LE(at)) : null;
+    return { json, bin };
+  }
+  return { json: JSON.parse(d.toString('utf8')), bin: null };
+};
+const writeGlb = (json, bin) => {
+  let js = Buffer.from(JSON.stringify(json), 'utf8');
+  js = Buffer.concat([js, Buffer.alloc((4 - (js.length % 4)) % 4, 0x20)]);
+  const chunks = [Buffer.alloc(8), js];
+  chunks[0].writeUInt32LE(js.length, 0);
+  chunks[0].writeUInt32LE(0x4e4f534a, 4);
+  if (bin) {
+    const b = Buffer.concat([bin, Buffer.alloc((4 - (bin.length % 4)) % 4, 0)]);
+    const h = Buffer.alloc(8);
+    h.writeUInt32LE(b.length, 0);
+    h.writeUInt32LE(0x004e4942, 4);
+    chunks.push(h, b);
+  }
+  const body = Buffer.concat(chunks);
+  const header = Buffer.alloc(12);
+  header.writeUInt32LE(0x46546c67, 0);
+  header.writeUInt32LE(2, 4);
+  header.writeUInt32LE(12 + body.length, 8);
+  return Buffer.concat([header, body]);
+};
+
+// Step 2 above: the placeholders CesiumJS 1.145 expects, the SPZ payload unchanged.
+const PREFIX = 'KHR_gaussian_splatting:';
+function cesiumPlaceholders(json) {
+  const prims = json.meshes.flatMap((m) => m.primitives);
+  if (prims.length !== 1) throw new Error(`${prims.length} primitives after convert (expected 1)`);
+  const attrs = prims[0].attributes;
+  const count = json.accessors[attrs.POSITION].count;
+  delete attrs[`${PREFIX}OPACITY`];
+  delete attrs[`${PREFIX}SH_DEGREE_0_COEF_0`];
+  json.accessors.push({ componentType: 5121, normalized: true, count, type: 'VEC4' });
+  attrs.COLOR_0 = json.accessors.length - 1;
+  for (const n of json.nodes) if (n.mesh !== undefined && !n.matrix && !n.translation && !n.rotation && !n.scale) {
+    n.matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+  }
+  return json.accessors[attrs.POSITION];
+}
+
+// Where the glTF's world frame goes: the east-north-up frame at longitude 0, latitude 0,
+// height 0 (ECEF (R, 0, 0), R = 6378137 m; east (0, 1, 0), north (0, 0, 1), up (1, 0, 0),
+// exact numbers), glTF +y up, as Cesium turns y-up content: WORLD = ENU · Y_UP_TO_Z_UP,
+// (x, y, z) → (R + y, x, −z). (Not the ECEF origin: Cesium's camera needs a cartographic
+// position, Camera._updateCameraChanged, which the Earth's centre has not.) The cameras are
+// mapped by WORLD too (cesium.html), so every view is the one of cameras.json exactly.
+const R = 6378137;
+const WORLD = [0, 1, 0, 0, 1, 0, 0, 0, 0, 0, -1, 0, R, 0, 0, 1];
+// The root tile's transform, column-major. Cesium places a splat at
+//   tile transform · Y_UP_TO_Z_UP · nodes[0].matrix · p_payload
+// (GaussianSplatPrimitive.js transformTile, lines 1239-1249; the axis correction is
+// getAxisCorrectionMatrix(Y, X) = Y_UP_TO_Z_UP, line 1003-1007: (x, y, z) → (x, −z, y)), and
+// reads the SPZ payload's numbers as they are (GltfSpzLoader.js line 237-239:
+// coordinateSystem "UNSPECIFIED"). splatgl writes the payload in SPZ's RUB axes as the
+// extension's text asks (docs/formats.md, "glTF with SPZ compression"): p_payload = D · p,
+// D = diag(−1, 1, −1) — a 180° turn about y, applied to rotations and (by parity) SH
+// coefficients as well. So the transform is WORLD · (Y_UP_TO_Z_UP · D)⁻¹ = ENU · diag(−1, −1, 1)
+// (Y_UP_TO_Z_UP · D · Y_UP_TO_Z_UP⁻¹ is the 180° turn about z), and a splat at glTF p lands at
+// WORLD · p. SH view directions use the inverse of the same chain (GaussianSplatPrimitive.js
+// line 1785-1807), so they end up in the payload's frame, where the SH were written.
+const TILE_TRANSFORM = [0, -1, 0, 0, 0, 0, -1, 0, 1, 0, 0, 0, R, 0, 0, 1];
+const yUpToZUp = ([x, y, z]) => [x, -z, y];
+
+const manifest = JSON.parse(fs.readFileSync(path.join(suite, 'manifest.json'), 'utf8'));
+const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'splatgl-cesium-'));
+const views = [];
+const onlyView = process.env.CESIUM_VIEW;
+const roll = Number(process.env.CESIUM_ROLL ?? '1e-4');
+if (!Number.isFinite(roll)) { console.error('cesium.mjs: CESIUM_ROLL is not a number'); process.exit(2); }
+if (roll !== 0) console.error(`cesium.mjs: cameras rolled by ${roll} rad (CESIUM_ROLL=0 for none)`);
+const shift = Number(process.env.CESIUM_SHIFT ?? '1e-4');
+if (!Number.isFinite(shift)) { console.error('cesium.mjs: CESIUM_SHIFT is not a number'); process.exit(2); }
+if (shift !== 0) console.error(`cesium.mjs: cameras shifted by ${shift} sideways (CESIUM_SHIFT=0 for none)`);
+for (const a of manifest.assets) {
+  if (only && a.name !== only) continue;
+  if (onlyView && !onlyView.startsWith(`${a.name}/`)) continue;
+  const dir = path.join(tmp, a.name);
+  fs.mkdirSync(dir);
+  const glb = path.join(dir, 'content.glb');
+  let gltfCameras = [];
+  try {
+    gltfCameras = readGlb(fs.readFileSync(path.join(suite, a.file))).json.cameras || [];
+    execFileSync(splatgl, ['convert', path.join(suite, a.file), glb, '--spz-compress', '-f'], { stdio: 'pipe' });
+    const { json, bin } = readGlb(fs.readFileSync(glb));
+    const pos = cesiumPlaceholders(json);
+    fs.writeFileSync(glb, writeGlb(json, bin));
+    // Bounding sphere of the decoded positions (POSITION min/max: glTF axes, as a reader
+    // converting RUB decodes them; D turns them to the payload's), in the tile's frame (after
+    // Y_UP_TO_Z_UP), with a margin for the splats' extent: it only lowers the near plane
+    // Cesium fits to it (View.js line 183), never below the camera's.
+    const [cx, cy, cz] = pos.min.map((lo, i) => (lo + pos.max[i]) / 2);
+    const c = yUpToZUp([-cx, cy, -cz]);
+    const half = Math.hypot(...pos.min.map((lo, i) => (pos.max[i] - lo) / 2));
+    const tileset = {
+      asset: { version: '1.1' },
+      extensionsUsed: ['3DTILES_content_gltf'],
+      extensions: { '3DTILES_content_gltf': {
+        extensionsUsed: ['KHR_gaussian_splatting', 'KHR_gaussian_splatting_compression_spz_2'],
+        extensionsRequired: ['KHR_gaussian_splatting', 'KHR_gaussian_splatting_compression_spz_2'],
+      } },
+      // Positive, or the root is never traversed: Cesium3DTilesetBaseTraversal.js line 54-59
+      // stops when the tileset's own geometricError gives an SSE <= the maximum (16 px).
+      geometricError: 1e6,
+      root: {
+        transform: TILE_TRANSFORM,
+        boundingVolume: { sphere: [...c, half * 1.5 + 1] },
+        geometricError: 0,
+        refine: 'ADD',
+        content: { uri: 'content.glb' },
+      },
+    };
+    fs.writeFileSync(path.join(dir, 'tileset.json'), JSON.stringify(tileset));
+  } catch (e) {
+    console.error(`${a.name}: cannot make its tileset: ${e.stderr || e.message}`);
+    continue;
+  }
+  const cams = JSON.parse(fs.readFileSync(path.join(suite, a.cameras_json), 'utf8'));
+  for (const c of a.cameras) {
+    const j = cams[c.cameras_json_index];
+    if (onlyView && c.image !== onlyView) continue;
+    views.push({ image: c.image, tileset: `/tiles/${a.name}/tileset.json`, width: c.width,
+                 height: c.height, fy: j.fy, position: j.position, rotation: j.rotation, roll, shift, world: WORLD,
+                 znear: gltfCameras[c.gltf_camera]?.perspective?.znear ?? 0.05 });
+    if (Math.abs(j.fx - j.fy) > 1e-3 * j.fy || Math.abs(j.cx - c.width / 2) > 1e-3 || Math.abs(j.cy - c.height / 2) > 1e-3) {
+      console.error(`${c.image}: fx != fy or the principal point is off centre; the page assumes neither`);
+    }
+  }
+}
+
+const send = (res, code, type, body) => { res.writeHead(code, { 'content-type': type }); res.end(body); };
+const inside = (base, rel) => {
+  const p = path.resolve(base, '.' + path.posix.normalize('/' + rel));
+  return p.startsWith(base + path.sep) ? p : null;
+};
+const types = { '.js': 'text/javascript', '.json': 'application/json', '.wasm': 'application/wasm',
+                '.css': 'text/css', '.png': 'image/png', '.jpg': 'image/jpeg', '.glb': 'model/gltf-binary' };
+let done;
+const finished = new Promise((r) => { done = r; });
+let received = 0;
+const expected = new Set(views.map((v) => v.image));
+const server = http.createServer((req, res) => {
+  let url;
+  try { url = decodeURIComponent(req.url.split('?')[0]); } catch { return send(res, 400, 'text/plain', 'bad url'); }
+  if (req.method === 'POST') {
+    let body = '';
+    req.on('data', (d) => { body += d; });
+    req.on('end', () => {
+      if (url === '/result') {
+        let msg;
+        try { msg = JSON.parse(body); } catch { return send(res, 400, 'text/plain', 'bad json'); }
+        const { image, png } = msg;
+        // Only the suite's own image names: nothing is written outside OUT.
+        if (!expected.has(image) || typeof png !== 'string') return send(res, 400, 'text/plain', 'unknown image');
+        const file = path.join(out, `${image}.png`);
+        fs.mkdirSync(path.dirname(file), { recursive: true });
+        fs.writeFileSync(file, Buffer.from(png.split(',')[1], 'base64'));
+        received++;
+      } else if (url === '/log') {
+        console.error(`page: ${body}`);
+      } else if (url === '/done') {
+        done();
+      }
+      send(res, 200, 'text/plain', 'ok');
+    });
+    return;
+  }
+  let file = null;
+  if (url === '/' || url === '/page') file = path.join(here, 'cesium.html');
+  else if (url === '/views.json') return send(res, 200, 'application/json', JSON.stringify(views));
+  else if (url.startsWith('/cesium/')) file = inside(cesiumBuild, url.slice(8));
+  else if (url.startsWith('/tiles/')) file = inside(tmp, url.slice(7));
+  if (!file || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
+    if (process.env.CESIUM_DEBUG) console.error(`cesium.mjs: 404 ${url}`);
+    return send(res, 404, 'text/plain', 'not found');
+  }
+  const type = file.endsWith('.html') ? 'text/html' : types[path.extname(file)] || 'application/octet-stream';
+  send(res, 200, type, fs.readFileSync(file));
+});
+server.listen(0, '127.0.0.1', () => {
+  const port = server.address().port;
+  const chromium = ['chromium', 'chromium-browser'].find((b) => {
+    try { execFileSync(b, ['--version'], { stdio: 'ignore' }); return true; } catch { return false; }
+  });
+  if (!chromium) { console.error('cesium.mjs: chromium not found'); process.exit(2); }
+  const browser = spawn(chromium, ['--headless', '--no-sandbox', ...(process.env.CESIUM_GL ? ['--use-angle=gl', '--ignore-gpu-blocklist', '--use-gl=angle'] : ['--use-angle=swiftshader']),
+    '--enable-unsafe-swiftshader', '--disable-extensions', '--no-first-run', '--force-device-scale-factor=1',
+    `--user-data-dir=${path.join(tmp, 'profile')}`, `http://127.0.0.1:${port}/page${process.env.CESIUM_DEBUG ? '?debug' : ''}`],
+    { stdio: ['ignore', 'ignore', 'pipe'] });
+  browser.stderr.on('data', () => {});
+  const timer = setTimeout(() => { console.error(`cesium.mjs: timed out after ${limitS} s`); done(); }, limitS * 1000);
+  finished.then(() => {
+    clearTimeout(timer);
+    console.log(`cesium.mjs: ${received} of ${views.length} images -> ${out}`);
+    const code = received === views.length ? 0 : 1;
+    // Remove the temporary folder (tilesets, chromium profile) only once chromium has exited.
+    const cleanup = () => {
+      try { fs.rmSync(tmp, { recursive: true, force: true, maxRetries: 5 }); } catch (e) {
+        console.error(`cesium.mjs: could not remove ${tmp}: ${e.message}`);
+      }
+      process.exit(code);
+    };
+    server.close();
+    if (browser.exitCode !== null || browser.signalCode !== null) cleanup();
+    else { browser.once('exit', cleanup); browser.kill('SIGKILL'); setTimeout(cleanup, 5000); }
+  });
+});
