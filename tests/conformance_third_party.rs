@@ -123,6 +123,12 @@ fn gaussian_splats_3d_is_graded_by_the_rules_its_source_breaks() {
     assert!(named_for("eigenvalue_floor").contains(&"subpixel_dilation".to_owned()));
     // src/worker/sorter.cpp: the key is clip-space z (view depth), not camera distance.
     assert!(!asset("sort_distance_not_depth")["pass"].as_bool().unwrap());
+    assert!(named_for("view_depth_order").contains(&"sort_distance_not_depth".to_owned()));
+    // The diagnosis names its three deviations that an asset decides, and nothing else (the
+    // eigenvalue floor rather than erratum d, which 30 passing assets contradict).
+    let mut all = named.clone();
+    all.sort();
+    assert_eq!(all, ["eigenvalue_floor", "erratum_f", "view_depth_order"]);
     // :12364 "Valid values are 0 - 2": degree 3 ignored, which the RC allows.
     for a in ["sh_degree_3", "sh_rotated_node"] {
         let a = asset(a);
@@ -131,7 +137,9 @@ fn gaussian_splats_3d_is_graded_by_the_rules_its_source_breaks() {
         assert!(cause.contains("the RC allows it"), "{cause}");
     }
     let passed = json["passed"].as_u64().unwrap();
-    assert!(passed >= 8, "{passed} RC assets pass");
+    // Measured 23 of 29 (docs/conformance.md): its other choices (8-bit colour, half-float
+    // covariances, the 2.83σ cut and the floor together) are admitted where not tested.
+    assert!(passed >= 20, "{passed} RC assets pass");
     for d in [&suite, &images, &report] {
         std::fs::remove_dir_all(d).ok();
     }
