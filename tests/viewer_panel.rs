@@ -33,25 +33,9 @@ fn cameras_json(dir: &std::path::Path) -> (std::path::PathBuf, Vec3) {
     (path, other)
 }
 
-/// `render --backend gl --target rgba16f` of the default scene with `args`.
+/// [`render_gl`], which has EGL here (the test checked with [`reference`]).
 fn render(dir: &std::path::Path, args: &[&str]) -> splatgl::image::Image {
-    let out = dir.join("render.png");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_splatgl"))
-        .args([
-            "render",
-            "--backend",
-            "gl",
-            "--target",
-            "rgba16f",
-            "-f",
-            "-o",
-        ])
-        .arg(&out)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    splatgl::image::Image::read(&out).unwrap()
+    render_gl(dir, args).expect("EGL was there a moment ago")
 }
 
 #[test]

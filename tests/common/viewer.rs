@@ -314,11 +314,10 @@ impl Viewer {
     }
 }
 
-/// `splatgl render --backend gl --target rgba16f` of the default scene from [`CAMERA`] (and
-/// `extra` options)
-/// (None when there is no EGL here).
-pub fn reference(cwd: &Path, extra: &[&str]) -> Option<Image> {
-    let out = cwd.join("reference.png");
+/// `splatgl render --backend gl --target rgba16f` of the default scene with `args` (None when
+/// there is no EGL here: a skip, which fails under `SPLATGL_REQUIRE=all`).
+pub fn render_gl(cwd: &Path, args: &[&str]) -> Option<Image> {
+    let out = cwd.join("render.png");
     let o = Command::new(env!("CARGO_BIN_EXE_splatgl"))
         .args([
             "render",
@@ -330,8 +329,7 @@ pub fn reference(cwd: &Path, extra: &[&str]) -> Option<Image> {
             "-o",
         ])
         .arg(&out)
-        .args(CAMERA)
-        .args(extra)
+        .args(args)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
@@ -341,6 +339,11 @@ pub fn reference(cwd: &Path, extra: &[&str]) -> Option<Image> {
     }
     assert!(o.status.success(), "{err}");
     Some(Image::read(&out).unwrap())
+}
+
+/// [`render_gl`] from [`CAMERA`] (and `extra` options).
+pub fn reference(cwd: &Path, extra: &[&str]) -> Option<Image> {
+    render_gl(cwd, &[&CAMERA[..], extra].concat())
 }
 
 /// Columns `x0..x1` of `img`.
