@@ -28,7 +28,7 @@
 //! (`SPLATGL_BENCH_CROSSOVER`, default `10,100,1000,10000,100000` splats, SH 3, direct vs
 //! pre-pass; `none` skips it). `SPLATGL_BENCH_PREDICT=0` skips the prediction table.
 //!
-//! `cargo bench --bench gl`; `scripts/bench-gpu.sh` runs it at 1920×1080 with 1M and 4M.
+//! `cargo bench --features testing --bench gl`; `scripts/bench-gpu.sh` runs it at 1920×1080 with 1M and 4M.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -41,7 +41,7 @@ use glow::HasContext;
 use splatgl::camera::Camera;
 use splatgl::cull::{CullBounds, visible_into};
 use splatgl::gl::{
-    ColorFormat, DrawPath, Pipeline, ReadbackTarget, SplatRenderer, frustum_for_camera,
+    ColorFormat, DrawPath, Errata, Pipeline, ReadbackTarget, SplatRenderer, frustum_for_camera,
 };
 use splatgl::headless::{GlApi, HeadlessContext};
 use splatgl::sort::{SortRequest, Sorter};
@@ -123,16 +123,18 @@ impl PathKind {
     }
 
     fn draw_path(self) -> DrawPath {
-        let with = |pipeline| DrawPath {
-            pipeline,
-            former_quads: false,
+        let pipeline = match self {
+            PathKind::Former | PathKind::Cull | PathKind::Extent => Pipeline::Direct,
+            PathKind::New => Pipeline::Auto,
+            PathKind::PrePass => Pipeline::PrePass,
         };
-        match self {
-            PathKind::Former | PathKind::Cull => DrawPath::FORMER,
-            PathKind::Extent => with(Pipeline::Direct),
-            PathKind::New => DrawPath::default(),
-            PathKind::PrePass => with(Pipeline::PrePass),
-        }
+        DrawPath { pipeline }
+    }
+
+    /// Whether the path draws the former quads (the renderer built with
+    /// `Errata::FORMER_QUADS`).
+    fn former_quads(self) -> bool {
+        matches!(self, PathKind::Former | PathKind::Cull)
     }
 
     fn culls(self) -> bool {
@@ -160,6 +162,8 @@ impl Row {
 struct Bench<'a> {
     gl: &'a glow::Context,
     renderer: SplatRenderer,
+    /// The same cloud by the former quads (its own program, `Errata::FORMER_QUADS`).
+    former: SplatRenderer,
     sorter: Sorter,
     query: Option<(u32, glow::Query)>,
     frames: usize,
@@ -167,6 +171,12 @@ struct Bench<'a> {
 }
 
 impl Bench<'_> {
+    /// Uploads `cloud` to both renderers (the current quads and the former ones).
+    fn upload(&mut self, cloud: &SplatCloud) {
+        self.renderer.upload(self.gl, cloud).unwrap();
+        self.former.upload(self.gl, cloud).unwrap();
+    }
+
     /// Runs `frames` (+ 1 warm-up) frames of `cloud` from `cam` orbiting by `step` radians per
     /// frame around `target`, by `path`.
     fn run(
@@ -178,7 +188,12 @@ impl Bench<'_> {
         path: PathKind,
     ) -> Row {
         let gl = self.gl;
-        self.renderer.set_draw_path(gl, path.draw_path()).unwrap();
+        let renderer = if path.former_quads() {
+            &mut self.former
+        } else {
+            &mut self.renderer
+        };
+        renderer.set_draw_path(gl, path.draw_path()).unwrap();
         let (w, h) = self.size;
         let mut rows = Vec::new();
         for f in 0..=self.frames {
@@ -200,7 +215,7 @@ impl Bench<'_> {
                 self.sorter.sort_by_distance(&cloud.positions, eye)
             };
             let drawn = order.len();
-            self.renderer.set_order(gl, order).unwrap();
+            renderer.set_order(gl, order).unwrap();
             // SAFETY: glFinish has no preconditions.
             unsafe { gl.finish() };
             let (t1, c1) = (Instant::now(), cpu_time());
@@ -210,7 +225,7 @@ impl Bench<'_> {
                     gl.begin_query(target, q);
                 }
             }
-            self.renderer.draw_current(gl, &cam).unwrap();
+            renderer.draw_current(gl, &cam).unwrap();
             // SAFETY: ends the query begun above; glFinish.
             let fragments = unsafe {
                 let r = self.query.map(|(target, q)| {
@@ -228,7 +243,7 @@ impl Bench<'_> {
                     sort: ms(t1 - t0),
                     draw: ms(t2 - t1),
                     draw_cpu: ms(c2 - c1),
-                    prepass: self.renderer.last_draw_used_prepass(),
+                    prepass: renderer.last_draw_used_prepass(),
                 });
             }
         }
@@ -405,6 +420,7 @@ fn main() {
     let mut b = Bench {
         gl,
         renderer: SplatRenderer::new(gl).unwrap(),
+        former: SplatRenderer::with_errata(gl, Errata::FORMER_QUADS).unwrap(),
         sorter: Sorter::new(),
         query,
         frames,
@@ -429,7 +445,7 @@ fn main() {
             println!("{name}: not available (skipped)");
             continue;
         };
-        b.renderer.upload(gl, &cloud).unwrap();
+        b.upload(&cloud);
         let bounds = CullBounds::new(&cloud);
         let half = half_view(&cam, &cloud, &bounds);
         for (view, c) in [("full", cam), ("half", half)] {
@@ -465,6 +481,7 @@ fn main() {
     }
     predict::crossover(&mut b, &crossover, scale);
     b.renderer.destroy(gl);
+    b.former.destroy(gl);
     frame.destroy(gl);
 }
 

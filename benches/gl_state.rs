@@ -10,7 +10,7 @@
 //! state (blending off, `ONE, ZERO`, depth writes on), so restore mode changes and puts back
 //! the usual pieces (bindings, blend, depth mask); the modes alternate draw by draw.
 //!
-//! `cargo bench --bench gl_state` (`SPLATGL_BENCH_DRAWS`, default 4000).
+//! `cargo bench --features testing --bench gl_state` (`SPLATGL_BENCH_DRAWS`, default 4000).
 
 #[path = "../tests/common/mod.rs"]
 mod common;

@@ -4,7 +4,7 @@
 //! a memory-bandwidth baseline; and (printed once, not timed) the
 //! order error of the quantized modes.
 //!
-//! Run: `cargo bench --bench sort` (filter with e.g. `-- 1000000`).
+//! Run: `cargo bench --features testing --bench sort` (filter with e.g. `-- 1000000`).
 
 use std::hint::black_box;
 use std::time::Duration;

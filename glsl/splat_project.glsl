@@ -36,7 +36,6 @@ uniform int u_splat_count;         // splats uploaded: an order index past them 
 uniform int u_model_count;
 uniform vec4 u_model_rows[3 * MAX_CLOUDS]; // rows 0..2 of each model's affine matrix
 uniform mat3 u_sh_rotation[MAX_CLOUDS];    // world -> model directions (polar rotation^T)
-uniform int u_former_quads;        // 1: the former quads (3 sigma, FORMER_QUAD_MARGIN_PX)
 uniform int u_antialiased;         // 1: opacity compensated for the dilation (antialiased kernel)
 
 // What the quad's corners and the fragments need of one splat.
@@ -179,14 +178,10 @@ bool project_splat(uint index, out Splat s) {
     float k2 = min(CUTOFF_M2, 2.0 * log(opacity / ALPHA_MIN) + OPACITY_M2_MARGIN);
     float quad_margin = QUAD_MARGIN_PX;
 #ifdef FORMER_QUADS
-    // Erratum variants draw exactly the former quads (erratum d's is no bounding box).
+    // Erratum variants and the benchmarks' baseline (test builds only) draw exactly the
+    // former quads (erratum d's is no bounding box).
     k2 = CUTOFF_M2;
     quad_margin = FORMER_QUAD_MARGIN_PX;
-#else
-    if (u_former_quads != 0) {
-        k2 = CUTOFF_M2;
-        quad_margin = FORMER_QUAD_MARGIN_PX;
-    }
 #endif
     float mid = 0.5 * (cov2d[0][0] + cov2d[1][1]);
     float lambda1 = mid + sqrt(max(0.1, mid * mid - det));

@@ -8,7 +8,7 @@
 #   FRAMES=3 SCENES=1m SIZE=1280x720 scripts/bench-gpu.sh
 #   CROSSOVER=100,1000,10000 scripts/bench-gpu.sh   # also the pre-pass crossover table
 #
-# The whole `cargo bench --bench gl` output is kept in target/bench-gpu.log.
+# The whole `cargo bench --features testing --bench gl` output is kept in target/bench-gpu.log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 log=target/bench-gpu.log
@@ -18,7 +18,7 @@ SPLATGL_BENCH_SCENES="${SCENES:-1m,4m}" \
 SPLATGL_BENCH_FRAMES="${FRAMES:-5}" \
 SPLATGL_BENCH_CROSSOVER="${CROSSOVER:-none}" \
 SPLATGL_BENCH_PREDICT=0 \
-    cargo bench --bench gl >"$log" 2>&1 || { tail -30 "$log"; exit 1; }
+    cargo bench --features testing --bench gl >"$log" 2>&1 || { tail -30 "$log"; exit 1; }
 grep -m1 '^context:' "$log"
 grep -m1 '^framebuffer' "$log"
 echo

@@ -27,12 +27,9 @@ pub mod cloud;
 pub mod compare;
 pub mod conformance;
 pub mod convert;
+pub mod covariance;
 pub mod cull;
 pub mod engine;
-// Covariance algebra behind the loader's node transforms: public for the node-transform tests,
-// not part of the documented API (`SplatCloud::covariance` is the user-facing form).
-#[doc(hidden)]
-pub mod covariance;
 pub mod files;
 #[cfg(feature = "gl")]
 pub mod gl;
@@ -42,11 +39,8 @@ pub mod image;
 pub mod load;
 pub mod profile;
 pub mod reference;
-// Synthetic scenes (the CLI's default scene, seeded random clouds for tests, benches and
-// examples): public for those targets, not part of the documented API.
 pub mod sh;
 pub mod sort;
-#[doc(hidden)]
 pub mod synthetic;
 #[cfg(feature = "viewer")]
 pub mod viewer;

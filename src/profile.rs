@@ -112,8 +112,8 @@ pub const QUAD_AXIS_FACTOR: f64 = 1.02;
 /// See [`QUAD_AXIS_FACTOR`] (pixels).
 pub const QUAD_MARGIN_PX: f64 = 0.125;
 /// The quad margin before the opacity-aware extent (pixels): what the erratum variants and
-/// the benchmarks' "former" path draw with.
-#[doc(hidden)]
+/// the benchmarks' "former" path draw with (programs built only in test builds; the
+/// production shaders never see it).
 pub const FORMER_QUAD_MARGIN_PX: f64 = 0.5;
 
 // ---------------------------------------------------------------------------------------------

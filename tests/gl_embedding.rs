@@ -85,7 +85,6 @@ fn every_call(gl: &glow::Context, settings: DrawSettings) {
 fn prepass() -> DrawPath {
     DrawPath {
         pipeline: Pipeline::PrePass,
-        ..DrawPath::default()
     }
 }
 

@@ -644,6 +644,7 @@ fn pixel_bits(img: &Image) -> Vec<u32> {
 /// Renders with the former rules (3σ boxes, every splat projected and sorted), the
 /// opacity-aware boxes alone, and the default (opacity-aware boxes, culled before the sort);
 /// asserts the images are bit-identical and returns the tile entries of the first two.
+#[cfg(feature = "testing")] // reference::render_with_path
 fn same_image_by_every_path(what: &str, cloud: &SplatCloud, cam: &Camera) -> (usize, usize) {
     use splatgl::reference::{Path, PixelBox, render_with_path};
     let o = opts();
@@ -678,6 +679,7 @@ fn same_image_by_every_path(what: &str, cloud: &SplatCloud, cam: &Camera) -> (us
 /// The opacity-aware pixel box and the cull before the sort change no bit of the reference
 /// image on the real scenes, from outside (framed) and from inside (about half the scene in
 /// view), while the boxes really shrink and the cull really removes splats.
+#[cfg(feature = "testing")] // reference::render_with_path
 #[test]
 fn opacity_aware_extent_and_cull_leave_real_scenes_bit_identical() {
     use splatgl::cull::{CullBounds, Frustum, visible_into};
@@ -705,6 +707,7 @@ fn opacity_aware_extent_and_cull_leave_real_scenes_bit_identical() {
 
 /// The same on synthetic worst cases: low opacities (small k), long needles (where the f32
 /// rounding bound takes over), splats across the image border and the near plane.
+#[cfg(feature = "testing")] // reference::render_with_path
 #[test]
 fn opacity_aware_extent_is_exact_for_needles_low_opacity_and_borders() {
     let mut cloud = random_cloud(3000, 1, 1.0, 77);

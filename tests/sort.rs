@@ -173,6 +173,7 @@ fn key_cases() -> Vec<(&'static str, Vec<f32>)> {
 // ---------------------------------------------------------------- exact order
 
 #[test]
+#[cfg(feature = "testing")] // Sorter::set_max_digit_bits
 fn full_precision_equals_stable_std_sort() {
     for max_digit in [11, 8] {
         let mut sorter = Sorter::new();

@@ -106,7 +106,7 @@ pub fn fragment_table(b: &mut Bench, _summary: &[(String, &str, usize, Vec<Row>)
         let Some((cloud, cam, target)) = scene(name, w, h, scale) else {
             continue;
         };
-        b.renderer.upload(b.gl, &cloud).unwrap();
+        b.upload(&cloud);
         let bounds = CullBounds::new(&cloud);
         let full = b.run(&cloud, &bounds, &cam, target, PathKind::Cull);
         let k = b.run(&cloud, &bounds, &cam, target, PathKind::Extent);
@@ -160,7 +160,7 @@ pub fn crossover(b: &mut Bench, sizes: &str, scale: f32) {
         for s in &mut cloud.scales {
             *s = s.map(|v| v * k);
         }
-        b.renderer.upload(b.gl, &cloud).unwrap();
+        b.upload(&cloud);
         let bounds = CullBounds::new(&cloud);
         let d = b.run(&cloud, &bounds, &cam, target, PathKind::Extent);
         let p = b.run(&cloud, &bounds, &cam, target, PathKind::PrePass);

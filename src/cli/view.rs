@@ -99,7 +99,9 @@ pub struct Args {
     /// per frame (layout, tessellation and GL calls).
     #[arg(long, requires = "bench_frames")]
     pub bench_panel: bool,
-    /// Test hook: deliver FILE as a dropped file once the first scene is shown.
+    /// Test hook (feature `testing`): deliver FILE as a dropped file once the first scene is
+    /// shown.
+    #[cfg(feature = "testing")]
     #[arg(long, hide = true, value_name = "FILE")]
     pub test_drop: Option<PathBuf>,
     #[command(flatten)]
@@ -145,6 +147,7 @@ fn go(a: Args) -> Result<(), String> {
         }),
         print_camera_json: a.cam.print_camera_json,
         no_ui: a.no_ui,
+        #[cfg(feature = "testing")]
         test_drop: a.test_drop,
     };
     splatgl::viewer::run(opts).map_err(|e| e.to_string())

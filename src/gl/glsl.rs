@@ -59,9 +59,9 @@ impl GlslVersion {
 }
 
 /// Switches that put the review draft's Appendix A behaviour back, one erratum each (see
-/// `docs/appendix-errata.md`). **For the erratum tests only** (hidden from the documented API):
-/// every `true` field makes the output wrong on purpose. `Errata::default()` is the correct
-/// renderer.
+/// `docs/appendix-errata.md`), and the former quads. **For the erratum tests and the
+/// benchmarks only** (feature `testing`): every erratum field makes the output wrong on
+/// purpose. `Errata::default()` is the correct renderer, and the only one users can build.
 #[doc(hidden)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Errata {
@@ -82,6 +82,27 @@ pub struct Errata {
     pub i_no_dilation: bool,
     /// (k) no ±1.3·tan(half fov) clamp inside J and no 0.99 cap on α.
     pub k_no_clamp_no_cap: bool,
+    /// Not an erratum: the quads before the opacity-aware extent (the 3σ ellipse's rectangle
+    /// whatever the opacity, [`crate::profile::FORMER_QUAD_MARGIN_PX`] margin). The same image
+    /// with more fragments: the benchmarks' baseline. Every erratum variant draws these too.
+    pub former_quads: bool,
+}
+
+impl Errata {
+    /// Only the former quads ([`Errata::former_quads`]): the correct image by the path the
+    /// benchmarks compare against.
+    #[cfg(feature = "testing")]
+    pub const FORMER_QUADS: Errata = Errata {
+        a_transposed_rotation: false,
+        b_transposed_view: false,
+        d_focal_offset: false,
+        e_appendix_sh: false,
+        f_power_4: false,
+        g_src_alpha_blend: false,
+        i_no_dilation: false,
+        k_no_clamp_no_cap: false,
+        former_quads: true,
+    };
 }
 
 impl Errata {
@@ -101,7 +122,11 @@ impl Errata {
             }
         }
         if *self != Errata::default() {
+            // Erratum variants and the benchmarks' baseline: the former quads, whose margin
+            // only they need.
             s.push_str("#define FORMER_QUADS\n");
+            let margin = float_lit(profile::FORMER_QUAD_MARGIN_PX as f32 as f64);
+            s.push_str(&format!("#define FORMER_QUAD_MARGIN_PX {margin}\n"));
         }
         s
     }
@@ -128,10 +153,6 @@ pub(crate) fn defines(layout: &TextureLayout) -> String {
     def("OPACITY_M2_MARGIN", f32_lit(profile::OPACITY_M2_MARGIN));
     def("QUAD_AXIS_FACTOR", f32_lit(profile::QUAD_AXIS_FACTOR));
     def("QUAD_MARGIN_PX", f32_lit(profile::QUAD_MARGIN_PX));
-    def(
-        "FORMER_QUAD_MARGIN_PX",
-        f32_lit(profile::FORMER_QUAD_MARGIN_PX),
-    );
     def("FOV_CLAMP", f32_lit(profile::JACOBIAN_CLAMP));
     def("SH_DC_BIAS", f32_lit(profile::SH_DC_BIAS));
     def("SH_C0", float_lit(SH_C0));
@@ -250,10 +271,6 @@ mod tests {
             ("OPACITY_M2_MARGIN".into(), profile::OPACITY_M2_MARGIN),
             ("QUAD_AXIS_FACTOR".into(), profile::QUAD_AXIS_FACTOR),
             ("QUAD_MARGIN_PX".into(), profile::QUAD_MARGIN_PX),
-            (
-                "FORMER_QUAD_MARGIN_PX".into(),
-                profile::FORMER_QUAD_MARGIN_PX,
-            ),
             ("FOV_CLAMP".into(), profile::JACOBIAN_CLAMP),
             ("SH_DC_BIAS".into(), profile::SH_DC_BIAS),
             ("SH_C0".into(), SH_C0),
@@ -331,6 +348,23 @@ mod tests {
                 "#define {name} has no Rust twin in this test"
             );
         }
+    }
+
+    #[test]
+    fn only_switched_programs_carry_the_former_quads() {
+        assert_eq!(Errata::default().defines(), "");
+        let former = Errata {
+            former_quads: true,
+            ..Errata::default()
+        };
+        let d = former.defines();
+        let margin = d
+            .lines()
+            .find_map(|l| l.strip_prefix("#define FORMER_QUAD_MARGIN_PX "))
+            .expect("the former quads' margin");
+        let margin: f64 = margin.parse().unwrap();
+        assert_eq!(margin as f32, profile::FORMER_QUAD_MARGIN_PX as f32);
+        assert!(d.starts_with("#define FORMER_QUADS\n"), "{d}");
     }
 
     #[test]

@@ -75,16 +75,21 @@ pub use glsl::Errata;
 #[cfg(not(feature = "testing"))]
 pub(crate) use glsl::Errata;
 pub use prepass::PREPASS_MIN_SPLATS;
+// Test and benchmark hooks (feature `testing`): host programs for the state tests, the draw
+// path, the state-call counts.
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use program::build_program;
 pub use readback::{ColorFormat, DepthFormat, ReadbackTarget};
 pub use renderer::SplatRenderer;
 pub use scene::SplatScene;
 pub use settings::{DepthFunc, DrawSettings, FrameSort};
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use settings::{DrawPath, Pipeline};
 #[allow(deprecated)]
 pub use sort::{DistanceSorter, sort_back_to_front};
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use state::StateCalls;
 pub use target::OffscreenTarget;

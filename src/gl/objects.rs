@@ -125,6 +125,7 @@ impl<'gl> Creating<'gl> {
     }
 
     /// Creation succeeded and the caller takes the objects over itself (nothing is deleted).
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))] // build_program (tests)
     pub(crate) fn release(mut self) {
         self.objects.clear();
     }

@@ -33,7 +33,7 @@ const COMPONENTS: [i32; 5] = [4, 4, 4, 3, 2];
 pub(crate) const RECORD_BYTES: usize = 68;
 
 /// Below this many splats drawn, [`Pipeline::Auto`](super::Pipeline::Auto) draws directly.
-/// On llvmpipe the pre-pass wins from about 10 splats on (`cargo bench --bench gl`,
+/// On llvmpipe the pre-pass wins from about 10 splats on (`cargo bench --features testing --bench gl`,
 /// `docs/gl-backend.md` "Pre-pass crossover"): its fixed cost there is a few µs. On a GPU a
 /// second draw with its program switch costs tens of µs, more than a direct draw of a
 /// thousand splats takes, so small clouds keep the direct path (costing at most 0.4 ms on

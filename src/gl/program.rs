@@ -8,8 +8,8 @@ use super::objects::Creating;
 
 /// Compiles and links a program from two assembled sources; the caller owns (and deletes) the
 /// program. Compile and link errors carry the driver's log and the numbered sources.
-/// Exposed for the GL tests only.
-#[doc(hidden)]
+/// For the GL tests' host programs only (feature `testing`).
+#[cfg(feature = "testing")]
 pub fn build_program(
     gl: &glow::Context,
     name: &str,
@@ -22,7 +22,7 @@ pub fn build_program(
     Ok(program)
 }
 
-/// [`build_program`] with the program created in `objects` (deleted with them on a later
+/// `build_program` with the program created in `objects` (deleted with them on a later
 /// failure). The shaders are always deleted before returning.
 pub(crate) fn build_program_in(
     objects: &mut Creating<'_>,

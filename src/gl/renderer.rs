@@ -190,6 +190,7 @@ impl SplatRenderer {
 
     /// Chooses the draw path (hidden, see [`Pipeline`]); creates the pre-pass's objects
     /// when the uploaded cloud needs them now.
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn set_draw_path(&mut self, gl: &glow::Context, path: DrawPath) -> Result<(), GlError> {
         self.owned.check()?;
@@ -198,12 +199,14 @@ impl SplatRenderer {
     }
 
     /// The draw path (hidden, see [`Pipeline`]).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn draw_path(&self) -> DrawPath {
         self.path
     }
 
     /// Whether the last draw ran the transform-feedback pre-pass (hidden: tests, benchmarks).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn last_draw_used_prepass(&self) -> bool {
         self.used_prepass.get()
@@ -297,6 +300,7 @@ impl SplatRenderer {
     }
 
     /// The linked splat program (for inspection, e.g. its active attributes; erratum tests).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn program(&self) -> glow::Program {
         self.program
@@ -304,6 +308,7 @@ impl SplatRenderer {
 
     /// GL calls the state handling of the last draw made (restore mode adds queries and
     /// restoring calls). **For the state-cost measurement** (hidden from the documented API).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn last_state_calls(&self) -> StateCalls {
         self.state_calls.get()

@@ -186,7 +186,8 @@ impl SplatScene {
         self.renderer.settings_mut()
     }
 
-    /// The renderer's draw path (hidden, see [`super::Pipeline`]).
+    /// The renderer's draw path (feature `testing`, see [`super::Pipeline`]).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn set_draw_path(
         &mut self,

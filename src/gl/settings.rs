@@ -94,8 +94,8 @@ impl Default for DrawSettings {
 }
 
 /// Which way the renderer computes the per-splat maths. **For the benchmarks and the tests
-/// that compare the paths** (hidden from the documented API): every path draws the same image.
-#[doc(hidden)]
+/// that compare the paths** (feature `testing`): every path draws the same image.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))] // only tests choose a path
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Pipeline {
     /// The pre-pass from [`PREPASS_MIN_SPLATS`] splats drawn on, else direct (the default).
@@ -108,22 +108,11 @@ pub enum Pipeline {
     PrePass,
 }
 
-/// The renderer's draw path (hidden, see [`Pipeline`]).
-#[doc(hidden)]
+/// The renderer's draw path (feature `testing`, see [`Pipeline`]). The former quads the
+/// benchmarks compare against are a program of their own (`Errata::FORMER_QUADS`), so the
+/// production shaders carry no trace of them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct DrawPath {
     /// Direct, pre-pass, or chosen by the splat count.
     pub pipeline: Pipeline,
-    /// The former quads: the 3σ ellipse's rectangle whatever the opacity, with the former
-    /// 0.5 px margin ([`crate::profile::FORMER_QUAD_MARGIN_PX`]), instead of the
-    /// opacity-aware extent and [`crate::profile::QUAD_MARGIN_PX`].
-    pub former_quads: bool,
-}
-
-impl DrawPath {
-    /// The path before the opacity-aware extent and the pre-pass.
-    pub const FORMER: DrawPath = DrawPath {
-        pipeline: Pipeline::Direct,
-        former_quads: true,
-    };
 }

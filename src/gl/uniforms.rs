@@ -35,7 +35,7 @@ macro_rules! uniforms {
 uniforms! {
     u_geometry, u_sh, u_sh_texels, u_sh_fetch_texels, u_sh_degree, u_view_matrix,
     u_projection_matrix, u_focal_length, u_tan_half_fov, u_camera_position, u_viewport,
-    u_cull_depth, u_splat_count, u_model_count, u_model_rows, u_sh_rotation, u_former_quads,
+    u_cull_depth, u_splat_count, u_model_count, u_model_rows, u_sh_rotation,
     u_antialiased,
 }
 
@@ -112,8 +112,6 @@ impl SplatRenderer {
             gl.uniform_1_i32(u.u_geometry.as_ref(), 0);
             gl.uniform_1_i32(u.u_sh.as_ref(), 1);
             gl.uniform_1_i32(u.u_model_count.as_ref(), m.count as i32);
-            let full = i32::from(self.path.former_quads);
-            gl.uniform_1_i32(u.u_former_quads.as_ref(), full);
             let aa = i32::from(settings.antialiased);
             gl.uniform_1_i32(u.u_antialiased.as_ref(), aa);
             if m.count > 0 {

@@ -140,9 +140,10 @@ impl HeadlessContext {
     }
 
     /// Like [`HeadlessContext::with_api`], asking EGL for the given `(major, minor)` version
-    /// (which the driver may raise: Mesa gives the newest compatible one). **For tests**
-    /// (context-creation failures, old versions; hidden from the documented API).
-    #[doc(hidden)]
+    /// (which the driver may raise: Mesa gives the newest compatible one): e.g. a host that
+    /// wants a specific GL version, or a test of old versions. A context below the renderer's
+    /// minimum (OpenGL 3.3, OpenGL ES 3.0) is created, but [`crate::gl::SplatRenderer::new`]
+    /// refuses it with [`crate::gl::GlError::ContextVersion`].
     pub fn with_api_version(api: GlApi, version: (i32, i32)) -> Result<Self, HeadlessError> {
         let e = egl()?;
         let display = e.display();

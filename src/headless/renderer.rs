@@ -5,7 +5,7 @@ use super::{HeadlessContext, HeadlessError};
 use crate::camera::Camera;
 use crate::cloud::{ColorSpace, SplatCloud};
 use crate::gl::frame::{Blend, FrameTargets, Output};
-use crate::gl::{DrawPath, DrawSettings, Errata, SplatRenderer};
+use crate::gl::{DrawSettings, Errata, SplatRenderer};
 use crate::image::Image;
 use glow::HasContext;
 
@@ -109,9 +109,11 @@ impl HeadlessRenderer {
     }
 
     /// Chooses the renderer's draw path and whether `render` culls before sorting. **For the
-    /// tests and benchmarks that compare the paths** (every path draws the same image).
+    /// tests and benchmarks that compare the paths** (feature `testing`; every path draws the
+    /// same image).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
-    pub fn set_path(&mut self, path: DrawPath, cull: bool) -> Result<(), HeadlessError> {
+    pub fn set_path(&mut self, path: crate::gl::DrawPath, cull: bool) -> Result<(), HeadlessError> {
         self.ctx.make_current()?;
         self.renderer.set_draw_path(self.ctx.gl(), path)?;
         self.cull = cull;

@@ -20,8 +20,13 @@ mod project;
 mod raster;
 mod sort;
 
+// The switches of how the reference gets to its image (the same image by every one): for
+// the tests and benchmarks that show it (feature `testing`).
+#[cfg(not(feature = "testing"))]
+use project::Path;
+#[cfg(feature = "testing")]
 #[doc(hidden)]
-pub use project::PixelBox;
+pub use project::{Path, PixelBox};
 use project::{Projected, ViewContext};
 pub use sort::SortMode;
 #[allow(deprecated)]
@@ -93,46 +98,29 @@ pub fn render(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Imag
     render_with_stats(cloud, camera, opts).0
 }
 
-/// How the reference gets to its image. Every combination gives the bit-identical image
-/// (tested); the switches exist for the tests and benchmarks that show it.
-#[doc(hidden)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Path {
-    /// Pixel box per splat.
-    pub extent: PixelBox,
-    /// Project and sort only the splats the camera's frustum may see ([`crate::cull`]).
-    pub cull: bool,
-}
-
-impl Default for Path {
-    fn default() -> Self {
-        Path {
-            extent: PixelBox::OpacityAware,
-            cull: true,
-        }
-    }
-}
-
-impl Path {
-    /// The rules before the opacity-aware extent and the cull: 3σ boxes, every splat.
-    pub const FULL: Path = Path {
-        extent: PixelBox::Full,
-        cull: false,
-    };
-}
-
 /// [`render`], also returning [`RenderStats`].
 pub fn render_with_stats(
     cloud: &SplatCloud,
     camera: &Camera,
     opts: &RenderOptions,
 ) -> (Image, RenderStats) {
-    render_with_path(cloud, camera, opts, Path::default())
+    render_by(cloud, camera, opts, Path::default())
 }
 
-/// [`render_with_stats`] by a given [`Path`] (the image does not depend on it).
+/// [`render_with_stats`] by a given `Path` (the image does not depend on it; feature
+/// `testing`).
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub fn render_with_path(
+    cloud: &SplatCloud,
+    camera: &Camera,
+    opts: &RenderOptions,
+    path: Path,
+) -> (Image, RenderStats) {
+    render_by(cloud, camera, opts, path)
+}
+
+fn render_by(
     cloud: &SplatCloud,
     camera: &Camera,
     opts: &RenderOptions,
@@ -201,7 +189,8 @@ pub fn render_with_path(
 
 /// One projected splat as the rasterizer sees it: centre in pixels (top-left origin), Σ'
 /// after dilation `[xx, xy, yy]` px², opacity. **For the benchmark's fragment-count
-/// prediction** (hidden from the documented API).
+/// prediction** (feature `testing`).
+#[cfg(feature = "testing")]
 #[doc(hidden)]
 pub fn footprints(cloud: &SplatCloud, camera: &Camera, opts: &RenderOptions) -> Vec<[f32; 6]> {
     let degree = opts.sh_degree.min(cloud.sh_degree);

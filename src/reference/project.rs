@@ -38,7 +38,7 @@ pub(crate) struct Projected {
 /// Which box of pixels a splat is rasterized over. Both give bit-identical images (every
 /// pixel left out by `OpacityAware` fails the per-pixel test; `docs/rendering-profile.md` §3);
 /// the switch exists for the tests and benchmarks that show it.
-#[doc(hidden)]
+#[cfg_attr(not(feature = "testing"), allow(dead_code))] // `Full`: the tests' former rule
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PixelBox {
     /// The box of the ellipse m² ≤ min(9, 2·ln(opacity/ALPHA_MIN) + margin), widened by a
@@ -47,6 +47,34 @@ pub enum PixelBox {
     OpacityAware,
     /// The box of the 3σ ellipse whatever the opacity (the former rule).
     Full,
+}
+
+/// How the reference gets to its image. Every combination gives the bit-identical image
+/// (tested); the switches exist for the tests and benchmarks that show it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Path {
+    /// Pixel box per splat.
+    pub extent: PixelBox,
+    /// Project and sort only the splats the camera's frustum may see ([`crate::cull`]).
+    pub cull: bool,
+}
+
+impl Default for Path {
+    fn default() -> Self {
+        Path {
+            extent: PixelBox::OpacityAware,
+            cull: true,
+        }
+    }
+}
+
+#[cfg_attr(not(feature = "testing"), allow(dead_code))] // for the tests (feature `testing`)
+impl Path {
+    /// The rules before the opacity-aware extent and the cull: 3σ boxes, every splat.
+    pub const FULL: Path = Path {
+        extent: PixelBox::Full,
+        cull: false,
+    };
 }
 
 /// Per-view constants shared by all splats.

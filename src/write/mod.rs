@@ -56,15 +56,14 @@ pub struct GltfWriteOptions {
     pub scale: Comp,
     /// OPACITY: one of [`OPACITY_TYPES`].
     pub opacity: Comp,
-    /// Extra bytes after each element (gives every view an explicit `byteStride`).
-    #[doc(hidden)]
+    /// Extra bytes after each element (gives every view an explicit `byteStride`; the
+    /// conformance suite's stride asset).
     pub padding: usize,
-    /// Write OPACITY as a sparse accessor without a bufferView (zeros + overrides).
-    #[doc(hidden)]
+    /// Write OPACITY as a sparse accessor without a bufferView (zeros + overrides; the
+    /// conformance suite's sparse asset).
     pub sparse_opacity: bool,
     /// Write SCALE as the review draft did, `ln(scale)` (float): a legacy file, for the
     /// conformance suite's legacy asset. Not RC-valid.
-    #[doc(hidden)]
     pub legacy_log_scale: bool,
     /// Column-major 4×4 matrix of the node holding the mesh (`None`: no matrix).
     pub node_matrix: Option<[f64; 16]>,
@@ -269,9 +268,8 @@ pub(crate) fn extension_object(m: &crate::cloud::SplatMeta) -> Value {
     })
 }
 
-/// Builds the glTF JSON and the binary buffer (the buffer's `uri` is left unset), for tests
-/// that edit the document before writing it.
-#[doc(hidden)]
+/// Builds the glTF JSON and the binary buffer (the buffer's `uri` is left unset), for callers
+/// that edit the document before writing it (then [`glb_bytes`]).
 pub fn build(cloud: &SplatCloud, o: &GltfWriteOptions) -> (Value, Vec<u8>) {
     let mut b = Builder::new(o.padding);
     let attrs = b.splat_attributes(cloud, o);
@@ -324,8 +322,7 @@ pub(crate) fn gltf_bytes(mut doc: Value, bin: &[u8]) -> Vec<u8> {
 }
 
 /// `.glb` bytes of a document whose buffer 0 is `bin` (the JSON chunk space-padded and the
-/// BIN chunk zero-padded to 4 bytes). Public for the tests' and fuzzers' generated documents.
-#[doc(hidden)]
+/// BIN chunk zero-padded to 4 bytes): a document from [`build`], edited or not.
 pub fn glb_bytes(doc: &Value, bin: &[u8]) -> Vec<u8> {
     let mut json = serde_json::to_vec(doc).unwrap_or_default();
     while !json.len().is_multiple_of(4) {
