@@ -28,18 +28,18 @@ pub(crate) fn points_box<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> Opti
     if axes[0].is_empty() {
         return None;
     }
-    let [x, y, z] = &mut axes;
-    let lo = Vec3::new(
-        percentile(x, false),
-        percentile(y, false),
-        percentile(z, false),
-    );
-    let hi = Vec3::new(
-        percentile(x, true),
-        percentile(y, true),
-        percentile(z, true),
-    );
-    Some((lo, hi))
+    Some((corner(&mut axes, false), corner(&mut axes, true)))
+}
+
+/// Per axis, the [`percentile`] of the non-empty `axes`: a box's lower (`upper = false`) or
+/// upper corner.
+fn corner(axes: &mut [Vec<f32>; 3], upper: bool) -> Vec3 {
+    let [x, y, z] = axes;
+    Vec3::new(
+        percentile(x, upper),
+        percentile(y, upper),
+        percentile(z, upper),
+    )
 }
 
 /// The 1st (`upper = false`) or the 99th percentile (`upper`) of the non-empty `v`, as
@@ -106,18 +106,7 @@ impl Extent {
         if lo[0].is_empty() {
             return None;
         }
-        let [l0, l1, l2] = &mut lo;
-        let [h0, h1, h2] = &mut hi;
-        let lo = Vec3::new(
-            percentile(l0, false),
-            percentile(l1, false),
-            percentile(l2, false),
-        );
-        let hi = Vec3::new(
-            percentile(h0, true),
-            percentile(h1, true),
-            percentile(h2, true),
-        );
+        let (lo, hi) = (corner(&mut lo, false), corner(&mut hi, true));
         // Percentiles taken per side can cross for a near-degenerate axis: keep lo ≤ hi.
         Some(Extent {
             lo: lo.min(hi),

@@ -266,49 +266,7 @@ pub fn diagnose(
 ) -> (Vec<Diagnosis>, Vec<Option<Explanation>>) {
     let mut chosen: Vec<Deviation> = Vec::new();
     let mut assigned: Vec<Option<Explanation>> = vec![None; failures.len()];
-    loop {
-        let covered =
-            |e: &Explanation, with: &[Deviation]| e.deviations.iter().all(|d| with.contains(d));
-        // Candidates: every distinct deviation set that explains some camera still open;
-        // score = the open cameras it (with what is chosen) would explain.
-        let mut candidates: Vec<&Vec<Deviation>> = failures
-            .iter()
-            .zip(&assigned)
-            .filter(|(_, a)| a.is_none())
-            .flat_map(|(f, _)| f.explained_by.iter().map(|e| &e.deviations))
-            .collect();
-        candidates.sort();
-        candidates.dedup();
-        // Key: consistent with the passing assets, cameras explained, then how closely (the
-        // sum of the best PSNRs, capped at 200 dB each).
-        let mut best: Option<((bool, usize, f64), Vec<Deviation>)> = None;
-        for devs in candidates {
-            let mut with = chosen.clone();
-            with.extend(devs.iter().copied());
-            let mut n = 0;
-            let mut fit = 0.0;
-            for (g, _) in failures.iter().zip(&assigned).filter(|(_, a)| a.is_none()) {
-                let psnr = g
-                    .explained_by
-                    .iter()
-                    .filter(|x| covered(x, &with))
-                    .map(|x| x.psnr.min(200.0))
-                    .fold(f64::NEG_INFINITY, f64::max);
-                if psnr > f64::NEG_INFINITY {
-                    n += 1;
-                    fit += psnr;
-                }
-            }
-            let consistent = !devs.iter().any(|d| contradicted.contains(d));
-            let key = (consistent && n > 0, n, fit);
-            if best.as_ref().is_none_or(|(m, _)| key > *m) {
-                best = Some((key, devs.clone()));
-            }
-        }
-        let Some(((_, n, _), devs)) = best else { break };
-        if n == 0 {
-            break;
-        }
+    while let Some(devs) = best_candidate(failures, &assigned, &chosen, contradicted) {
         chosen.extend(
             devs.iter()
                 .copied()
@@ -326,8 +284,61 @@ pub fn diagnose(
             }
         }
     }
+    (entries(failures, &assigned), assigned)
+}
+
+/// Whether every deviation of `e` is among `with`.
+fn covered(e: &Explanation, with: &[Deviation]) -> bool {
+    e.deviations.iter().all(|d| with.contains(d))
+}
+
+/// The next deviation set of [`diagnose`]'s cover (`None` when none explains another open
+/// camera). Candidates: every distinct set that explains some camera still open. Key:
+/// consistent with the passing assets, the open cameras it (with what is `chosen`) would
+/// explain, then how closely (the sum of the best PSNRs, capped at 200 dB each).
+fn best_candidate(
+    failures: &[Failure],
+    assigned: &[Option<Explanation>],
+    chosen: &[Deviation],
+    contradicted: &[Deviation],
+) -> Option<Vec<Deviation>> {
+    let open = || failures.iter().zip(assigned).filter(|(_, a)| a.is_none());
+    let mut candidates: Vec<&Vec<Deviation>> = open()
+        .flat_map(|(f, _)| f.explained_by.iter().map(|e| &e.deviations))
+        .collect();
+    candidates.sort();
+    candidates.dedup();
+    let mut best: Option<((bool, usize, f64), Vec<Deviation>)> = None;
+    for devs in candidates {
+        let mut with = chosen.to_vec();
+        with.extend(devs.iter().copied());
+        let (mut n, mut fit) = (0, 0.0);
+        for (g, _) in open() {
+            let psnr = g
+                .explained_by
+                .iter()
+                .filter(|x| covered(x, &with))
+                .map(|x| x.psnr.min(200.0))
+                .fold(f64::NEG_INFINITY, f64::max);
+            if psnr > f64::NEG_INFINITY {
+                n += 1;
+                fit += psnr;
+            }
+        }
+        let consistent = !devs.iter().any(|d| contradicted.contains(d));
+        let key = (consistent && n > 0, n, fit);
+        if best.as_ref().is_none_or(|(m, _)| key > *m) {
+            best = Some((key, devs.clone()));
+        }
+    }
+    best.filter(|((_, n, _), _)| *n > 0).map(|(_, devs)| devs)
+}
+
+/// [`diagnose`]'s entries: per deviation of the chosen explanations, the assets and the
+/// evidence of the cameras it explains (in the failures' order).
+fn entries(failures: &[Failure], assigned: &[Option<Explanation>]) -> Vec<Diagnosis> {
     let mut entries: Vec<Diagnosis> = Vec::new();
-    for (f, a) in failures.iter().zip(&assigned) {
+    for (f, a) in failures.iter().zip(assigned) {
         let Some(e) = a else { continue };
         for d in &e.deviations {
             let entry = match entries.iter_mut().position(|x| x.deviation == *d) {
@@ -351,5 +362,5 @@ pub fn diagnose(
             });
         }
     }
-    (entries, assigned)
+    entries
 }

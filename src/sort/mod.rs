@@ -40,6 +40,7 @@ mod visible;
 pub use async_sorter::{AsyncSorter, SortRequest, SortedFrame};
 pub use keys::{far_first_key, squared_distance, view_depth};
 pub use quantize::quantized_bucket_width;
+use reuse::LastView;
 pub use reuse::Outcome;
 #[cfg(feature = "gl")]
 pub(crate) use stale::StaleOrders;
@@ -119,50 +120,6 @@ pub struct SortScratch {
     ranges: Vec<[f32; 4]>,
 }
 
-/// The view a sort was made for (for reuse).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct LastView {
-    ptr: usize,
-    len: usize,
-    mode: SortMode,
-    precision: Precision,
-    eye: [u32; 3],
-    forward: [u32; 3],
-    /// Safe radius ([`Reuse::MotionBound`]), 0 when not computed.
-    radius: f64,
-    eye_f: [f32; 3],
-    /// For a culled sort ([`Sorter::sort_visible`]): the bounds' address and the frustum.
-    cull: Option<(usize, crate::cull::Frustum)>,
-}
-
-impl LastView {
-    fn new(
-        positions: &[[f32; 3]],
-        mode: SortMode,
-        precision: Precision,
-        eye: [f32; 3],
-        forward: [f32; 3],
-        cull: Option<(usize, crate::cull::Frustum)>,
-    ) -> LastView {
-        LastView {
-            ptr: positions.as_ptr() as usize,
-            len: positions.len(),
-            mode,
-            precision,
-            eye: bits_of(eye),
-            // The forward vector only matters to view-depth keys.
-            forward: if mode == SortMode::ViewDepth {
-                bits_of(forward)
-            } else {
-                [0; 3]
-            },
-            radius: 0.0,
-            eye_f: eye,
-            cull,
-        }
-    }
-}
-
 /// A reusable back-to-front sorter. See the [module docs](self) for the exact order.
 #[derive(Debug)]
 pub struct Sorter {
@@ -179,10 +136,6 @@ impl Default for Sorter {
     fn default() -> Self {
         Self::new()
     }
-}
-
-fn bits_of(v: [f32; 3]) -> [u32; 3] {
-    v.map(f32::to_bits)
 }
 
 impl Sorter {
@@ -228,6 +181,7 @@ impl Sorter {
 
     /// Tuning knob for benchmarks: most bits per radix pass, 8..=11 (default 11: a 32-bit key
     /// takes 3 passes; 8 gives 4 passes of 256 buckets). Does not change the result.
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub fn set_max_digit_bits(&mut self, bits: u32) {
         self.max_digit_bits = bits.clamp(8, radix::MAX_DIGIT_BITS);

@@ -1,5 +1,6 @@
-//! The safe radius of [`Reuse::MotionBound`](super::Reuse::MotionBound): how far the eye may
-//! move before a full-precision `cameraDistance` order could change.
+//! Reusing the last order: the view it was sorted for ([`LastView`], equal inputs give the
+//! same order) and the safe radius of [`Reuse::MotionBound`](super::Reuse::MotionBound): how
+//! far the eye may move before a full-precision `cameraDistance` order could change.
 //!
 //! Claim: let the last order be sorted for eye `e` with computed keys `k_c = fl(|p − e|²)`.
 //! If the eye moves by `δ` with `|δ| < R` (below), a fresh sort for `e + δ` returns the same
@@ -18,6 +19,57 @@
 //!
 //! `R = min(0.4 √K, min over adjacent pairs with p_i ≠ p_j of (gap − M) / (2 |p_i − p_j|))`,
 //! and 0 if any gap is `≤ M` or any key is not finite.
+
+use super::{Precision, SortMode};
+
+/// The view a sort was made for (for reuse).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct LastView {
+    pub(super) ptr: usize,
+    pub(super) len: usize,
+    pub(super) mode: SortMode,
+    pub(super) precision: Precision,
+    pub(super) eye: [u32; 3],
+    pub(super) forward: [u32; 3],
+    /// Safe radius ([`Reuse::MotionBound`](super::Reuse::MotionBound)), 0 when not computed.
+    pub(super) radius: f64,
+    pub(super) eye_f: [f32; 3],
+    /// For a culled sort ([`Sorter::sort_visible`](super::Sorter::sort_visible)): the bounds'
+    /// address and the frustum.
+    pub(super) cull: Option<(usize, crate::cull::Frustum)>,
+}
+
+impl LastView {
+    pub(super) fn new(
+        positions: &[[f32; 3]],
+        mode: SortMode,
+        precision: Precision,
+        eye: [f32; 3],
+        forward: [f32; 3],
+        cull: Option<(usize, crate::cull::Frustum)>,
+    ) -> LastView {
+        LastView {
+            ptr: positions.as_ptr() as usize,
+            len: positions.len(),
+            mode,
+            precision,
+            eye: bits_of(eye),
+            // The forward vector only matters to view-depth keys.
+            forward: if mode == SortMode::ViewDepth {
+                bits_of(forward)
+            } else {
+                [0; 3]
+            },
+            radius: 0.0,
+            eye_f: eye,
+            cull,
+        }
+    }
+}
+
+fn bits_of(v: [f32; 3]) -> [u32; 3] {
+    v.map(f32::to_bits)
+}
 
 /// What the last call did.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -17,18 +17,19 @@ use winit::window::{Fullscreen, Window, WindowId};
 mod commands;
 mod frame;
 mod interface;
+mod scene;
 
 use super::controls::Controls;
 use super::draw::Targets;
-use super::loading::{LoadEvent, Loaded, display_name, spawn};
+use super::loading::LoadEvent;
 use super::panel::{Action, Facts, Live, Panel};
 use super::rig::Rig;
 use super::stats::Stats;
 use super::surface::GlSurfaceWindow;
 use super::{ViewerError, ViewerOptions};
-use crate::camera::{Camera, CamerasJsonEntry, Extent, GltfPerspective, SceneView, UpAxis};
+use crate::camera::{CamerasJsonEntry, Extent, GltfPerspective, UpAxis};
 use crate::gl::{DrawSettings, SplatRenderer};
-use crate::load::{Format, LoadOptions};
+use crate::load::LoadOptions;
 use crate::sort::StaleOrders as Orders;
 use frame::BenchRun;
 
@@ -194,144 +195,6 @@ impl App {
         el.exit();
     }
 
-    /// Starts loading `path` (`None`: the default scene) in the background.
-    pub fn start_load(&mut self, path: Option<PathBuf>) {
-        self.load_id += 1;
-        self.loading_name = display_name(path.as_deref());
-        self.status = Some(format!("loading {}", self.loading_name));
-        eprintln!("loading {}", self.loading_name);
-        let proxy = self.proxy.clone();
-        let send = move |ev| {
-            // The loop is gone only while exiting: nothing to report to.
-            let _ = proxy.send_event(UserEvent::Load(ev));
-        };
-        let opts = Arc::clone(&self.load_opts);
-        let keep = super::loading::Keep {
-            max_splats: self.opts.max_splats,
-        };
-        spawn(self.load_id, path, opts, keep, send);
-        self.update_title(true);
-    }
-
-    /// Reports a failed load; without a scene to keep it ends the viewer.
-    fn load_failed(&mut self, el: &ActiveEventLoop, msg: String) {
-        self.status = None;
-        if self.shown.is_none() {
-            self.fail(el, ViewerError::Load(msg));
-            return;
-        }
-        eprintln!(
-            "error: {msg} (keeping {})",
-            self.shown.as_ref().map_or("", |s| &s.name)
-        );
-        self.message = Some((format!("error: {msg}"), Instant::now()));
-        self.update_title(true);
-    }
-
-    /// The first camera of a scene: the command-line options for the first file, a framing
-    /// with the scene's up axis for later ones; and the pivot distance.
-    fn first_camera(&self, l: &Loaded, up: UpAxis) -> Result<(Camera, f32), String> {
-        let (w, h) = self.render_size();
-        if self.shown.is_none() {
-            let mut v = self.opts.view.clone();
-            (v.width, v.height) = (Some(w), Some(h));
-            let scene = SceneView {
-                cloud: &l.cloud,
-                format: l.format,
-                cameras: &l.cameras,
-            };
-            let cam = v.camera(scene, (w, h)).map_err(|e| e.to_string())?;
-            return Ok((cam, v.focus_distance(&cam, &l.cloud)));
-        }
-        let fov = self
-            .rig
-            .map_or(self.opts.view.fov_deg.to_radians(), |r| r.fov_y());
-        let cam = Camera::frame_cloud(&l.cloud, up, fov, w, h)
-            .ok_or("no splat that can be drawn, nothing to frame")?;
-        let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
-        let focus = fit.map_or(1.0, |e| cam.focus_distance_to(e.centre()));
-        Ok((cam, focus))
-    }
-
-    /// Shows a loaded scene (or keeps the previous one when it cannot be shown).
-    fn install(&mut self, el: &ActiveEventLoop, l: Loaded) {
-        let name = l.name();
-        let up = (self.opts.view.up)
-            .unwrap_or_else(|| crate::camera::UpAxis::for_cloud(l.format, &l.cloud));
-        let (cam, focus) = match self.first_camera(&l, up) {
-            Ok(c) => c,
-            Err(e) if self.shown.is_none() => {
-                return self.fail(el, ViewerError::Load(format!("{name}: {e}")));
-            }
-            Err(e) => return self.load_failed(el, format!("{name}: {e}")),
-        };
-        let positions: Arc<[[f32; 3]]> = l.cloud.positions.as_slice().into();
-        let tau = self.opts.stale.tolerance(&l.cloud);
-        let mut orders = match Orders::new(positions, tau, self.opts.sort_sync) {
-            Ok(o) => o,
-            Err(e) => return self.load_failed(el, format!("{name}: sorter thread: {e}")),
-        };
-        orders.set_crop(self.crop);
-        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
-            return;
-        };
-        if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
-            return self.load_failed(el, format!("{name}: {e}"));
-        }
-        for w in &l.warnings {
-            eprintln!("warning: {w}");
-        }
-        self.settings.antialiased = self.opts.antialiased.resolve(l.trained_antialiased);
-        let extent = Extent::of_cloud(&l.cloud);
-        let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
-        let rig = Rig::from_camera(&cam, focus, up.vector());
-        self.controls.fly_speed = extent.map_or(1.0, |e| (0.5 * e.radius()).max(0.05));
-        self.controls.stop();
-        let budget = if l.cloud.len() < l.file_len {
-            format!(" (of {}, --max-splats)", l.file_len)
-        } else {
-            String::new()
-        };
-        let format = l.format.map_or("built in", Format::name);
-        println!(
-            "loaded: {name}: {} splats{budget}, SH degree {}, {format}, up {}, stale tolerance {tau}, \
-             kernel {}",
-            l.cloud.len(),
-            l.cloud.sh_degree,
-            up.name(),
-            if self.settings.antialiased {
-                "antialiased"
-            } else {
-                "plain"
-            }
-        );
-        let facts = self.facts_of(&l, &name);
-        self.shown = Some(Shown {
-            facts,
-            name,
-            path: l.path,
-            len: l.cloud.len(),
-            file_len: l.file_len,
-            sh_degree: l.cloud.sh_degree,
-            cameras: l.cameras,
-            extent,
-            fit,
-            orders,
-            uploaded: None,
-            up,
-            home: rig,
-        });
-        self.rig = Some(rig);
-        self.camera_index = 0;
-        self.frames_shown = 0;
-        self.prev_eye = None;
-        if let Some(b) = self.opts.bench.filter(|_| self.bench.is_none()) {
-            self.bench = Some(BenchRun::new(b, rig));
-        }
-        self.update_title(true);
-        self.request_redraw();
-    }
-
     pub fn request_redraw(&self) {
         if let Some(w) = &self.win {
             w.window.request_redraw();
@@ -393,7 +256,9 @@ impl App {
         }
     }
 
-    /// The test hook: a file "dropped" through [`App::handle`] after a few frames.
+    /// The test hook (feature `testing`): a file "dropped" through [`App::handle`] after a few
+    /// frames.
+    #[cfg(feature = "testing")]
     pub fn test_drop(&mut self, el: &ActiveEventLoop) {
         if self.shown.is_some()
             && self.frames_shown >= 3
@@ -401,6 +266,16 @@ impl App {
         {
             self.handle(el, WindowEvent::DroppedFile(p));
         }
+    }
+}
+
+impl App {
+    /// Whether the test hook still has a file to drop (never without feature `testing`).
+    fn drop_pending(&self) -> bool {
+        #[cfg(feature = "testing")]
+        return self.opts.test_drop.is_some();
+        #[cfg(not(feature = "testing"))]
+        false
     }
 }
 
@@ -463,7 +338,7 @@ impl ApplicationHandler<UserEvent> for App {
     }
 
     fn about_to_wait(&mut self, _el: &ActiveEventLoop) {
-        let hook = self.opts.test_drop.is_some() && self.shown.is_some();
+        let hook = cfg!(feature = "testing") && self.drop_pending() && self.shown.is_some();
         let ui = self
             .panel
             .as_ref()

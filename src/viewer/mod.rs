@@ -117,8 +117,9 @@ pub struct ViewerOptions {
     pub print_camera_json: bool,
     /// Start with the interface hidden (`--no-ui`; `G` shows it).
     pub no_ui: bool,
-    /// Test hook: after the first scene has been shown for a few frames, deliver this path as
-    /// a `DroppedFile` window event (the drag-and-drop code path).
+    /// Test hook (feature `testing`): after the first scene has been shown for a few frames,
+    /// deliver this path as a `DroppedFile` window event (the drag-and-drop code path).
+    #[cfg(feature = "testing")]
     #[doc(hidden)]
     pub test_drop: Option<PathBuf>,
 }
@@ -143,6 +144,7 @@ impl Default for ViewerOptions {
             bench: None,
             print_camera_json: false,
             no_ui: false,
+            #[cfg(feature = "testing")]
             test_drop: None,
         }
     }

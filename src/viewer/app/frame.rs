@@ -114,6 +114,7 @@ impl App {
         if let Err(e) = self.draw_frame(el) {
             self.fail(el, e);
         }
+        #[cfg(feature = "testing")]
         self.test_drop(el);
     }
 

@@ -1,0 +1,158 @@
+//! A scene's life in the viewer: the background load of a file (or the default scene), a
+//! failed load (the previous scene stays), the first camera of a new scene, and installing it
+//! (upload, sorter, panel facts, title).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use winit::event_loop::ActiveEventLoop;
+
+use super::frame::BenchRun;
+use super::{App, Shown, UserEvent};
+use crate::camera::{Camera, Extent, SceneView, UpAxis};
+use crate::load::Format;
+use crate::sort::StaleOrders as Orders;
+use crate::viewer::ViewerError;
+use crate::viewer::loading::{self, Loaded, display_name, spawn};
+use crate::viewer::rig::Rig;
+
+impl App {
+    /// Starts loading `path` (`None`: the default scene) in the background.
+    pub fn start_load(&mut self, path: Option<PathBuf>) {
+        self.load_id += 1;
+        self.loading_name = display_name(path.as_deref());
+        self.status = Some(format!("loading {}", self.loading_name));
+        eprintln!("loading {}", self.loading_name);
+        let proxy = self.proxy.clone();
+        let send = move |ev| {
+            // The loop is gone only while exiting: nothing to report to.
+            let _ = proxy.send_event(UserEvent::Load(ev));
+        };
+        let opts = Arc::clone(&self.load_opts);
+        let keep = loading::Keep {
+            max_splats: self.opts.max_splats,
+        };
+        spawn(self.load_id, path, opts, keep, send);
+        self.update_title(true);
+    }
+
+    /// Reports a failed load; without a scene to keep it ends the viewer.
+    pub(super) fn load_failed(&mut self, el: &ActiveEventLoop, msg: String) {
+        self.status = None;
+        if self.shown.is_none() {
+            self.fail(el, ViewerError::Load(msg));
+            return;
+        }
+        eprintln!(
+            "error: {msg} (keeping {})",
+            self.shown.as_ref().map_or("", |s| &s.name)
+        );
+        self.message = Some((format!("error: {msg}"), Instant::now()));
+        self.update_title(true);
+    }
+
+    /// The first camera of a scene: the command-line options for the first file, a framing
+    /// with the scene's up axis for later ones; and the pivot distance.
+    fn first_camera(&self, l: &Loaded, up: UpAxis) -> Result<(Camera, f32), String> {
+        let (w, h) = self.render_size();
+        if self.shown.is_none() {
+            let mut v = self.opts.view.clone();
+            (v.width, v.height) = (Some(w), Some(h));
+            let scene = SceneView {
+                cloud: &l.cloud,
+                format: l.format,
+                cameras: &l.cameras,
+            };
+            let cam = v.camera(scene, (w, h)).map_err(|e| e.to_string())?;
+            return Ok((cam, v.focus_distance(&cam, &l.cloud)));
+        }
+        let fov = self
+            .rig
+            .map_or(self.opts.view.fov_deg.to_radians(), |r| r.fov_y());
+        let cam = Camera::frame_cloud(&l.cloud, up, fov, w, h)
+            .ok_or("no splat that can be drawn, nothing to frame")?;
+        let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
+        let focus = fit.map_or(1.0, |e| cam.focus_distance_to(e.centre()));
+        Ok((cam, focus))
+    }
+
+    /// Shows a loaded scene (or keeps the previous one when it cannot be shown).
+    pub(super) fn install(&mut self, el: &ActiveEventLoop, l: Loaded) {
+        let name = l.name();
+        let up = (self.opts.view.up)
+            .unwrap_or_else(|| crate::camera::UpAxis::for_cloud(l.format, &l.cloud));
+        let (cam, focus) = match self.first_camera(&l, up) {
+            Ok(c) => c,
+            Err(e) if self.shown.is_none() => {
+                return self.fail(el, ViewerError::Load(format!("{name}: {e}")));
+            }
+            Err(e) => return self.load_failed(el, format!("{name}: {e}")),
+        };
+        let positions: Arc<[[f32; 3]]> = l.cloud.positions.as_slice().into();
+        let tau = self.opts.stale.tolerance(&l.cloud);
+        let mut orders = match Orders::new(positions, tau, self.opts.sort_sync) {
+            Ok(o) => o,
+            Err(e) => return self.load_failed(el, format!("{name}: sorter thread: {e}")),
+        };
+        orders.set_crop(self.crop);
+        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+            return;
+        };
+        if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
+            return self.load_failed(el, format!("{name}: {e}"));
+        }
+        for w in &l.warnings {
+            eprintln!("warning: {w}");
+        }
+        self.settings.antialiased = self.opts.antialiased.resolve(l.trained_antialiased);
+        let extent = Extent::of_cloud(&l.cloud);
+        let fit = Extent::of_cloud_at(&l.cloud, crate::camera::FIT_SIGMAS);
+        let rig = Rig::from_camera(&cam, focus, up.vector());
+        self.controls.fly_speed = extent.map_or(1.0, |e| (0.5 * e.radius()).max(0.05));
+        self.controls.stop();
+        let budget = if l.cloud.len() < l.file_len {
+            format!(" (of {}, --max-splats)", l.file_len)
+        } else {
+            String::new()
+        };
+        let format = l.format.map_or("built in", Format::name);
+        println!(
+            "loaded: {name}: {} splats{budget}, SH degree {}, {format}, up {}, stale tolerance {tau}, \
+             kernel {}",
+            l.cloud.len(),
+            l.cloud.sh_degree,
+            up.name(),
+            if self.settings.antialiased {
+                "antialiased"
+            } else {
+                "plain"
+            }
+        );
+        let facts = self.facts_of(&l, &name);
+        self.shown = Some(Shown {
+            facts,
+            name,
+            path: l.path,
+            len: l.cloud.len(),
+            file_len: l.file_len,
+            sh_degree: l.cloud.sh_degree,
+            cameras: l.cameras,
+            extent,
+            fit,
+            orders,
+            uploaded: None,
+            up,
+            home: rig,
+        });
+        self.rig = Some(rig);
+        self.camera_index = 0;
+        self.frames_shown = 0;
+        self.prev_eye = None;
+        if let Some(b) = self.opts.bench.filter(|_| self.bench.is_none()) {
+            self.bench = Some(BenchRun::new(b, rig));
+        }
+        self.update_title(true);
+        self.request_redraw();
+    }
+}
