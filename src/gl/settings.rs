@@ -98,7 +98,7 @@ impl Default for DrawSettings {
 #[cfg_attr(not(feature = "testing"), allow(dead_code))] // only tests choose a path
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Pipeline {
-    /// The pre-pass from [`PREPASS_MIN_SPLATS`] splats drawn on, else direct (the default).
+    /// The pre-pass from [`PREPASS_MIN_SPLATS`](super::PREPASS_MIN_SPLATS) splats drawn on, else direct (the default).
     #[default]
     Auto,
     /// Every quad corner runs the per-splat maths (the path before the pre-pass).
