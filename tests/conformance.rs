@@ -406,6 +406,14 @@ fn a_renderer_without_dilation_passes_every_rc_asset_and_differs_on_its_profile_
 fn run_rendered(
     render_one: &dyn Fn(&splatgl::SplatCloud, &splatgl::camera::Camera) -> Image,
 ) -> Vec<runner::AssetResult> {
+    run_rendered_with(&runner::RunOptions::default(), render_one)
+}
+
+/// [`run_rendered`] with the runner's options.
+fn run_rendered_with(
+    opts: &runner::RunOptions,
+    render_one: &dyn Fn(&splatgl::SplatCloud, &splatgl::camera::Camera) -> Image,
+) -> Vec<runner::AssetResult> {
     let (d, m) = suite();
     let mut images = std::collections::HashMap::new();
     for ai in 0..m.assets.len() {
@@ -414,7 +422,7 @@ fn run_rendered(
             images.insert(c.image.clone(), render_one(&scene.cloud, cam));
         }
     }
-    runner::run(d, m, |c| images.get(&c.image).cloned().map(Ok)).unwrap()
+    runner::run_with(d, m, opts, |c| images.get(&c.image).cloned().map(Ok)).unwrap()
 }
 
 /// The RC assets that fail, and the deviations the diagnosis names.
@@ -511,6 +519,39 @@ fn planted_variants_fail_only_their_rule_and_the_diagnosis_names_them() {
         detecting(&["bounding_box_cutoff", "view_depth_order"])
     );
     assert_eq!(named, ["bounding_box_cutoff", "view_depth_order"]);
+}
+
+/// Images of SPZ copies of the assets (`KHR_gaussian_splatting_compression_spz_2`, as
+/// `convert --spz-compress` writes them), drawn by the reference rasterizer — not the model —
+/// fail RC assets against the float references, pass them all when the run is told the input
+/// was SPZ (`--input-precision spz`), and the diagnosis of the undeclared run names the SPZ
+/// precision.
+#[test]
+fn spz_copies_pass_when_declared_and_are_named_when_not() {
+    use splatgl::reference::{RenderOptions, render_display};
+    let spz_render = |cl: &splatgl::SplatCloud, c: &splatgl::camera::Camera| {
+        let bytes = splatgl::write::to_glb_spz(cl).unwrap();
+        let mut q = splatgl::load::load_bytes(&bytes, None, &Default::default())
+            .unwrap()
+            .cloud;
+        q.meta = cl.meta.clone();
+        let o = RenderOptions::default();
+        render_display(&q, c, &o, q.meta.color_space.effective()).0
+    };
+    let undeclared = run_rendered(&spz_render);
+    let (failed, named) = verdict(&undeclared);
+    assert!(!failed.is_empty(), "SPZ precision changes no verdict");
+    assert_eq!(named, ["spz_precision"], "{failed:?}");
+    let declared = runner::RunOptions {
+        input: runner::InputPrecision::Spz,
+    };
+    let r = run_rendered_with(&declared, &spz_render);
+    let (failed, _) = verdict(&r);
+    assert!(failed.is_empty(), "{failed:?}");
+    eprintln!(
+        "SPZ copies: {} RC assets fail undeclared, none declared",
+        verdict(&undeclared).0.len()
+    );
 }
 
 /// The HTML report opens in headless Chromium: the title and one table row per camera.

@@ -50,6 +50,21 @@ pub struct RunArgs {
     /// Where report.html and report.json go (default DIR/report).
     #[arg(short, long, value_name = "OUT_DIR")]
     pub out: Option<PathBuf>,
+    /// What --images were rendered from: `exact` (the suite's assets as written) or `spz`
+    /// (SPZ-compressed copies, `splatgl convert --spz-compress`, for a renderer that reads
+    /// only KHR_gaussian_splatting_compression_spz_2): each image is then judged against the
+    /// model of its SPZ copy, and passes when it matches it.
+    #[arg(long, value_enum, default_value = "exact", requires = "images")]
+    pub input_precision: InputPrecisionArg,
+}
+
+/// What the images were rendered from (`--input-precision`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputPrecisionArg {
+    /// The suite's assets as written.
+    Exact,
+    /// SPZ-compressed copies of them.
+    Spz,
 }
 
 /// Writes an output atomically (temporary file renamed into place), never over `inputs`.
@@ -66,7 +81,7 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let (results, source) = if let Some(images) = &a.images {
         (
-            run_images(&a.dir, &m, images)?,
+            run_images(&a.dir, &m, images, a.input_precision)?,
             images.display().to_string(),
         )
     } else {
@@ -88,11 +103,22 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
 }
 
 /// Compares another renderer's images, found in the folder `images`, with the suite's.
-fn run_images(dir: &Path, m: &Manifest, images: &Path) -> Result<Vec<AssetResult>, String> {
+fn run_images(
+    dir: &Path,
+    m: &Manifest,
+    images: &Path,
+    input: InputPrecisionArg,
+) -> Result<Vec<AssetResult>, String> {
     if !images.is_dir() {
         return Err(format!("--images {}: not a folder", images.display()));
     }
-    runner::run(dir, m, |c| {
+    let opts = runner::RunOptions {
+        input: match input {
+            InputPrecisionArg::Exact => runner::InputPrecision::Exact,
+            InputPrecisionArg::Spz => runner::InputPrecision::Spz,
+        },
+    };
+    runner::run_with(dir, m, &opts, |c| {
         runner::find_image(images, c).map(|p| Image::read(&p).map_err(|e| e.to_string()))
     })
 }

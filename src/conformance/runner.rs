@@ -88,24 +88,48 @@ fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
         .count()
 }
 
-/// The RC allows ignoring SH coefficients above some degree: an image that matches the model
-/// so capped passes, with that said (`None`: it matches none).
+/// What the images of a run were rendered from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InputPrecision {
+    /// The suite's assets as written (float attributes).
+    #[default]
+    Exact,
+    /// SPZ-compressed copies of them (`splatgl convert --spz-compress`: an adapter for a
+    /// renderer that reads only `KHR_gaussian_splatting_compression_spz_2`). The images are
+    /// then judged against the model of what those copies carry: an image that matches it
+    /// passes, with that said, and the diagnosis explains failures from the SPZ copy.
+    Spz,
+}
+
+/// Options of [`run_with`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions {
+    /// What the images were rendered from.
+    pub input: InputPrecision,
+}
+
+/// The choices an image may pass with although it differs from the reference: the RC allows
+/// ignoring SH coefficients above some degree, and with SPZ input the image is judged by what
+/// the SPZ copy carries (`loaded` holds that copy then). `None`: it matches none; `Some(None)`:
+/// it matches the SPZ copy as it is.
 fn allowed_choice(
     loaded: &(crate::load::Scene, Vec<crate::camera::Camera>),
-    ci: usize,
+    (ci, input): (usize, InputPrecision),
     c: &CameraEntry,
     img: &Image,
     bound: &[f64],
-) -> Option<Deviation> {
+) -> Option<Option<Deviation>> {
     let degree = loaded.0.cloud.sh_degree as usize;
-    [Variant::ShDegree2, Variant::ShDegree1, Variant::ShDegree0]
+    let exact = (input == InputPrecision::Spz).then_some(None);
+    let caps = [Variant::ShDegree2, Variant::ShDegree1, Variant::ShDegree0]
         .into_iter()
         .skip(3 - degree.min(3))
-        .map(Deviation::Variant)
-        .find(|d| {
-            let m = diagnosis::model_image(&loaded.0.cloud, &loaded.1[ci], &[*d]);
-            !fails(img, &m, bound, &c.tolerance)
-        })
+        .map(|v| Some(Deviation::Variant(v)));
+    exact.into_iter().chain(caps).find(|d| {
+        let devs: Vec<Deviation> = d.iter().copied().collect();
+        let m = diagnosis::model_image(&loaded.0.cloud, &loaded.1[ci], &devs);
+        !fails(img, &m, bound, &c.tolerance)
+    })
 }
 
 /// Compares the images `get(camera)` returns (`None`: missing; `Err`: unreadable) with the
@@ -116,11 +140,22 @@ fn allowed_choice(
 pub fn run(
     dir: &Path,
     m: &Manifest,
+    get: impl FnMut(&CameraEntry) -> Option<Result<Image, String>>,
+) -> Result<Vec<AssetResult>, String> {
+    run_with(dir, m, &RunOptions::default(), get)
+}
+
+/// [`run`] with options (what the images were rendered from).
+pub fn run_with(
+    dir: &Path,
+    m: &Manifest,
+    opts: &RunOptions,
     mut get: impl FnMut(&CameraEntry) -> Option<Result<Image, String>>,
 ) -> Result<Vec<AssetResult>, String> {
     let mut results = Vec::new();
     let mut budget = Budget {
         cameras_left: MAX_EXPLAINED,
+        input: opts.input,
     };
     for (ai, a) in m.assets.iter().enumerate() {
         let mut cams = Vec::new();
@@ -153,9 +188,10 @@ const MAX_EXPLAINED: usize = 256;
 /// A camera is explained only while pixels × splats stays below this (the model is O(W·H·N)).
 const MAX_MODEL_WORK: u64 = 1 << 28;
 
-/// What is left of a run's diagnosis work.
+/// What is left of a run's diagnosis work, and what its images were rendered from.
 struct Budget {
     cameras_left: usize,
+    input: InputPrecision,
 }
 
 /// An asset loaded for the models, once: `None` until needed, `Some(None)` when it failed.
@@ -224,7 +260,7 @@ fn camera_result(
     r.against_reference = Some((cmp.psnr, cmp.max_abs as f64));
     r.comparison = Some(cmp);
     if !r.pass {
-        let l = loaded.get_or_insert_with(|| render::load_asset(dir, m, ai).ok());
+        let l = loaded.get_or_insert_with(|| load_for_models(dir, m, ai, budget.input));
         let note = allow_or_explain(l.as_ref(), ci, &img, &bound, budget, &mut r);
         if !r.pass {
             r.cause = Some(format!(
@@ -235,6 +271,21 @@ fn camera_result(
     }
     r.actual = Some(img);
     Ok(r)
+}
+
+/// Asset `ai` as the models need it: as written, or its SPZ copy for SPZ input (`None` when
+/// it does not load, or SPZ cannot carry it).
+fn load_for_models(
+    dir: &Path,
+    m: &Manifest,
+    ai: usize,
+    input: InputPrecision,
+) -> Option<(crate::load::Scene, Vec<crate::camera::Camera>)> {
+    let (mut scene, cams) = render::load_asset(dir, m, ai).ok()?;
+    if input == InputPrecision::Spz {
+        scene.cloud = super::model::spz_copy(&scene.cloud)?;
+    }
+    Some((scene, cams))
 }
 
 /// The result of camera `c` before any comparison: not passing, nothing explained.
@@ -263,31 +314,60 @@ fn allow_or_explain(
     bound: &[f64],
     budget: &mut Budget,
     r: &mut CameraResult,
-) -> &'static str {
+) -> String {
     let c = &r.camera;
     let work = l.map_or(u64::MAX, |l| {
         (c.width as u64 * c.height as u64).saturating_mul(l.0.cloud.len() as u64)
     });
     match l {
         Some(l) if work <= MAX_MODEL_WORK => {
-            if let Some(d) = allowed_choice(l, ci, c, img, bound) {
+            if let Some(d) = allowed_choice(l, (ci, budget.input), c, img, bound) {
                 r.pass = true;
-                r.cause = Some(format!(
-                    "passes as a renderer that {} (the RC allows it: {})",
-                    d.describe().to_lowercase(),
-                    d.rc_section()
-                ));
+                r.cause = Some(match d {
+                    Some(d) => format!(
+                        "passes as a renderer that {} (the RC allows it: {})",
+                        d.describe().to_lowercase(),
+                        d.rc_section()
+                    ),
+                    None => "passes against the SPZ copy it was rendered from (--input-precision spz: the model of what KHR_gaussian_splatting_compression_spz_2 carries)".into(),
+                });
             } else if budget.cameras_left > 0 {
                 budget.cameras_left -= 1;
                 r.explained_by = diagnosis::explain(&l.0.cloud, &l.1[ci], c, img, bound);
             } else {
-                return "not diagnosed (the run's diagnosis budget is spent); ";
+                return format!(
+                    "{}not diagnosed (the run's diagnosis budget is spent); ",
+                    against_copy(l, ci, img, bound, budget.input)
+                );
             }
-            ""
+            against_copy(l, ci, img, bound, budget.input)
         }
-        Some(_) => "not diagnosed (too large for the models); ",
-        None => "not diagnosed (the asset does not load); ",
+        Some(_) => "not diagnosed (too large for the models); ".into(),
+        None => "not diagnosed (the asset does not load); ".into(),
     }
+}
+
+/// With SPZ input, how far `img` is from the model of the SPZ copy it was rendered from (the
+/// pixel count above is against the float reference), for the cause; empty otherwise.
+fn against_copy(
+    l: &(crate::load::Scene, Vec<crate::camera::Camera>),
+    ci: usize,
+    img: &Image,
+    bound: &[f64],
+    input: InputPrecision,
+) -> String {
+    if input != InputPrecision::Spz {
+        return String::new();
+    }
+    let m = diagnosis::model_image(&l.0.cloud, &l.1[ci], &[]);
+    let (_, ratio) = measure(img, &m, bound);
+    format!(
+        "against its SPZ copy {} (worst {ratio:.2}×); ",
+        match over_bound(img, &m, bound) {
+            0 => "no pixel over its bound, but the PSNR or largest error fails".to_owned(),
+            n => format!("{n} pixels over their bound"),
+        }
+    )
 }
 
 /// The failing cameras that had an image to explain.

@@ -33,11 +33,19 @@ pub enum Variant {
     /// The 3D covariance Σ stored as half floats (GaussianSplats3D's covariance textures,
     /// Spark's packed splats): footprints off by up to ~0.05 % of their size.
     HalfCovariance,
+    /// The splats as `KHR_gaussian_splatting_compression_spz_2` carries them (SPZ v2: 12-bit
+    /// fixed-point positions, 8-bit log scales, quaternions, colour and opacity, 5/4-bit SH):
+    /// what a renderer given the SPZ-compressed asset draws. `conformance run
+    /// --input-precision spz` accepts it (the images were rendered from SPZ copies).
+    SpzPrecision,
+    /// Spark's default packed splats (half-float centres, 8-bit colour, opacity in steps of
+    /// 2/255, 8-bit ln scales over [−12, 9], 8+8+8-bit octahedral quaternions, SH 7/8/6 bits).
+    PackedSplat,
 }
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 12] = [
+    pub const ALL: [Variant; 14] = [
         Variant::BoxCut,
         Variant::ViewDepthOrder,
         Variant::AaCompensation,
@@ -50,6 +58,8 @@ impl Variant {
         Variant::Colour8Bit,
         Variant::EigenvalueFloor,
         Variant::HalfCovariance,
+        Variant::SpzPrecision,
+        Variant::PackedSplat,
     ];
     /// A short identifier (the diagnosis's `rule`).
     pub fn name(self) -> &'static str {
@@ -66,6 +76,8 @@ impl Variant {
             Variant::Colour8Bit => "colour_and_opacity_8bit",
             Variant::EigenvalueFloor => "eigenvalue_floor",
             Variant::HalfCovariance => "covariance_f16",
+            Variant::SpzPrecision => "spz_precision",
+            Variant::PackedSplat => "packed_splat_precision",
         }
     }
     /// What a renderer with this variant does, for reports.
@@ -91,6 +103,12 @@ impl Variant {
                 "Σ' rebuilt from eigenvalues mid ± √max(0.1, mid² − det) (near-round footprints anisotropic, sub-pixel splats dropped)"
             }
             Variant::HalfCovariance => "3D covariance stored as half floats (lossy storage)",
+            Variant::SpzPrecision => {
+                "splats at SPZ precision (KHR_gaussian_splatting_compression_spz_2: 8-bit log scales, quaternions, colour and opacity)"
+            }
+            Variant::PackedSplat => {
+                "packed splats (Spark): 8-bit ln scales, 8-bit octahedral quaternions, opacity in steps of 2/255, half-float centres"
+            }
         }
     }
     /// The RC section whose rule the variant departs from.
@@ -111,6 +129,12 @@ impl Variant {
             Variant::EigenvalueFloor => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
             Variant::HalfCovariance => {
                 "RC Splat Reconstruction (Σ = R S Sᵀ Rᵀ); the RC does not specify a renderer's precision"
+            }
+            Variant::SpzPrecision => {
+                "RC Attributes (float SCALE, ROTATION, OPACITY); SPZ precision is the input's when the asset was given as KHR_gaussian_splatting_compression_spz_2"
+            }
+            Variant::PackedSplat => {
+                "RC Attributes (float SCALE, ROTATION, OPACITY); the RC does not specify a renderer's precision, but scales off by up to ±4 % change footprints beyond any bound"
             }
         }
     }
