@@ -14,78 +14,26 @@
 //! without them the test is skipped, which fails under `SPLATGL_REQUIRE=all`.
 
 mod common;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("splatgl-cesium-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-fn missing_tools() -> Option<String> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let cesium = root.join(".npm-tools/node_modules/cesium/Build/Cesium/Cesium.js");
-    if !cesium.exists() {
-        return Some(format!("{} not installed", cesium.display()));
-    }
-    if Command::new("node").arg("--version").output().is_err() {
-        return Some("node not runnable".into());
-    }
-    // The browsers cesium.mjs looks for.
-    let browser = ["chromium", "chromium-browser"]
-        .iter()
-        .any(|b| Command::new(b).arg("--version").output().is_ok());
-    (!browser).then(|| "chromium (or chromium-browser) not runnable".into())
-}
+use common::third_party::*;
 
 #[test]
 fn cesium_is_graded_by_the_rules_its_source_breaks() {
-    if let Some(why) = missing_tools() {
+    if let Some(why) = missing_tools("cesium/Build/Cesium/Cesium.js") {
         common::skip(&why);
         return;
     }
-    let (suite, images, report) = (tmp("suite"), tmp("images"), tmp("report"));
-    let r = common::cli::run(&["conformance", "generate", suite.to_str().unwrap()]);
-    assert_eq!(r.code, 0, "{}", r.all());
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/conformance/cesium.mjs");
-    let out = Command::new("node")
-        .arg(&script)
-        .args([&suite, &images])
-        .args([
-            "--splatgl",
-            env!("CARGO_BIN_EXE_splatgl"),
-            "--timeout",
-            "300",
-        ])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "cesium.mjs: {err}");
-    let r = common::cli::run(&[
-        "conformance",
-        "run",
-        suite.to_str().unwrap(),
-        "--images",
-        images.to_str().unwrap(),
-        "-o",
-        report.to_str().unwrap(),
-    ]);
-    eprintln!("{}", r.all());
-    assert_eq!(r.code, 1, "CesiumJS breaks RC rules: {}", r.all());
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(report.join("report.json")).unwrap()).unwrap();
-    let asset = |name: &str| {
-        json["assets"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|a| a["name"] == name)
-            .unwrap_or_else(|| panic!("{name}"))
-            .clone()
-    };
-    let pass = |name: &str| asset(name)["pass"].as_bool().unwrap();
-    let psnr = |name: &str| asset(name)["psnr"].as_f64().unwrap_or(f64::INFINITY);
+    let (suite, images, report) = (
+        generate("cesium-suite"),
+        tmp("cesium"),
+        tmp("cesium-report"),
+    );
+    render("cesium.mjs", &suite, &images, &[], &[]);
+    // The images come from SPZ copies of the assets: graded by what those carry.
+    let (code, json) = grade(&suite, &images, &report, &["--input-precision", "spz"]);
+    assert_eq!(code, 1, "CesiumJS breaks RC rules");
+    let pass = |name: &str| passes(&json, name);
+    let asset = |name: &str| asset(&json, name).clone();
+    let psnr = |name: &str| psnr(&json, name);
     // Every view came back: no splat primitive failed to load or to sort.
     assert!(json["assets"].as_array().unwrap().iter().all(|a| {
         a["cameras"]
@@ -128,7 +76,12 @@ fn cesium_is_graded_by_the_rules_its_source_breaks() {
     // wasm-splats src/radix.rs:25-33: the key is view-space z (positions · the model-view
     // matrix's third row), not the distance to the camera.
     assert!(!pass("sort_distance_not_depth"));
-    for d in [&suite, &images, &report] {
-        std::fs::remove_dir_all(d).ok();
-    }
+    // Graded as SPZ input, a failing camera also says how far it is from the model of the SPZ
+    // copy it was rendered from (the pixel count before it is against the float reference).
+    let sort_cause = asset("sort_distance_not_depth")["cameras"][0]["cause"]
+        .as_str()
+        .unwrap_or("")
+        .to_owned();
+    assert!(sort_cause.contains("against its SPZ copy"), "{sort_cause}");
+    clean(&[&suite, &images, &report]);
 }

@@ -44,34 +44,13 @@
 // Environment: CESIUM_ROLL (radians, default 1e-4), CESIUM_SHIFT (glTF units, default 1e-4),
 // CESIUM_VIEW=ASSET/CAMERA (one view), CESIUM_DEBUG=1 (page logs on stderr),
 // CESIUM_GL=1 (ANGLE on GL instead of SwiftShader), SPLATGL_ROOT (the splatgl checkout with
-// target/debug/splatgl and .npm-tools/; default: the checkout this script is in).
-import { spawn, execFileSync } from 'node:child_process';
+// target/debug/splatgl and .npm-tools/; default: the checkout this script is in). The server
+// and chromium: common.mjs.
 import fs from 'node:fs';
-import http from 'node:http';
-import os from 'node:os';
 import path from 'node:path';
+import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-
-const here = path.dirname(fileURLToPath(import.meta.url));
-const root = process.env.SPLATGL_ROOT || path.resolve(here, '../..');
-const args = process.argv.slice(2);
-const opt = (name, dflt) => {
-  const i = args.indexOf(name);
-  return i >= 0 ? args.splice(i, 2)[1] : dflt;
-};
-const splatgl = opt('--splatgl', path.join(root, 'target/debug/splatgl'));
-const only = opt('--only', null);
-const limitS = Number(opt('--timeout', '600'));
-const [suite, out] = args;
-if (!suite || !out) {
-  console.error('usage: cesium.mjs SUITE OUT [--splatgl PATH] [--only ASSET] [--timeout S]');
-  process.exit(2);
-}
-const cesiumBuild = path.join(root, '.npm-tools/node_modules/cesium/Build/Cesium');
-if (!fs.existsSync(path.join(cesiumBuild, 'Cesium.js'))) {
-  console.error(`cesium.mjs: ${cesiumBuild}/Cesium.js not installed (scripts/npm-tools.sh)`);
-  process.exit(2);
-}
+import { renderSuite } from './common.mjs';
 
 // A GLB's JSON (first chunk) and BIN (second chunk, if any); .gltf: the JSON alone.
 const readGlb = (d) => {
@@ -145,146 +124,63 @@ const WORLD = [0, 1, 0, 0, 1, 0, 0, 0, 0, 0, -1, 0, R, 0, 0, 1];
 const TILE_TRANSFORM = [0, -1, 0, 0, 0, 0, -1, 0, 1, 0, 0, 0, R, 0, 0, 1];
 const yUpToZUp = ([x, y, z]) => [x, -z, y];
 
-const manifest = JSON.parse(fs.readFileSync(path.join(suite, 'manifest.json'), 'utf8'));
-const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'splatgl-cesium-'));
-const views = [];
-const onlyView = process.env.CESIUM_VIEW;
-const roll = Number(process.env.CESIUM_ROLL ?? '1e-4');
-if (!Number.isFinite(roll)) { console.error('cesium.mjs: CESIUM_ROLL is not a number'); process.exit(2); }
-if (roll !== 0) console.error(`cesium.mjs: cameras rolled by ${roll} rad (CESIUM_ROLL=0 for none)`);
-const shift = Number(process.env.CESIUM_SHIFT ?? '1e-4');
-if (!Number.isFinite(shift)) { console.error('cesium.mjs: CESIUM_SHIFT is not a number'); process.exit(2); }
-if (shift !== 0) console.error(`cesium.mjs: cameras shifted by ${shift} sideways (CESIUM_SHIFT=0 for none)`);
-for (const a of manifest.assets) {
-  if (only && a.name !== only) continue;
-  if (onlyView && !onlyView.startsWith(`${a.name}/`)) continue;
-  const dir = path.join(tmp, a.name);
-  fs.mkdirSync(dir);
+const numberEnv = (name, dflt) => {
+  const v = Number(process.env[name] ?? dflt);
+  if (!Number.isFinite(v)) { console.error(`cesium.mjs: ${name} is not a number`); process.exit(2); }
+  return v;
+};
+const roll = numberEnv('CESIUM_ROLL', '1e-4');
+const shift = numberEnv('CESIUM_SHIFT', '1e-4');
+const banner = [
+  roll !== 0 ? `cesium.mjs: cameras rolled by ${roll} rad (CESIUM_ROLL=0 for none)` : null,
+  shift !== 0 ? `cesium.mjs: cameras shifted by ${shift} sideways (CESIUM_SHIFT=0 for none)` : null,
+].filter(Boolean).join('\n') || null;
+
+// Steps 1-3 above for one asset: DIR/content.glb and DIR/tileset.json.
+function tilesetOf(a, { suite, splatgl, dir }) {
   const glb = path.join(dir, 'content.glb');
-  let gltfCameras = [];
-  try {
-    gltfCameras = readGlb(fs.readFileSync(path.join(suite, a.file))).json.cameras || [];
-    execFileSync(splatgl, ['convert', path.join(suite, a.file), glb, '--spz-compress', '-f'], { stdio: 'pipe' });
-    const { json, bin } = readGlb(fs.readFileSync(glb));
-    const pos = cesiumPlaceholders(json);
-    fs.writeFileSync(glb, writeGlb(json, bin));
-    // Bounding sphere of the decoded positions (POSITION min/max: glTF axes, as a reader
-    // converting RUB decodes them; D turns them to the payload's), in the tile's frame (after
-    // Y_UP_TO_Z_UP), with a margin for the splats' extent: it only lowers the near plane
-    // Cesium fits to it (View.js line 183), never below the camera's.
-    const [cx, cy, cz] = pos.min.map((lo, i) => (lo + pos.max[i]) / 2);
-    const c = yUpToZUp([-cx, cy, -cz]);
-    const half = Math.hypot(...pos.min.map((lo, i) => (pos.max[i] - lo) / 2));
-    const tileset = {
-      asset: { version: '1.1' },
-      extensionsUsed: ['3DTILES_content_gltf'],
-      extensions: { '3DTILES_content_gltf': {
-        extensionsUsed: ['KHR_gaussian_splatting', 'KHR_gaussian_splatting_compression_spz_2'],
-        extensionsRequired: ['KHR_gaussian_splatting', 'KHR_gaussian_splatting_compression_spz_2'],
-      } },
-      // Positive, or the root is never traversed: Cesium3DTilesetBaseTraversal.js line 54-59
-      // stops when the tileset's own geometricError gives an SSE <= the maximum (16 px).
-      geometricError: 1e6,
-      root: {
-        transform: TILE_TRANSFORM,
-        boundingVolume: { sphere: [...c, half * 1.5 + 1] },
-        geometricError: 0,
-        refine: 'ADD',
-        content: { uri: 'content.glb' },
-      },
-    };
-    fs.writeFileSync(path.join(dir, 'tileset.json'), JSON.stringify(tileset));
-  } catch (e) {
-    console.error(`${a.name}: cannot make its tileset: ${e.stderr || e.message}`);
-    continue;
-  }
-  const cams = JSON.parse(fs.readFileSync(path.join(suite, a.cameras_json), 'utf8'));
-  for (const c of a.cameras) {
-    const j = cams[c.cameras_json_index];
-    if (onlyView && c.image !== onlyView) continue;
-    views.push({ image: c.image, tileset: `/tiles/${a.name}/tileset.json`, width: c.width,
-                 height: c.height, fy: j.fy, position: j.position, rotation: j.rotation, roll, shift, world: WORLD,
-                 znear: gltfCameras[c.gltf_camera]?.perspective?.znear ?? 0.05 });
-    if (Math.abs(j.fx - j.fy) > 1e-3 * j.fy || Math.abs(j.cx - c.width / 2) > 1e-3 || Math.abs(j.cy - c.height / 2) > 1e-3) {
-      console.error(`${c.image}: fx != fy or the principal point is off centre; the page assumes neither`);
-    }
-  }
+  execFileSync(splatgl, ['convert', path.join(suite, a.file), glb, '--spz-compress', '-f'], { stdio: 'pipe' });
+  const { json, bin } = readGlb(fs.readFileSync(glb));
+  const pos = cesiumPlaceholders(json);
+  fs.writeFileSync(glb, writeGlb(json, bin));
+  // Bounding sphere of the decoded positions (POSITION min/max: glTF axes, as a reader
+  // converting RUB decodes them; D turns them to the payload's), in the tile's frame (after
+  // Y_UP_TO_Z_UP), with a margin for the splats' extent: it only lowers the near plane
+  // Cesium fits to it (View.js line 183), never below the camera's.
+  const [cx, cy, cz] = pos.min.map((lo, i) => (lo + pos.max[i]) / 2);
+  const c = yUpToZUp([-cx, cy, -cz]);
+  const half = Math.hypot(...pos.min.map((lo, i) => (pos.max[i] - lo) / 2));
+  const tileset = {
+    asset: { version: '1.1' },
+    extensionsUsed: ['3DTILES_content_gltf'],
+    extensions: { '3DTILES_content_gltf': {
+      extensionsUsed: ['KHR_gaussian_splatting', 'KHR_gaussian_splatting_compression_spz_2'],
+      extensionsRequired: ['KHR_gaussian_splatting', 'KHR_gaussian_splatting_compression_spz_2'],
+    } },
+    // Positive, or the root is never traversed: Cesium3DTilesetBaseTraversal.js line 54-59
+    // stops when the tileset's own geometricError gives an SSE <= the maximum (16 px).
+    geometricError: 1e6,
+    root: {
+      transform: TILE_TRANSFORM,
+      boundingVolume: { sphere: [...c, half * 1.5 + 1] },
+      geometricError: 0,
+      refine: 'ADD',
+      content: { uri: 'content.glb' },
+    },
+  };
+  fs.writeFileSync(path.join(dir, 'tileset.json'), JSON.stringify(tileset));
+  return { tileset: `/files/${a.name}/tileset.json` };
 }
 
-const send = (res, code, type, body) => { res.writeHead(code, { 'content-type': type }); res.end(body); };
-const inside = (base, rel) => {
-  const p = path.resolve(base, '.' + path.posix.normalize('/' + rel));
-  return p.startsWith(base + path.sep) ? p : null;
-};
-const types = { '.js': 'text/javascript', '.json': 'application/json', '.wasm': 'application/wasm',
-                '.css': 'text/css', '.png': 'image/png', '.jpg': 'image/jpeg', '.glb': 'model/gltf-binary' };
-let done;
-const finished = new Promise((r) => { done = r; });
-let received = 0;
-const expected = new Set(views.map((v) => v.image));
-const server = http.createServer((req, res) => {
-  let url;
-  try { url = decodeURIComponent(req.url.split('?')[0]); } catch { return send(res, 400, 'text/plain', 'bad url'); }
-  if (req.method === 'POST') {
-    let body = '';
-    req.on('data', (d) => { body += d; });
-    req.on('end', () => {
-      if (url === '/result') {
-        let msg;
-        try { msg = JSON.parse(body); } catch { return send(res, 400, 'text/plain', 'bad json'); }
-        const { image, png } = msg;
-        // Only the suite's own image names: nothing is written outside OUT.
-        if (!expected.has(image) || typeof png !== 'string') return send(res, 400, 'text/plain', 'unknown image');
-        const file = path.join(out, `${image}.png`);
-        fs.mkdirSync(path.dirname(file), { recursive: true });
-        fs.writeFileSync(file, Buffer.from(png.split(',')[1], 'base64'));
-        received++;
-      } else if (url === '/log') {
-        console.error(`page: ${body}`);
-      } else if (url === '/done') {
-        done();
-      }
-      send(res, 200, 'text/plain', 'ok');
-    });
-    return;
-  }
-  let file = null;
-  if (url === '/' || url === '/page') file = path.join(here, 'cesium.html');
-  else if (url === '/views.json') return send(res, 200, 'application/json', JSON.stringify(views));
-  else if (url.startsWith('/cesium/')) file = inside(cesiumBuild, url.slice(8));
-  else if (url.startsWith('/tiles/')) file = inside(tmp, url.slice(7));
-  if (!file || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
-    if (process.env.CESIUM_DEBUG) console.error(`cesium.mjs: 404 ${url}`);
-    return send(res, 404, 'text/plain', 'not found');
-  }
-  const type = file.endsWith('.html') ? 'text/html' : types[path.extname(file)] || 'application/octet-stream';
-  send(res, 200, type, fs.readFileSync(file));
-});
-server.listen(0, '127.0.0.1', () => {
-  const port = server.address().port;
-  const chromium = ['chromium', 'chromium-browser'].find((b) => {
-    try { execFileSync(b, ['--version'], { stdio: 'ignore' }); return true; } catch { return false; }
-  });
-  if (!chromium) { console.error('cesium.mjs: chromium not found'); process.exit(2); }
-  const browser = spawn(chromium, ['--headless', '--no-sandbox', ...(process.env.CESIUM_GL ? ['--use-angle=gl', '--ignore-gpu-blocklist', '--use-gl=angle'] : ['--use-angle=swiftshader']),
-    '--enable-unsafe-swiftshader', '--disable-extensions', '--no-first-run', '--force-device-scale-factor=1',
-    `--user-data-dir=${path.join(tmp, 'profile')}`, `http://127.0.0.1:${port}/page${process.env.CESIUM_DEBUG ? '?debug' : ''}`],
-    { stdio: ['ignore', 'ignore', 'pipe'] });
-  browser.stderr.on('data', () => {});
-  const timer = setTimeout(() => { console.error(`cesium.mjs: timed out after ${limitS} s`); done(); }, limitS * 1000);
-  finished.then(() => {
-    clearTimeout(timer);
-    console.log(`cesium.mjs: ${received} of ${views.length} images -> ${out}`);
-    const code = received === views.length ? 0 : 1;
-    // Remove the temporary folder (tilesets, chromium profile) only once chromium has exited.
-    const cleanup = () => {
-      try { fs.rmSync(tmp, { recursive: true, force: true, maxRetries: 5 }); } catch (e) {
-        console.error(`cesium.mjs: could not remove ${tmp}: ${e.message}`);
-      }
-      process.exit(code);
-    };
-    server.close();
-    if (browser.exitCode !== null || browser.signalCode !== null) cleanup();
-    else { browser.once('exit', cleanup); browser.kill('SIGKILL'); setTimeout(cleanup, 5000); }
-  });
+const root = process.env.SPLATGL_ROOT || path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+renderSuite({
+  name: 'cesium',
+  page: 'cesium.html',
+  required: ['cesium/Build/Cesium/Cesium.js'],
+  prefix: 'CESIUM',
+  viewExtra: { roll, shift, world: WORLD },
+  banner,
+  prepare: tilesetOf,
+  mounts: { '/cesium/': path.join(root, '.npm-tools/node_modules/cesium/Build/Cesium') },
+  chromiumArgs: ['--force-device-scale-factor=1'],
 });

@@ -1,18 +1,22 @@
-// What the conformance adapters for other renderers (gs3d.mjs, spark.mjs) share: the command
-// line, each asset of a generated suite converted to INRIA PLY with `splatgl convert --up y`
-// and its cameras turned into views, and a page served from 127.0.0.1 to headless Chromium,
-// which POSTs each image back (written as OUT/ASSET/CAMERA.png); chromium is killed after the
-// last image or after the time limit.
+// What the conformance adapters for other renderers (gs3d.mjs, spark.mjs, cesium.mjs) share:
+// the command line, each asset of a generated suite prepared for the renderer (by default
+// converted to INRIA PLY with `splatgl convert --up y`) and its cameras turned into views, and
+// a page served from 127.0.0.1 to headless Chromium, which POSTs each image back (written as
+// OUT/ASSET/CAMERA.png); chromium is killed after the last image or after the time limit.
 //
-//   renderSuite({ name, page, required, prefix, viewExtra, banner })
+//   renderSuite({ name, page, required, prefix, viewExtra, banner, prepare, mounts, chromiumArgs })
 //
 // name: the adapter's name in messages ("gs3d" -> "gs3d.mjs: ..."); page: the HTML file next
 // to this module that renders the views; required: files under .npm-tools/node_modules the
-// page imports (served as /npm/...); prefix: the environment variables' prefix (PREFIX_VIEW=
-// ASSET/CAMERA renders one view, PREFIX_DEBUG=1 asks the page to log, PREFIX_GL=1 runs ANGLE
-// on GL instead of SwiftShader); viewExtra: fields added to every view; banner: printed on
-// stderr first. SPLATGL_ROOT: the splatgl checkout (target/debug/splatgl, .npm-tools/);
-// default: the checkout this module is in.
+// page imports; prefix: the environment variables' prefix (PREFIX_VIEW=ASSET/CAMERA renders
+// one view, PREFIX_DEBUG=1 asks the page to log, PREFIX_GL=1 runs ANGLE on GL instead of
+// SwiftShader); viewExtra: fields added to every view; banner: printed on stderr first;
+// prepare(asset, { suite, tmp, splatgl, dir }): writes what the page loads into `dir` (a
+// folder of its own under the temporary folder) and returns the fields it adds to each of the
+// asset's views (default: the PLY conversion, { ply: '/files/ASSET/asset.ply' }); mounts: URL
+// prefixes served from folders, besides /files/ (the prepared files) and /npm/ (default:
+// none); chromiumArgs: extra flags. SPLATGL_ROOT: the splatgl checkout (target/debug/splatgl,
+// .npm-tools/); default: the checkout this module is in.
 import { spawn, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
@@ -32,7 +36,18 @@ export const gltfJson = (file) => {
   return JSON.parse(d.toString('utf8'));
 };
 
-export function renderSuite({ name, page, required, prefix, viewExtra = {}, banner = null }) {
+// The default `prepare`: the asset as INRIA PLY, in the axes its numbers are written in.
+const plyOf = (a, { suite, splatgl, dir }) => {
+  execFileSync(splatgl, ['convert', path.join(suite, a.file), path.join(dir, 'asset.ply'), '--up', 'y', '-f'], { stdio: 'pipe' });
+  return { ply: `/files/${a.name}/asset.ply` };
+};
+
+const types = { '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json',
+                '.wasm': 'application/wasm', '.css': 'text/css', '.png': 'image/png', '.jpg': 'image/jpeg',
+                '.glb': 'model/gltf-binary', '.html': 'text/html' };
+
+export function renderSuite({ name, page, required, prefix, viewExtra = {}, banner = null,
+                              prepare = plyOf, mounts = {}, chromiumArgs = [] }) {
   const me = `${name}.mjs`;
   // The splatgl checkout (its target/debug/splatgl and .npm-tools/): SPLATGL_ROOT, else the
   // folder two above this module (scripts/conformance/).
@@ -67,11 +82,13 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
   for (const a of manifest.assets) {
     if (only && !only.has(a.name)) continue;
     if (onlyView && !onlyView.startsWith(`${a.name}/`)) continue;
-    const ply = path.join(tmp, `${a.name}.ply`);
+    const dir = path.join(tmp, a.name);
+    fs.mkdirSync(dir, { recursive: true });
+    let fields;
     try {
-      execFileSync(splatgl, ['convert', path.join(suite, a.file), ply, '--up', 'y', '-f'], { stdio: 'pipe' });
+      fields = prepare(a, { suite, tmp, splatgl, dir });
     } catch (e) {
-      console.error(`${a.name}: convert failed: ${e.stderr}`);
+      console.error(`${a.name}: cannot prepare it: ${e.stderr || e.message}`);
       continue;
     }
     const cams = JSON.parse(fs.readFileSync(path.join(suite, a.cameras_json), 'utf8'));
@@ -82,7 +99,7 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
     for (const c of a.cameras) {
       const j = cams[c.cameras_json_index];
       if (onlyView && c.image !== onlyView) continue;
-      views.push({ image: c.image, ply: `/ply/${a.name}.ply`, width: c.width, height: c.height,
+      views.push({ image: c.image, ...fields, width: c.width, height: c.height,
                    fy: j.fy, position: j.position, rotation: j.rotation,
                    ...viewExtra,
                    znear: gltfCameras[c.gltf_camera]?.perspective?.znear ?? 0.05 });
@@ -128,13 +145,18 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
       return;
     }
     let file = null;
-    let type = 'application/octet-stream';
-    if (url === '/' || url === '/page') { file = path.join(here, page); type = 'text/html'; }
+    if (url === '/' || url === '/page') file = path.join(here, page);
     else if (url === '/views.json') return send(res, 200, 'application/json', JSON.stringify(views));
-    else if (url.startsWith('/npm/')) { file = inside(npm, url.slice(5)); type = 'text/javascript'; }
-    else if (url.startsWith('/ply/')) file = inside(tmp, url.slice(5));
-    if (!file || !fs.existsSync(file)) return send(res, 404, 'text/plain', 'not found');
-    send(res, 200, type, fs.readFileSync(file));
+    else {
+      const served = { '/files/': tmp, '/npm/': npm, ...mounts };
+      const at = Object.keys(served).find((p) => url.startsWith(p));
+      if (at) file = inside(served[at], url.slice(at.length));
+    }
+    if (!file || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
+      if (process.env[`${prefix}_DEBUG`]) console.error(`${me}: 404 ${url}`);
+      return send(res, 404, 'text/plain', 'not found');
+    }
+    send(res, 200, types[path.extname(file)] || 'application/octet-stream', fs.readFileSync(file));
   });
   server.listen(0, '127.0.0.1', () => {
     const port = server.address().port;
@@ -143,7 +165,7 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
     });
     if (!chromium) { console.error(`${me}: chromium not found`); process.exit(2); }
     const browser = spawn(chromium, ['--headless', '--no-sandbox', ...(process.env[`${prefix}_GL`] ? ['--use-angle=gl', '--ignore-gpu-blocklist', '--use-gl=angle'] : ['--use-angle=swiftshader']),
-      '--enable-unsafe-swiftshader', '--disable-extensions', '--no-first-run',
+      '--enable-unsafe-swiftshader', '--disable-extensions', '--no-first-run', ...chromiumArgs,
       `--user-data-dir=${path.join(tmp, 'profile')}`, `http://127.0.0.1:${port}/page${process.env[`${prefix}_DEBUG`] ? '?debug' : ''}`],
       { stdio: ['ignore', 'ignore', 'pipe'] });
     browser.stderr.on('data', () => {});
@@ -152,7 +174,7 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
       clearTimeout(timer);
       console.log(`${me}: ${received} of ${views.length} images -> ${out}`);
       const code = received === views.length ? 0 : 1;
-      // Remove the temporary folder (PLYs, chromium profile) only once chromium has exited:
+      // Remove the temporary folder (prepared files, chromium profile) only once chromium has exited:
       // it may still be writing its profile when it is killed.
       const cleanup = () => {
         try { fs.rmSync(tmp, { recursive: true, force: true, maxRetries: 5 }); } catch (e) {

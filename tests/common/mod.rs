@@ -15,6 +15,8 @@ pub mod cli;
 #[cfg(feature = "gl")]
 pub mod gl;
 pub mod packed;
+#[cfg(feature = "cli")]
+pub mod third_party;
 #[cfg(all(feature = "viewer", feature = "cli"))]
 pub mod viewer;
 
