@@ -78,6 +78,21 @@ pub(crate) fn measure(img: &Image, want: &Image, bound: &[f64]) -> (Comparison, 
     (c, ratio)
 }
 
+/// How many pixels of `a` differ from `b` by more than their bound (in any channel).
+pub(crate) fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .zip(bound)
+        .filter(|((p, q), bd)| {
+            (0..3).any(|k| {
+                let e = (p[k] - q[k]).abs() as f64;
+                e.is_nan() || e > **bd
+            })
+        })
+        .count()
+}
+
 /// Whether `img` fails the camera: a pixel over its bound, the max error over `max_abs` or
 /// the PSNR under `min_psnr`.
 pub(crate) fn fails(img: &Image, want: &Image, bound: &[f64], t: &Tolerance) -> bool {

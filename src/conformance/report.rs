@@ -52,7 +52,9 @@ fn num(v: Option<f64>) -> Value {
 
 /// `report.json`: `diagnosis` (the smallest set of deviations that explains every failing
 /// camera: `rule`, `rc_section`, `description`, `rc_allowed`, `assets`, `evidence`), `assets` (per asset `name`, `rule`, `checks`, `pass`, `psnr`, `max_abs`,
-/// `skipped`, `catches`, `cause`, `cameras` with the same per camera plus the tolerance and `cause`),
+/// `skipped`, `catches`, `cause`, `cameras` with the same per camera plus the tolerance, `cause`
+/// and `nearest`: the model an unexplained failure came nearest to, `rules`, `pixels_over`,
+/// `worst_ratio`),
 /// `passed`, `failed`, `skipped` (counts of the RC assets), `profile` {`matched`, `differ`},
 /// `source`.
 pub fn to_json(results: &[AssetResult], source: &str) -> Value {
@@ -72,6 +74,10 @@ pub fn to_json(results: &[AssetResult], source: &str) -> Value {
                         "tolerance": {"max_abs": c.camera.tolerance.max_abs,
                                       "min_psnr": c.camera.tolerance.min_psnr},
                         "cause": c.cause,
+                        "nearest": c.closest.as_ref().map(|n| json!({
+                            "rules": n.deviations.iter().map(|d| d.name()).collect::<Vec<_>>(),
+                            "pixels_over": n.over, "worst_ratio": n.worst,
+                        })),
                     })
                 })
                 .collect();

@@ -1,8 +1,8 @@
 //! Comparing a set of images with the suite's references, per the manifest's tolerances, and
 //! naming the likely cause of known failure patterns.
 
-use super::diagnosis::{self, Deviation, Diagnosis, Explanation, Failure};
-use super::generate::{clamped, fails, measure};
+use super::diagnosis::{self, Closest, Deviation, Diagnosis, Explanation, Failure, Search};
+use super::generate::{clamped, fails, measure, over_bound};
 use super::manifest::{AssetEntry, CameraEntry, Manifest, suite_path};
 use super::model::Variant;
 use super::render;
@@ -23,6 +23,8 @@ pub struct CameraResult {
     pub cause: Option<String>,
     /// What explains a failure ([`diagnosis::explain`]; empty when it passes or has no image).
     pub explained_by: Vec<Explanation>,
+    /// For a failure nothing explains, the model it came nearest to (reported as `nearest`).
+    pub closest: Option<Closest>,
     /// PSNR and max error against the reference (when an image of the right size was given).
     pub against_reference: Option<(f64, f64)>,
     /// Expected (reference) and actual images (clamped), for the report.
@@ -72,20 +74,6 @@ pub fn find_image(images: &Path, c: &CameraEntry) -> Option<std::path::PathBuf> 
         .iter()
         .filter_map(|e| suite_path(images, &format!("{}.{e}", c.image)).ok())
         .find(|p| p.is_file())
-}
-
-fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
-    a.pixels
-        .iter()
-        .zip(&b.pixels)
-        .zip(bound)
-        .filter(|((p, q), bd)| {
-            (0..3).any(|k| {
-                let e = (p[k] - q[k]).abs() as f64;
-                e.is_nan() || e > **bd
-            })
-        })
-        .count()
 }
 
 /// What the images of a run were rendered from.
@@ -178,8 +166,52 @@ pub fn run_with(
             cameras: cams,
         });
     }
+    second_look(dir, m, &mut budget, &mut results)?;
     name_causes(&mut results);
     Ok(results)
+}
+
+/// The cameras the per-camera search left unexplained, tried with the deviations the
+/// diagnosis named for the others ([`diagnosis::explain_with`]), within the run's budget.
+fn second_look(
+    dir: &Path,
+    m: &Manifest,
+    budget: &mut Budget,
+    results: &mut [AssetResult],
+) -> Result<(), String> {
+    let named: Vec<_> = diagnosis(results).iter().map(|d| d.deviation).collect();
+    if named.len() < 2 {
+        return Ok(());
+    }
+    for (ai, r) in results.iter_mut().enumerate().filter(|(_, r)| !r.skipped) {
+        let mut loaded: Loaded = None;
+        for (ci, c) in r.cameras.iter_mut().enumerate() {
+            let open = !c.pass && c.explained_by.is_empty() && c.against_reference.is_some();
+            let Some(img) = c
+                .actual
+                .as_ref()
+                .filter(|_| open && budget.cameras_left > 0)
+            else {
+                continue;
+            };
+            let l = loaded.get_or_insert_with(|| load_for_models(dir, m, ai, budget.input));
+            let Some((scene, cams)) = l.as_ref() else {
+                break;
+            };
+            let work = (c.camera.width as u64 * c.camera.height as u64)
+                .saturating_mul(scene.cloud.len() as u64);
+            if work > MAX_MODEL_WORK {
+                break;
+            }
+            budget.cameras_left -= 1;
+            let (_, bound) = reference_and_bound(dir, &c.camera)?;
+            let mut search = Search::new(&scene.cloud, &cams[ci], &c.camera, img, &bound);
+            search.closest = c.closest.take();
+            c.explained_by = search.explain_with(&named);
+            c.closest = search.closest;
+        }
+    }
+    Ok(())
 }
 
 /// At most this many failing cameras are explained with the models in one run (each costs up
@@ -296,6 +328,7 @@ fn not_compared(c: &CameraEntry, want: &Image) -> CameraResult {
         pass: false,
         cause: None,
         explained_by: Vec::new(),
+        closest: None,
         against_reference: None,
         expected: want.clone(),
         actual: None,
@@ -333,7 +366,9 @@ fn allow_or_explain(
                 });
             } else if budget.cameras_left > 0 {
                 budget.cameras_left -= 1;
-                r.explained_by = diagnosis::explain(&l.0.cloud, &l.1[ci], c, img, bound);
+                let mut search = Search::new(&l.0.cloud, &l.1[ci], c, img, bound);
+                r.explained_by = search.explain();
+                r.closest = search.closest;
             } else {
                 return format!(
                     "{}not diagnosed (the run's diagnosis budget is spent); ",
@@ -413,6 +448,12 @@ pub fn diagnosis(results: &[AssetResult]) -> Vec<Diagnosis> {
     diagnosis::diagnose(&failures(results), &contradicted(results)).0
 }
 
+/// `a + b + …` of the deviations' rule names.
+fn rule_names(devs: &[Deviation]) -> String {
+    let names: Vec<String> = devs.iter().map(|d| d.name()).collect();
+    names.join(" + ")
+}
+
 /// Completes each explained failure's `cause` with the deviation the diagnosis attributes it
 /// to, or `unexplained` and the asset's stock hint.
 fn name_causes(results: &mut [AssetResult]) {
@@ -426,6 +467,7 @@ fn name_causes(results: &mut [AssetResult]) {
             }
             let text = match it.next().flatten() {
                 Some(e) => {
+                    c.closest = None;
                     let what: Vec<String> = e.deviations.iter().map(|d| d.describe()).collect();
                     format!(
                         "explained by {} ({:.1} dB against that model)",
@@ -433,7 +475,22 @@ fn name_causes(results: &mut [AssetResult]) {
                         e.psnr
                     )
                 }
-                None => format!("unexplained: {hint}"),
+                None => match &c.closest {
+                    // Far nearer to a model than to the correct one: the stock hint (a guess
+                    // from the reference alone) would name a fault the model rules out.
+                    Some(n) if n.over * 4 <= n.baseline_over => format!(
+                        "unexplained, a near miss of {} ({} pixels over their bound, worst {:.2}×)",
+                        rule_names(&n.deviations),
+                        n.over,
+                        n.worst
+                    ),
+                    Some(n) => format!(
+                        "unexplained (nearest: {}, {} pixels over their bound): {hint}",
+                        rule_names(&n.deviations),
+                        n.over
+                    ),
+                    None => format!("unexplained: {hint}"),
+                },
             };
             c.cause = Some(c.cause.take().unwrap_or_default() + &text);
         }
