@@ -73,6 +73,14 @@ fn cesium_is_graded_by_the_rules_its_source_breaks() {
     // axes of the footprint and exp(−4|v|²) is cut only beyond it (|v|² > 4 never happens
     // inside), a 2.83σ square rather than the 3σ ellipse.
     assert!(!pass("cutoff_three_sigma"));
+    // That square is the model the cut-off asset comes nearest to (or is explained by).
+    let cut = asset("cutoff_three_sigma");
+    let square = cut["cameras"][0]["nearest"]["rules"]
+        .as_array()
+        .is_some_and(|r| r.iter().any(|x| x == "square_cutoff"))
+        || named_for(&json, "square_cutoff")
+            .is_some_and(|a| a.contains(&"cutoff_three_sigma".to_owned()));
+    assert!(square, "{cut:#}");
     // wasm-splats src/radix.rs:25-33: the key is view-space z (positions · the model-view
     // matrix's third row), not the distance to the camera.
     assert!(!pass("sort_distance_not_depth"));

@@ -210,7 +210,7 @@ fn cutoff() -> AssetSpec {
         vec![cam("front", [0.0, 0.0, 3.0])],
     )
     .catches(&[Erratum::F])
-    .detects(&[Variant::BoxCut])
+    .detects(&[Variant::BoxCut, Variant::SquareCut])
 }
 
 fn blend_order() -> AssetSpec {

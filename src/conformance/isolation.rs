@@ -23,7 +23,7 @@ type TermField = fn(&mut model::Terms) -> &mut f64;
 /// assets designed for it and no other.
 /// - the 0.3 px² dilation (erratum i): an RC-silent choice (the RC leaves Σ' to "the same
 ///   forward pass algorithm used during training"), detected by `subpixel_dilation`;
-/// - the shape of the cut-off (erratum f's 2.83σ, a 3.33σ bounding box): an RC rule,
+/// - the shape of the cut-off (erratum f's 2.83σ, a 3.33σ bounding box, a 2.83σ square): an RC rule,
 ///   detected by `cutoff_three_sigma` alone;
 /// - the order by view depth instead of camera distance: an RC rule, detected by the sorting
 ///   assets;
@@ -33,10 +33,13 @@ type TermField = fn(&mut model::Terms) -> &mut f64;
 /// - Σ' rebuilt from eigenvalues floored at mid ± √0.1 (GaussianSplats3D's numerical
 ///   safeguard): like the dilation, a choice about Σ' at the scale of a pixel, detected by
 ///   `subpixel_dilation` (a profile asset) alone.
-const ISOLATED: [(Admitted, TermField); 7] = [
+const ISOLATED: [(Admitted, TermField); 8] = [
     (Admitted::Erratum(Erratum::I), |t| &mut t.dilation),
     (Admitted::Erratum(Erratum::F), |t| &mut t.cutoff_shape),
     (Admitted::Variant(Variant::BoxCut), |t| &mut t.cutoff_shape),
+    (Admitted::Variant(Variant::SquareCut), |t| {
+        &mut t.cutoff_shape
+    }),
     (Admitted::Variant(Variant::ViewDepthOrder), |t| {
         &mut t.sort_order
     }),

@@ -35,14 +35,18 @@ fn major_axis(a: f64, b: f64, c: f64, l1: f64) -> [f64; 2] {
     }
 }
 
-/// The half axes (pixels) of the 3.33σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
-/// scaled by 3.33·√λ.
-pub(super) fn box_half_axes(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
+/// How many σ the half axes of [`Variant::BoxCut`](super::Variant::BoxCut)'s box reach.
+pub(super) const BOX_SIGMA: f64 = 3.33;
+/// …and those of [`Variant::SquareCut`](super::Variant::SquareCut)'s square (2√2).
+pub(super) const SQUARE_SIGMA: f64 = 2.0 * std::f64::consts::SQRT_2;
+
+/// The half axes (pixels) of the `k`σ box of Σ' = [[a, b], [b, c]]: its eigenvectors
+/// scaled by k·√λ.
+pub(super) fn box_half_axes(a: f64, b: f64, c: f64, k: f64) -> [[f64; 2]; 2] {
     let (mid, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
     let (l1, l2) = (mid + half, (mid - half).max(0.0));
     let e1 = major_axis(a, b, c, l1);
     let e2 = [-e1[1], e1[0]];
-    let k = 3.33;
     [
         [k * l1.sqrt() * e1[0], k * l1.sqrt() * e1[1]],
         [k * l2.sqrt() * e2[0], k * l2.sqrt() * e2[1]],

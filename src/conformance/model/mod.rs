@@ -40,7 +40,7 @@ struct Layer {
     f16_err: f64,
     /// Pixels `[x0, x1] × [y0, y1]` (centres, inclusive float bounds) the splat may touch.
     rect: [f64; 4],
-    /// [`Variant::BoxCut`]: the box's half axes (pixels), `None` for the ellipse cut.
+    /// [`Variant::BoxCut`] or [`Variant::SquareCut`]: the half axes (pixels) of the box, `None` for the ellipse cut.
     box_axes: Option<[[f64; 2]; 2]>,
 }
 

@@ -11,7 +11,7 @@ use crate::profile::{ALPHA_MAX, ALPHA_MIN, DILATION_PX2, JACOBIAN_CLAMP, NEAR_CU
 use crate::reference::SortMode;
 use glam::{DMat3, DQuat, DVec3};
 
-use super::footprint::{box_half_axes, eigenvalue_floor};
+use super::footprint::{BOX_SIGMA, SQUARE_SIGMA, box_half_axes, eigenvalue_floor};
 
 /// The appendix's SH basis (erratum e): no Condon–Shortley signs, 2.89 for coefficient 14.
 fn appendix_basis(d: [f64; 3]) -> [f64; 16] {
@@ -146,7 +146,13 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
     let dir = (mean - view.eye).normalize().to_array();
     let (color, f16_err) = colour(cloud, i, dir, view.on(Erratum::E), view.vars);
     let opacity = model_opacity(cloud, i, view, det0, det);
-    let box_axes = view.var(Variant::BoxCut).then(|| box_half_axes(a, b, cc));
+    let box_axes = [
+        (Variant::BoxCut, BOX_SIGMA),
+        (Variant::SquareCut, SQUARE_SIGMA),
+    ]
+    .into_iter()
+    .find(|(v, _)| view.var(*v))
+    .map(|(_, k)| box_half_axes(a, b, cc, k));
     let (centre, rect) = centre_and_rect(view, [a, cc, det], [u, v], t.z, box_axes);
     Some(Layer {
         centre,

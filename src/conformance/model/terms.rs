@@ -22,7 +22,7 @@ pub struct Terms {
     /// Deviations an asset admits because it does not test them (set by the generator, not by
     /// [`super::render`]; isolation): the difference the model shows without the 0.3 px² dilation,
     pub dilation: f64,
-    /// …with another cut-off shape (2.83σ, a 3.33σ bounding box),
+    /// …with another cut-off shape (2.83σ, a 3.33σ bounding box, a 2.83σ square),
     pub cutoff_shape: f64,
     /// …with splats ordered by view depth,
     pub sort_order: f64,

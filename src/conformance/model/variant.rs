@@ -6,6 +6,10 @@
 pub enum Variant {
     /// Splats cut by their oriented 3.33σ bounding box instead of the 3σ ellipse.
     BoxCut,
+    /// Splats cut by a 2√2σ ≈ 2.83σ square along the footprint's axes, its corners at 4σ
+    /// (CesiumJS: quads of ±√(2λ) in its units, never discarded inside) instead of the 3σ
+    /// ellipse: the ring 2.83σ–3σ lost along the axes, faint corners up to 4σ drawn.
+    SquareCut,
     /// Blending order by view depth (camera-space z; per tile or global, the same per pixel)
     /// instead of camera distance.
     ViewDepthOrder,
@@ -45,8 +49,9 @@ pub enum Variant {
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 14] = [
+    pub const ALL: [Variant; 15] = [
         Variant::BoxCut,
+        Variant::SquareCut,
         Variant::ViewDepthOrder,
         Variant::AaCompensation,
         Variant::ShDegree0,
@@ -65,6 +70,7 @@ impl Variant {
     pub fn name(self) -> &'static str {
         match self {
             Variant::BoxCut => "bounding_box_cutoff",
+            Variant::SquareCut => "square_cutoff",
             Variant::ViewDepthOrder => "view_depth_order",
             Variant::AaCompensation => "antialiasing_compensation",
             Variant::ShDegree0 => "sh_ignored_above_degree_0",
@@ -84,6 +90,9 @@ impl Variant {
     pub fn describe(self) -> &'static str {
         match self {
             Variant::BoxCut => "splats cut by a 3.33σ bounding box instead of the 3σ ellipse",
+            Variant::SquareCut => {
+                "splats cut by a 2.83σ square along the footprint's axes (corners at 4σ) instead of the 3σ ellipse"
+            }
             Variant::ViewDepthOrder => {
                 "splats ordered by view depth (camera-space z) instead of distance to the camera"
             }
@@ -114,7 +123,7 @@ impl Variant {
     /// The RC section whose rule the variant departs from.
     pub fn rc_section(self) -> &'static str {
         match self {
-            Variant::BoxCut => "RC Ellipse Kernel Rendering (3σ cut-off)",
+            Variant::BoxCut | Variant::SquareCut => "RC Ellipse Kernel Rendering (3σ cut-off)",
             Variant::ViewDepthOrder => "RC Sorting Method (cameraDistance)",
             Variant::AaCompensation => "RC Ellipse Kernel Rendering (α = opacity · G(x))",
             Variant::ShDegree0 | Variant::ShDegree1 | Variant::ShDegree2 => {
