@@ -42,6 +42,7 @@ pub mod reference;
 pub mod sh;
 pub mod sort;
 pub mod synthetic;
+pub mod tiles;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod write;

@@ -15,8 +15,8 @@ const LAYERS: &[&[&str]] = &[
     &["camera"],
     // Reading and writing files; images; the synthetic scenes.
     &["load", "write", "image", "compare", "synthetic"],
-    // Per-frame CPU stages; the converter.
-    &["cull", "sort", "convert"],
+    // Per-frame CPU stages; the converter; tilesets (read through the loaders).
+    &["cull", "sort", "convert", "tiles"],
     // The two renderers.
     &["reference", "gl"],
     // Driving a renderer: headless EGL; either renderer for offline images.

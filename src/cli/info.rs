@@ -12,6 +12,9 @@ pub const JSON_HELP: &str = "Print JSON (keys: format, splat_count, sh_degree, c
 /// Runs `info`. Exit status 0, or 2 when the file cannot be loaded.
 pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
+    if super::tileset::is_tileset_file(&a.file, &opts) {
+        return super::tileset::info(&a, &opts);
+    }
     let loaded = match splatgl::load::load_path(&a.file, &opts) {
         Ok(l) => l,
         Err(e) => {

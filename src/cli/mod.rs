@@ -14,6 +14,7 @@ mod progress;
 mod render;
 mod render_backend;
 mod render_out;
+mod tileset;
 mod validate;
 #[cfg(feature = "viewer")]
 mod view;
@@ -63,7 +64,8 @@ enum Command {
 /// The arguments of `info` and `validate`: one file, read with the loader options.
 #[derive(clap::Args, Debug)]
 pub struct FileArgs {
-    /// The file (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog or a SOG meta.json).
+    /// The file (.gltf, .glb, .ply, .spz, .splat, .ksplat, .sog, a SOG meta.json, or a 3D Tiles
+    /// tileset.json).
     pub file: std::path::PathBuf,
     /// Print JSON (each command lists its keys).
     #[arg(long)]

@@ -9,6 +9,10 @@ pub const JSON_HELP: &str = "Print the findings as JSON (keys: file, format, sta
 /// Runs `validate`; the exit status is 0 valid, 1 invalid, 2 unreadable.
 pub fn run(a: super::FileArgs) -> ExitCode {
     let opts = a.load.options();
+    if super::tileset::is_tileset_file(&a.file, &opts) {
+        let t = splatgl::tiles::check(&a.file, &opts, true);
+        return print(&a, &t.report, &opts, Some("3dtiles"));
+    }
     let report = splatgl::load::validate::validate_path(&a.file, &opts);
     if let Some(format) = report.format
         && let Err(e) = a
@@ -19,8 +23,22 @@ pub fn run(a: super::FileArgs) -> ExitCode {
         eprintln!("error: {e}");
         return ExitCode::from(2);
     }
+    print(&a, &report, &opts, None)
+}
+
+/// Prints `report` (JSON or text, with its `format` named `format` where the report has none:
+/// a tileset) and returns the exit status.
+fn print(
+    a: &super::FileArgs,
+    report: &splatgl::load::validate::Report,
+    opts: &splatgl::load::LoadOptions,
+    format: Option<&str>,
+) -> ExitCode {
     if a.json {
         let mut json = report.to_json(&a.file);
+        if let Some(f) = format {
+            json["format"] = f.into();
+        }
         if a.verbose {
             json["limits"] = super::limits_json(&opts.limits);
         }

@@ -21,7 +21,7 @@ pub struct CameraResult {
     pub pass: bool,
     /// The likely cause of a failure (or the RC-allowed choice a pass was found with).
     pub cause: Option<String>,
-    /// What explains a failure ([`diagnosis::explain`]; empty when it passes or has no image).
+    /// What explains a failure ([`diagnosis::Search::explain`]; empty when it passes or has no image).
     pub explained_by: Vec<Explanation>,
     /// For a failure nothing explains, the model it came nearest to (reported as `nearest`).
     pub closest: Option<Closest>,

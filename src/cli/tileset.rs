@@ -1,0 +1,77 @@
+//! `info` and `validate` of a 3D Tiles tileset (`splatgl::tiles`): a `.json` file with
+//! `asset` and `root`.
+use splatgl::load::LoadOptions;
+use std::path::Path;
+use std::process::ExitCode;
+
+/// Whether `file` is a tileset: a `.json` within the size limit whose object has `asset` and
+/// `root` (anything else goes to the scene loaders, which name their own errors).
+pub fn is_tileset_file(file: &Path, opts: &LoadOptions) -> bool {
+    let json = file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    json && splatgl::files::read_bounded(file, opts.limits.max_bytes, "the file")
+        .is_ok_and(|b| splatgl::tiles::is_tileset(&b))
+}
+
+/// `info` of a tileset: per level the tiles, content files, splats and largest geometric
+/// error, and the root's bounding sphere. Exit status 0, or 2 when it cannot be read.
+pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
+    let t = splatgl::tiles::check(&a.file, opts, true);
+    let Some(ts) = &t.tileset else {
+        for line in t.report.summarized() {
+            eprintln!("{line}");
+        }
+        return ExitCode::from(2);
+    };
+    let sphere = ts.root.bounds.map(|b| b.sphere());
+    let levels: Vec<serde_json::Value> = t
+        .levels
+        .iter()
+        .map(|l| {
+            serde_json::json!({
+                "level": l.level, "tiles": l.tiles, "contents": l.contents,
+                "splats": l.splats, "geometric_error": l.geometric_error,
+            })
+        })
+        .collect();
+    let problems = t.report.summarized();
+    let json = serde_json::json!({
+        "file": a.file.display().to_string(),
+        "format": "3dtiles",
+        "version": ts.version,
+        "tiles": t.levels.iter().map(|l| l.tiles).sum::<usize>(),
+        "levels": levels,
+        "splat_count": t.report.splat_count,
+        "bounds_centre": sphere.map(|s| s.0.to_array()),
+        "bounds_radius": sphere.map(|s| s.1),
+        "problems": problems,
+    });
+    if a.json {
+        println!("{json:#}");
+        return ExitCode::SUCCESS;
+    }
+    println!("file:           {}", a.file.display());
+    println!("format:         3D Tiles {} tileset", ts.version);
+    println!("tiles:          {}", json["tiles"]);
+    println!("splats:         {}", t.report.splat_count.unwrap_or(0));
+    if let Some((c, r)) = sphere {
+        println!(
+            "bounds:         sphere ({:.3}, {:.3}, {:.3}) r {r:.3}",
+            c.x, c.y, c.z
+        );
+    }
+    println!("levels:");
+    for l in &t.levels {
+        println!(
+            "  {:>2}: {:>6} tiles, {:>6} contents, {:>10} splats, geometric error ≤ {}",
+            l.level, l.tiles, l.contents, l.splats, l.geometric_error
+        );
+    }
+    if !a.quiet {
+        for p in problems {
+            println!("warning: {p}");
+        }
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,200 @@
+//! The structural rules of a tileset and its content, for `info` and `validate`: what
+//! [`super::read`] found, geometric error that does not decrease, child volumes outside their
+//! parent's, content that is missing, outside the tileset's folder, not loadable, not splats,
+//! or with splats outside its tile's volume.
+
+use super::{Tile, Tileset};
+use crate::load::validate::Report;
+use crate::load::{Finding, Format, LoadOptions, load_path};
+use glam::{DMat4, DVec3};
+use std::path::Path;
+
+/// Relative slack of the containment tests (f32 positions, rounding of written volumes).
+const EPS: f64 = 1e-4;
+
+/// One level of the tree.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LevelSummary {
+    /// Depth (the root is 0).
+    pub level: usize,
+    /// Tiles at this depth.
+    pub tiles: usize,
+    /// Content files at this depth.
+    pub contents: usize,
+    /// Splats in the content that loaded.
+    pub splats: u64,
+    /// The largest `geometricError` at this depth.
+    pub geometric_error: f64,
+}
+
+/// What [`check`] found.
+#[derive(Debug, Clone)]
+pub struct TilesetReport {
+    /// The tileset, when `tileset.json` could be read.
+    pub tileset: Option<Tileset>,
+    /// Findings in tree order, as `validate` prints them.
+    pub report: Report,
+    /// Per depth.
+    pub levels: Vec<LevelSummary>,
+}
+
+/// Reads `path` as a tileset and checks it; with `load_content`, every tile's content is
+/// loaded (with `opts`: limits, containment) and its splats counted and checked against the
+/// tile's volume.
+pub fn check(path: &Path, opts: &LoadOptions, load_content: bool) -> TilesetReport {
+    let ts = match super::read(path, opts) {
+        Ok(ts) => ts,
+        Err(e) => {
+            return TilesetReport {
+                tileset: None,
+                report: Report {
+                    format: None,
+                    findings: vec![Finding::fatal("", e)],
+                    readable: false,
+                    splat_count: None,
+                },
+                levels: Vec::new(),
+            };
+        }
+    };
+    let mut findings: Vec<Finding> = ts
+        .problems
+        .iter()
+        .map(|p| match p.unsupported {
+            true => Finding::unsupported(&p.path, &p.message),
+            false => Finding::error(&p.path, &p.message),
+        })
+        .collect();
+    let mut levels: Vec<LevelSummary> = Vec::new();
+    let mut total = 0u64;
+    let mut stack = vec![(&ts.root, None::<&Tile>)];
+    while let Some((t, parent)) = stack.pop() {
+        if let Some(p) = parent {
+            nesting(t, p, &mut findings);
+        }
+        if levels.len() <= t.level {
+            levels.resize_with(t.level + 1, Default::default);
+        }
+        let l = &mut levels[t.level];
+        l.level = t.level;
+        l.tiles += 1;
+        l.contents += t.content.len();
+        l.geometric_error = l.geometric_error.max(t.geometric_error);
+        if load_content {
+            let n = contents(&ts, t, opts, &mut findings);
+            levels[t.level].splats += n;
+            total += n;
+        }
+        stack.extend(t.children.iter().rev().map(|c| (c, Some(t))));
+    }
+    let report = Report {
+        format: None,
+        findings,
+        readable: true,
+        splat_count: load_content.then_some(total as usize),
+    };
+    TilesetReport {
+        tileset: Some(ts),
+        report,
+        levels,
+    }
+}
+
+/// The rules between a tile and its parent: geometric error does not grow, and the child's
+/// volume lies inside the parent's (3D Tiles' spatial coherence, which selection relies on).
+fn nesting(t: &Tile, parent: &Tile, findings: &mut Vec<Finding>) {
+    if t.geometric_error > parent.geometric_error {
+        findings.push(Finding::warning(
+            format!("{}.geometricError", t.path),
+            format!(
+                "{} is larger than its parent's {}: a child must not be coarser than its parent",
+                t.geometric_error, parent.geometric_error
+            ),
+        ));
+    }
+    if let (Some(b), Some(pb)) = (t.bounds, parent.bounds)
+        && let Some(out) = b.extremes().into_iter().find(|p| !pb.contains(*p, EPS))
+    {
+        findings.push(Finding::warning(
+            format!("{}.boundingVolume", t.path),
+            format!(
+                "reaches ({:.4}, {:.4}, {:.4}), outside its parent's volume: children's volumes must lie inside their parent's",
+                out.x, out.y, out.z
+            ),
+        ));
+    }
+}
+
+/// glTF content is y-up; 3D Tiles is z-up, and a runtime turns glTF content by this before
+/// the tile transform (3D Tiles 1.1, "glTF transforms").
+const Y_UP_TO_Z_UP: DMat4 = DMat4::from_cols_array(&[
+    1.0, 0.0, 0.0, 0.0, //
+    0.0, 0.0, 1.0, 0.0, //
+    0.0, -1.0, 0.0, 0.0, //
+    0.0, 0.0, 0.0, 1.0,
+]);
+
+/// Loads tile `t`'s content, reports what is wrong with it, and returns its splat count.
+fn contents(ts: &Tileset, t: &Tile, opts: &LoadOptions, findings: &mut Vec<Finding>) -> u64 {
+    let mut total = 0;
+    for (i, uri) in t.content.iter().enumerate() {
+        let at = match t.content.len() {
+            1 => format!("{}.content", t.path),
+            _ => format!("{}.contents[{i}]", t.path),
+        };
+        if uri.ends_with(".json") {
+            findings.push(Finding::unsupported(
+                &at,
+                format!("{uri:?}: external tilesets are not read by splatgl yet"),
+            ));
+            continue;
+        }
+        let file = match crate::files::contained(ts.folder(), uri, opts.allow_outside_paths) {
+            Ok(f) => f,
+            Err(e) => {
+                findings.push(Finding::error(&at, e));
+                continue;
+            }
+        };
+        let scene = match load_path(&file, opts) {
+            Ok(s) => s,
+            Err(e) => {
+                findings.push(Finding::error(&at, format!("{uri:?} does not load: {e}")));
+                continue;
+            }
+        };
+        let format = scene.report.format;
+        if !matches!(format, Format::Gltf | Format::Glb) {
+            findings.push(Finding::warning(
+                &at,
+                format!(
+                    "{uri:?} is {}: 3D Tiles content is glTF (with KHR_gaussian_splatting for splats)",
+                    format.name()
+                ),
+            ));
+        }
+        let cloud = &scene.cloud;
+        total += cloud.len() as u64;
+        if let Some(b) = t.bounds {
+            let m = t.transform * Y_UP_TO_Z_UP;
+            let outside = cloud
+                .positions
+                .iter()
+                .filter(|p| {
+                    let p = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+                    !b.contains(m.transform_point3(p), EPS)
+                })
+                .count();
+            if outside > 0 {
+                findings.push(Finding::warning(
+                    &at,
+                    format!(
+                        "{outside} of its {} splat centres lie outside the tile's bounding volume (content turned y-up → z-up, then the tile transform)",
+                        cloud.len()
+                    ),
+                ));
+            }
+        }
+    }
+    total
+}

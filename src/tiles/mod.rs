@@ -1,0 +1,442 @@
+//! 3D Tiles 1.1 tilesets whose tile content is glTF with `KHR_gaussian_splatting` (CesiumJS's
+//! format for large splat scenes): [`read`] parses `tileset.json` into a tree of [`Tile`]s with
+//! their global transforms and bounding volumes; [`check`] applies the structural rules of
+//! 3D Tiles and loads each tile's content through [`crate::load`], for `info` and `validate`.
+//!
+//! What is read: `asset.version` (1.0 or 1.1), `geometricError`, `refine` (`ADD` / `REPLACE`,
+//! inherited from the parent), `transform` (column-major, composed parent × child),
+//! `boundingVolume` `box` and `sphere` (`region` is reported unsupported: it needs the WGS84
+//! ellipsoid), `content.uri` and 1.1's `contents[].uri`. Content URIs are resolved against the
+//! tileset's folder and must stay inside it ([`LoadOptions::allow_outside_paths`]); external
+//! tilesets (content that is itself a `tileset.json`), implicit tiling and selection by
+//! screen-space error are not done yet (issue 21).
+
+mod check;
+
+pub use check::{LevelSummary, TilesetReport, check};
+
+use crate::load::LoadOptions;
+use glam::{DMat3, DMat4, DVec3};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// At most this many tiles are read from one tileset (a hostile file cannot make the tree
+/// unbounded).
+pub const MAX_TILES: usize = 1 << 20;
+/// …and at most this deep.
+pub const MAX_DEPTH: usize = 64;
+
+/// How a tile's children refine it (3D Tiles `refine`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refine {
+    /// The children's content is drawn in addition to the parent's.
+    Add,
+    /// The children's content replaces the parent's.
+    Replace,
+}
+
+/// A tile's bounding volume in the tileset's frame (its transform applied).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bounds {
+    /// `box`: centre and three half-axis vectors (columns).
+    Box {
+        /// The centre.
+        centre: DVec3,
+        /// The half axes as columns.
+        half_axes: DMat3,
+    },
+    /// `sphere`: centre and radius.
+    Sphere {
+        /// The centre.
+        centre: DVec3,
+        /// The radius.
+        radius: f64,
+    },
+}
+
+impl Bounds {
+    /// The smallest sphere around it (for a box, the one through its corners).
+    pub fn sphere(&self) -> (DVec3, f64) {
+        match *self {
+            Bounds::Sphere { centre, radius } => (centre, radius),
+            Bounds::Box { centre, half_axes } => (
+                centre,
+                (half_axes.x_axis.abs() + half_axes.y_axis.abs() + half_axes.z_axis.abs()).length(),
+            ),
+        }
+    }
+
+    /// Whether `p` lies inside (with a relative tolerance `eps` of the volume's size).
+    pub fn contains(&self, p: DVec3, eps: f64) -> bool {
+        match *self {
+            Bounds::Sphere { centre, radius } => (p - centre).length() <= radius * (1.0 + eps),
+            Bounds::Box { centre, half_axes } => {
+                let d = p - centre;
+                [half_axes.x_axis, half_axes.y_axis, half_axes.z_axis]
+                    .iter()
+                    .all(|h| {
+                        let n2 = h.length_squared();
+                        n2 == 0.0 || d.dot(*h).abs() <= n2 * (1.0 + eps)
+                    })
+            }
+        }
+    }
+
+    /// Points that span it: a box's eight corners, a sphere's six axis extremes.
+    pub fn extremes(&self) -> Vec<DVec3> {
+        match *self {
+            Bounds::Sphere { centre, radius } => [DVec3::X, DVec3::Y, DVec3::Z]
+                .iter()
+                .flat_map(|a| [centre + *a * radius, centre - *a * radius])
+                .collect(),
+            Bounds::Box { centre, half_axes } => (0..8)
+                .map(|k| {
+                    let s = |bit: i32| if k & bit == 0 { -1.0 } else { 1.0 };
+                    centre
+                        + half_axes.x_axis * s(1)
+                        + half_axes.y_axis * s(2)
+                        + half_axes.z_axis * s(4)
+                })
+                .collect(),
+        }
+    }
+}
+
+/// One tile of the tree.
+#[derive(Debug, Clone)]
+pub struct Tile {
+    /// Where it is in `tileset.json` (`root.children[2].children[0]`).
+    pub path: String,
+    /// Its depth (the root is 0).
+    pub level: usize,
+    /// `geometricError` (metres of error if this tile is drawn instead of its children).
+    pub geometric_error: f64,
+    /// How its children refine it (its own `refine`, else its parent's).
+    pub refine: Refine,
+    /// The global transform: the product of the `transform`s from the root down to it.
+    pub transform: DMat4,
+    /// Its bounding volume in the tileset's frame; `None` when it has none splatgl reads
+    /// (`region`, or a malformed one: see the report).
+    pub bounds: Option<Bounds>,
+    /// Its content URIs (`content.uri`, `contents[].uri`), as written.
+    pub content: Vec<String>,
+    /// Its children.
+    pub children: Vec<Tile>,
+}
+
+impl Tile {
+    /// This tile and every tile below it, depth first.
+    pub fn walk(&self) -> Vec<&Tile> {
+        let mut out = vec![self];
+        for c in &self.children {
+            out.extend(c.walk());
+        }
+        out
+    }
+}
+
+/// A problem found while reading: its JSON path and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// Where (`root.children[1].boundingVolume`).
+    pub path: String,
+    /// What is wrong, and what was expected.
+    pub message: String,
+    /// Whether splatgl cannot use it although 3D Tiles allows it (`region`, external
+    /// tilesets), rather than the file breaking a rule.
+    pub unsupported: bool,
+}
+
+/// A tileset as read.
+#[derive(Debug, Clone)]
+pub struct Tileset {
+    /// The `tileset.json` read.
+    pub file: PathBuf,
+    /// `asset.version`.
+    pub version: String,
+    /// The root tile.
+    pub root: Tile,
+    /// What was wrong in the JSON that did not stop reading (each tile that has it is still
+    /// in the tree, with what could be read).
+    pub problems: Vec<Problem>,
+}
+
+impl Tileset {
+    /// The folder its content URIs are resolved against.
+    pub fn folder(&self) -> &Path {
+        self.file.parent().unwrap_or(Path::new("."))
+    }
+}
+
+/// Whether `bytes` look like a 3D Tiles `tileset.json`: a JSON object with `asset` and
+/// `root` — or, when it does not parse (nested too deep, truncated), text with the keys
+/// `"root"` and `"geometricError"`, so that [`read`] reports what is wrong with it as a
+/// tileset. What `info` and `validate` test before taking a `.json` file as one.
+pub fn is_tileset(bytes: &[u8]) -> bool {
+    let head = bytes.iter().position(|b| !b.is_ascii_whitespace());
+    if head.is_none_or(|i| bytes[i] != b'{') {
+        return false;
+    }
+    match serde_json::from_slice::<Value>(bytes) {
+        Ok(v) => v.get("asset").is_some() && v.get("root").is_some(),
+        Err(_) => {
+            let has = |k: &[u8]| bytes.windows(k.len()).any(|w| w == k);
+            has(b"\"root\"") && has(b"\"geometricError\"")
+        }
+    }
+}
+
+/// Reads `path` as a tileset: within the load limits (`max_bytes`, the JSON nesting depth),
+/// at most [`MAX_TILES`] tiles [`MAX_DEPTH`] deep. `Err` when it cannot be read at all (not
+/// JSON, no `root`, no usable `asset.version`); rule breaks inside tiles are
+/// [`Tileset::problems`].
+pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
+    let shown = path.display();
+    let bytes = crate::files::read_bounded(path, opts.limits.max_bytes, "the tileset")
+        .map_err(|e| format!("{shown}: {e}"))?;
+    crate::files::check_json_depth(&bytes, opts.limits.max_json_depth)
+        .map_err(|e| format!("{shown}: {e}"))?;
+    let v: Value = serde_json::from_slice(&bytes).map_err(|e| format!("{shown}: not JSON: {e}"))?;
+    let version = v
+        .pointer("/asset/version")
+        .and_then(Value::as_str)
+        .ok_or_else(|| format!("{shown}: asset.version: missing (expected \"1.0\" or \"1.1\")"))?
+        .to_owned();
+    let mut problems = Vec::new();
+    if version != "1.0" && version != "1.1" {
+        problems.push(Problem {
+            path: "asset.version".into(),
+            message: format!("{version:?}: expected \"1.0\" or \"1.1\""),
+            unsupported: true,
+        });
+    }
+    let root = v
+        .get("root")
+        .ok_or_else(|| format!("{shown}: root: missing"))?;
+    let mut reader = Reader {
+        tiles: 0,
+        problems: &mut problems,
+    };
+    let parent = Parent {
+        refine: None,
+        transform: DMat4::IDENTITY,
+        level: 0,
+    };
+    let root = reader
+        .tile(root, "root".into(), parent)
+        .ok_or_else(|| format!("{shown}: root: not a tile object"))?;
+    if root.refine_missing {
+        problems.push(Problem {
+            path: "root.refine".into(),
+            message: "missing: the root tile must say ADD or REPLACE (read as REPLACE)".into(),
+            unsupported: false,
+        });
+    }
+    Ok(Tileset {
+        file: path.to_owned(),
+        version,
+        root: root.tile,
+        problems,
+    })
+}
+
+/// What a tile inherits from its parent.
+#[derive(Clone, Copy)]
+struct Parent {
+    refine: Option<Refine>,
+    transform: DMat4,
+    level: usize,
+}
+
+/// A tile as read, and whether it had its own `refine`.
+struct ReadTile {
+    tile: Tile,
+    refine_missing: bool,
+}
+
+/// The state of one read: tiles so far and the problems found.
+struct Reader<'a> {
+    tiles: usize,
+    problems: &'a mut Vec<Problem>,
+}
+
+impl Reader<'_> {
+    fn problem(&mut self, path: &str, message: impl Into<String>, unsupported: bool) {
+        self.problems.push(Problem {
+            path: path.to_owned(),
+            message: message.into(),
+            unsupported,
+        });
+    }
+
+    /// The tile `v` at `path` below `parent`; `None` when `v` is not an object or the tree is
+    /// over its limits.
+    fn tile(&mut self, v: &Value, path: String, parent: Parent) -> Option<ReadTile> {
+        let obj = v.as_object()?;
+        self.tiles += 1;
+        if self.tiles > MAX_TILES || parent.level > MAX_DEPTH {
+            self.problem(
+                &path,
+                format!("more than {MAX_TILES} tiles or deeper than {MAX_DEPTH}: not read"),
+                true,
+            );
+            return None;
+        }
+        let geometric_error = match obj.get("geometricError").and_then(Value::as_f64) {
+            Some(g) if g.is_finite() && g >= 0.0 => g,
+            other => {
+                let found = other.map_or("missing".to_owned(), |g| g.to_string());
+                self.problem(
+                    &format!("{path}.geometricError"),
+                    format!("{found}: expected a number ≥ 0 (read as 0)"),
+                    false,
+                );
+                0.0
+            }
+        };
+        let own_refine = match obj.get("refine").map(|r| r.as_str()) {
+            None => None,
+            Some(Some("ADD")) => Some(Refine::Add),
+            Some(Some("REPLACE")) => Some(Refine::Replace),
+            Some(other) => {
+                self.problem(
+                    &format!("{path}.refine"),
+                    format!("{other:?}: expected \"ADD\" or \"REPLACE\" (inherited instead)"),
+                    false,
+                );
+                None
+            }
+        };
+        let refine = own_refine.or(parent.refine).unwrap_or(Refine::Replace);
+        let transform = parent.transform * self.transform(obj.get("transform"), &path);
+        let bounds = self.bounds(obj.get("boundingVolume"), &path, transform);
+        let content = self.content(obj, &path);
+        let mut children = Vec::new();
+        if let Some(list) = obj.get("children") {
+            let Some(list) = list.as_array() else {
+                self.problem(&format!("{path}.children"), "expected an array", false);
+                return None;
+            };
+            let below = Parent {
+                refine: Some(refine),
+                transform,
+                level: parent.level + 1,
+            };
+            for (i, c) in list.iter().enumerate() {
+                let cp = format!("{path}.children[{i}]");
+                match self.tile(c, cp.clone(), below) {
+                    Some(t) => children.push(t.tile),
+                    None if c.is_object() => {}
+                    None => self.problem(&cp, "expected a tile object", false),
+                }
+            }
+        }
+        Some(ReadTile {
+            tile: Tile {
+                path,
+                level: parent.level,
+                geometric_error,
+                refine,
+                transform,
+                bounds,
+                content,
+                children,
+            },
+            refine_missing: own_refine.is_none(),
+        })
+    }
+
+    /// A tile's own `transform` (identity when absent or malformed).
+    fn transform(&mut self, v: Option<&Value>, path: &str) -> DMat4 {
+        let Some(v) = v else {
+            return DMat4::IDENTITY;
+        };
+        let m: Option<Vec<f64>> = v
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_f64).collect());
+        match m {
+            Some(m) if m.len() == 16 && m.iter().all(|x| x.is_finite()) => {
+                DMat4::from_cols_slice(&m)
+            }
+            _ => {
+                self.problem(
+                    &format!("{path}.transform"),
+                    "expected 16 finite numbers, column-major (identity used)",
+                    false,
+                );
+                DMat4::IDENTITY
+            }
+        }
+    }
+
+    /// A tile's bounding volume in the tileset's frame.
+    fn bounds(&mut self, v: Option<&Value>, path: &str, m: DMat4) -> Option<Bounds> {
+        let at = format!("{path}.boundingVolume");
+        let Some(v) = v else {
+            self.problem(&at, "missing (every tile needs one)", false);
+            return None;
+        };
+        let nums = |k: &str| -> Option<Vec<f64>> {
+            let a = v.get(k)?.as_array()?;
+            let n: Vec<f64> = a.iter().filter_map(Value::as_f64).collect();
+            (n.len() == a.len() && n.iter().all(|x| x.is_finite())).then_some(n)
+        };
+        if let Some(b) = nums("box") {
+            if b.len() == 12 {
+                let m3 = DMat3::from_mat4(m);
+                let col = |i: usize| m3 * DVec3::new(b[i], b[i + 1], b[i + 2]);
+                return Some(Bounds::Box {
+                    centre: m.transform_point3(DVec3::new(b[0], b[1], b[2])),
+                    half_axes: DMat3::from_cols(col(3), col(6), col(9)),
+                });
+            }
+        } else if let Some(s) = nums("sphere") {
+            if s.len() == 4 && s[3] >= 0.0 {
+                // The largest column length of the transform scales the radius.
+                let m3 = DMat3::from_mat4(m);
+                let k = [m3.x_axis, m3.y_axis, m3.z_axis]
+                    .iter()
+                    .map(|c| c.length())
+                    .fold(0.0, f64::max);
+                return Some(Bounds::Sphere {
+                    centre: m.transform_point3(DVec3::new(s[0], s[1], s[2])),
+                    radius: s[3] * k,
+                });
+            }
+        } else if v.get("region").is_some() {
+            self.problem(
+                &at,
+                "region (longitude/latitude on the WGS84 ellipsoid) is not read by splatgl: use box or sphere",
+                true,
+            );
+            return None;
+        }
+        self.problem(
+            &at,
+            "expected box (12 finite numbers), sphere (4, radius ≥ 0) or region",
+            false,
+        );
+        None
+    }
+
+    /// A tile's content URIs (`content.uri`, `contents[].uri`).
+    fn content(&mut self, obj: &serde_json::Map<String, Value>, path: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut one = |c: &Value, at: String, out: &mut Vec<String>| match c
+            .get("uri")
+            .and_then(Value::as_str)
+        {
+            Some(u) => out.push(u.to_owned()),
+            None => self.problem(&at, "content without a uri string", false),
+        };
+        if let Some(c) = obj.get("content") {
+            one(c, format!("{path}.content"), &mut out);
+        }
+        if let Some(list) = obj.get("contents").and_then(Value::as_array) {
+            for (i, c) in list.iter().enumerate() {
+                one(c, format!("{path}.contents[{i}]"), &mut out);
+            }
+        }
+        out
+    }
+}
