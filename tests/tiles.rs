@@ -215,3 +215,149 @@ fn hostile_tilesets_are_errors_not_crashes() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Undoes 3D Tiles' y-up → z-up turn of glTF content, so the tileset's frame is the glTF
+/// frame and a tileset renders like its content loaded directly.
+const Z_UP_TO_Y_UP: [f64; 16] = [
+    1.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+];
+
+/// A REPLACE tileset: a coarse root of 10 splats over two children that split a 400-splat
+/// cloud in half along x; also the whole cloud as `whole.glb`.
+fn lod(d: &Path, child_b: &str) -> PathBuf {
+    let whole = splatgl::synthetic::random_cloud(400, 1, 1.0, 7);
+    let half = |left: bool| -> Vec<u32> {
+        (0..whole.len() as u32)
+            .filter(|&i| (whole.positions[i as usize][0] < 0.0) == left)
+            .collect()
+    };
+    let write = |name: &str, c: &splatgl::SplatCloud| {
+        std::fs::write(d.join(name), splatgl::write::to_glb(c, &Default::default())).unwrap()
+    };
+    write("whole.glb", &whole);
+    write("a.glb", &whole.select(&half(true)));
+    write("b.glb", &whole.select(&half(false)));
+    content(d, "coarse.glb", 10, 1.0, 8);
+    let h = [2.0, 2.0, 2.0];
+    tileset(
+        d,
+        json!({
+            "geometricError": 1.0, "refine": "REPLACE", "transform": Z_UP_TO_Y_UP,
+            "boundingVolume": bx([0.0, 0.0, 0.0], h), "content": { "uri": "coarse.glb" },
+            "children": [
+                { "geometricError": 0.0, "boundingVolume": bx([0.0, 0.0, 0.0], h),
+                  "content": { "uri": "a.glb" } },
+                { "geometricError": 0.0, "boundingVolume": bx([0.0, 0.0, 0.0], h),
+                  "content": { "uri": child_b } },
+            ],
+        }),
+    )
+}
+
+/// `render SCENE` from `eye` towards the origin with the reference backend into `out`.
+fn render(scene: &Path, eye: &str, out: &Path, extra: &[&str]) -> common::cli::Run {
+    let look = format!("{eye},0,0,0");
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--backend",
+        "reference",
+        "--look-at",
+        &look,
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "-f",
+        "-v",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
+#[test]
+fn a_near_view_refines_to_the_children_and_matches_the_whole_cloud() {
+    let d = dir("near");
+    let ts = lod(&d, "b.glb");
+    let r = render(&ts, "0,1,4", &d.join("tiles.png"), &[]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(
+        r.stderr.contains("tiles: 2 selected, 400 splats"),
+        "{}",
+        r.all()
+    );
+    let r = render(&d.join("whole.glb"), "0,1,4", &d.join("whole.png"), &[]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    let read = |n: &str| splatgl::image::Image::read(d.join(n)).unwrap();
+    let c = splatgl::compare::compare(&read("tiles.png"), &read("whole.png"), 1.0 / 255.0).unwrap();
+    assert!(c.psnr >= 50.0, "{} dB", c.psnr);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_far_view_or_a_small_budget_keeps_the_coarse_tile() {
+    let d = dir("far");
+    let ts = lod(&d, "b.glb");
+    let out = d.join("x.png");
+    let r = render(&ts, "0,5,40", &out, &[]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(
+        r.stderr.contains("tiles: 1 selected, 10 splats"),
+        "{}",
+        r.all()
+    );
+    // Near, but the two children (400 splats) do not fit in 300.
+    let r = render(&ts, "0,1,4", &out, &["--splat-budget", "300"]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(
+        r.stderr
+            .contains("tiles: 1 selected, 10 splats (budget 300), 1 held back"),
+        "{}",
+        r.all()
+    );
+    // Not even the root fits: a clear error.
+    let r = render(&ts, "0,1,4", &out, &["--splat-budget", "5"]);
+    assert_eq!(r.code, 2, "{}", r.all());
+    assert!(
+        r.stderr.contains("root tile alone holds 10 splats"),
+        "{}",
+        r.all()
+    );
+    // The option means nothing for a single file.
+    let r = render(
+        &d.join("whole.glb"),
+        "0,1,4",
+        &out,
+        &["--splat-budget", "5"],
+    );
+    assert_eq!(r.code, 2, "{}", r.all());
+    assert!(
+        r.stderr
+            .contains("--splat-budget applies to 3D Tiles tilesets only"),
+        "{}",
+        r.all()
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_missing_tile_is_skipped_with_a_warning_while_the_rest_draws() {
+    let d = dir("missing");
+    let ts = lod(&d, "gone.glb");
+    let r = render(&ts, "0,1,4", &d.join("x.png"), &[]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(
+        r.stderr.contains("root.children[1]: \"gone.glb\" skipped"),
+        "{}",
+        r.all()
+    );
+    let left = splatgl::load::load_path(d.join("a.glb"), &Default::default())
+        .unwrap()
+        .cloud
+        .len();
+    let line = format!("tiles: 2 selected, {left} splats");
+    assert!(r.stderr.contains(&line), "{line}: {}", r.all());
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -113,6 +113,13 @@ pub struct Args {
     /// Show progress even when stderr is not a terminal (one line per step).
     #[arg(long)]
     pub progress: bool,
+    /// For a 3D Tiles tileset: draw at most N splats per view (the tiles are chosen by
+    /// screen-space error, coarse to fine, within it).
+    #[arg(long, value_name = "N", default_value_t = splatgl::tiles::SelectOptions::DEFAULT_SPLAT_BUDGET)]
+    pub splat_budget: u64,
+    /// For a 3D Tiles tileset: refine tiles whose screen-space error is above PX pixels.
+    #[arg(long, value_name = "PX", default_value_t = splatgl::tiles::SelectOptions::DEFAULT_MAX_SCREEN_ERROR)]
+    pub max_screen_error: f64,
     #[command(flatten)]
     pub load: super::LoadArgs,
 }
@@ -322,7 +329,13 @@ fn go(a: &Args) -> Result<(), String> {
         };
         eprintln!("kernel: {kernel} (--antialiased {:?})", a.antialiased);
     }
-    let visible = render_views(a, &out, &mut engine, &cloud, &views, &opts, progress)?;
+    let (visible, drawn) = match &loaded.tileset {
+        Some(ts) => steps::render_tileset_views(a, &out, &mut engine, ts, &views, &opts, progress)?,
+        None => (
+            render_views(a, &out, &mut engine, &cloud, &views, &opts, progress)?,
+            cloud.len(),
+        ),
+    };
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;
     let visible = match (visible, batch) {
         (Some(v), false) => format!(" ({v} visible)"),
@@ -333,7 +346,7 @@ fn go(a: &Args) -> Result<(), String> {
     a.say(format!(
         "splatgl render: {} splats{visible}, {w}x{h}, backend {}: render {render_ms:.1} ms, \
          total {:.1} ms -> {target}",
-        cloud.len(),
+        drawn,
         engine.name(),
         t0.elapsed().as_secs_f64() * 1e3,
     ));

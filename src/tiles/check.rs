@@ -3,10 +3,11 @@
 //! parent's, content that is missing, outside the tileset's folder, not loadable, not splats,
 //! or with splats outside its tile's volume.
 
+use super::select::Y_UP_TO_Z_UP;
 use super::{Tile, Tileset};
 use crate::load::validate::Report;
 use crate::load::{Finding, Format, LoadOptions, load_path};
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 use std::path::Path;
 
 /// Relative slack of the containment tests (f32 positions, rounding of written volumes).
@@ -124,15 +125,6 @@ fn nesting(t: &Tile, parent: &Tile, findings: &mut Vec<Finding>) {
         ));
     }
 }
-
-/// glTF content is y-up; 3D Tiles is z-up, and a runtime turns glTF content by this before
-/// the tile transform (3D Tiles 1.1, "glTF transforms").
-const Y_UP_TO_Z_UP: DMat4 = DMat4::from_cols_array(&[
-    1.0, 0.0, 0.0, 0.0, //
-    0.0, 0.0, 1.0, 0.0, //
-    0.0, -1.0, 0.0, 0.0, //
-    0.0, 0.0, 0.0, 1.0,
-]);
 
 /// Loads tile `t`'s content, reports what is wrong with it, and returns its splat count.
 fn contents(ts: &Tileset, t: &Tile, opts: &LoadOptions, findings: &mut Vec<Finding>) -> u64 {

@@ -1,19 +1,23 @@
 //! 3D Tiles 1.1 tilesets whose tile content is glTF with `KHR_gaussian_splatting` (CesiumJS's
 //! format for large splat scenes): [`read`] parses `tileset.json` into a tree of [`Tile`]s with
 //! their global transforms and bounding volumes; [`check`] applies the structural rules of
-//! 3D Tiles and loads each tile's content through [`crate::load`], for `info` and `validate`.
+//! 3D Tiles and loads each tile's content through [`crate::load`], for `info` and `validate`;
+//! [`select`] chooses the tiles one camera needs within a splat budget, and [`TileCache`]
+//! loads their content once, in the tileset's frame, for `render`.
 //!
 //! What is read: `asset.version` (1.0 or 1.1), `geometricError`, `refine` (`ADD` / `REPLACE`,
 //! inherited from the parent), `transform` (column-major, composed parent × child),
 //! `boundingVolume` `box` and `sphere` (`region` is reported unsupported: it needs the WGS84
 //! ellipsoid), `content.uri` and 1.1's `contents[].uri`. Content URIs are resolved against the
 //! tileset's folder and must stay inside it ([`LoadOptions::allow_outside_paths`]); external
-//! tilesets (content that is itself a `tileset.json`), implicit tiling and selection by
-//! screen-space error are not done yet (issue 21).
+//! tilesets (content that is itself a `tileset.json`), implicit tiling, HTTP and a cache that
+//! evicts are not done yet (issue 21).
 
 mod check;
+mod select;
 
 pub use check::{LevelSummary, TilesetReport, check};
+pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
 
 use crate::load::LoadOptions;
 use glam::{DMat3, DMat4, DVec3};

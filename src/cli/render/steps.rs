@@ -4,16 +4,23 @@
 use super::super::camera_args::{camera_json_line, look_at_line};
 use super::super::progress::Progress;
 use super::super::render_out::Outputs;
+use super::super::tileset::is_tileset_file;
 use super::{Args, SortArg, load};
 use splatgl::SplatCloud;
 use splatgl::camera::{Camera, GltfPerspective};
 use splatgl::engine::Engine;
 use splatgl::load::Format;
 use splatgl::reference::{RenderOptions, SortMode};
+use std::path::Path;
 
 /// The scene to render (the file's cloud, format and camera nodes, or the bundled default
 /// scene), with the load options checked against its format.
 pub(super) fn load_scene(a: &Args, progress: Progress) -> Result<LoadedScene, String> {
+    let opts = a.load.options();
+    if let Some(p) = a.scene.as_deref().filter(|p| is_tileset_file(p, &opts)) {
+        return load_tileset(a, p, &opts);
+    }
+    tiles_only_options(a)?;
     let (cloud, format, cameras, trained_antialiased) = match &a.scene {
         Some(p) => {
             progress.stage(&format!("loading {}", p.display()));
@@ -43,6 +50,7 @@ pub(super) fn load_scene(a: &Args, progress: Progress) -> Result<LoadedScene, St
         format,
         cameras,
         trained_antialiased,
+        tileset: None,
     })
 }
 
@@ -56,6 +64,125 @@ pub(super) struct LoadedScene {
     pub(super) cameras: Vec<GltfPerspective>,
     /// The file's SPZ antialiasing flag (`--antialiased auto`).
     pub(super) trained_antialiased: bool,
+    /// A 3D Tiles tileset: each view draws the tiles chosen for it; `cloud` is then its
+    /// coarsest level with content, for framing.
+    pub(super) tileset: Option<splatgl::tiles::Tileset>,
+}
+
+/// `--splat-budget` and `--max-screen-error` choose tiles: an error for any other scene.
+fn tiles_only_options(a: &Args) -> Result<(), String> {
+    let d = splatgl::tiles::SelectOptions::default();
+    let given = [
+        ("--splat-budget", a.splat_budget != d.splat_budget),
+        (
+            "--max-screen-error",
+            a.max_screen_error != d.max_screen_error,
+        ),
+    ];
+    match given.iter().find(|(_, g)| *g) {
+        Some((flag, _)) => Err(format!("{flag} applies to 3D Tiles tilesets only")),
+        None => Ok(()),
+    }
+}
+
+/// A tileset: read, and its coarsest level with content loaded for framing the views (each
+/// view then draws its own selection, [`render_tileset_views`]).
+fn load_tileset(
+    a: &Args,
+    p: &Path,
+    opts: &splatgl::load::LoadOptions,
+) -> Result<LoadedScene, String> {
+    if a.crop.is_some() {
+        return Err("--crop does not apply to tilesets yet".into());
+    }
+    let ts = splatgl::tiles::read(p, opts)?;
+    if !a.quiet {
+        for pr in &ts.problems {
+            eprintln!("warning: {}: {}: {}", p.display(), pr.path, pr.message);
+        }
+    }
+    let mut cache = splatgl::tiles::TileCache::new(&ts, opts);
+    let all = ts.root.walk();
+    let level = all
+        .iter()
+        .filter(|t| !t.content.is_empty())
+        .map(|t| t.level)
+        .min()
+        .ok_or_else(|| format!("{}: no tile has content", p.display()))?;
+    let coarse: Vec<&splatgl::tiles::Tile> = all.into_iter().filter(|t| t.level == level).collect();
+    let cloud = cache.merged(&coarse);
+    warn_skipped(a, &mut cache);
+    if cloud.is_empty() {
+        return Err(format!(
+            "{}: the coarsest tiles hold no splats",
+            p.display()
+        ));
+    }
+    drop(cache);
+    Ok(LoadedScene {
+        cloud,
+        format: Some(Format::Glb),
+        cameras: Vec::new(),
+        trained_antialiased: false,
+        tileset: Some(ts),
+    })
+}
+
+/// Prints (once) the content files the cache skipped.
+fn warn_skipped(a: &Args, cache: &mut splatgl::tiles::TileCache<'_>) {
+    if !a.quiet {
+        for w in cache.warnings.drain(..) {
+            eprintln!("warning: {w}");
+        }
+    }
+}
+
+/// [`render_views`] for a tileset: per view, the tiles chosen by screen-space error within
+/// `--splat-budget`, their content uploaded and drawn. Returns the last view's visible count
+/// and its selected splats.
+pub(super) fn render_tileset_views(
+    a: &Args,
+    out: &Outputs,
+    engine: &mut Engine,
+    ts: &splatgl::tiles::Tileset,
+    views: &[(Camera, f32)],
+    opts: &RenderOptions,
+    progress: Progress,
+) -> Result<(Option<usize>, usize), String> {
+    let select = splatgl::tiles::SelectOptions {
+        splat_budget: a.splat_budget,
+        max_screen_error: a.max_screen_error,
+    };
+    let mut cache = splatgl::tiles::TileCache::new(ts, &a.load.options());
+    let (mut visible, mut drawn) = (None, 0);
+    let mut entries = Vec::new();
+    for (i, (cam, distance)) in views.iter().enumerate() {
+        progress.step("selecting tiles", i, views.len());
+        let sel = splatgl::tiles::select(ts, cam, &select, &mut |t| cache.splats(t))?;
+        let cloud = cache.merged(&sel.tiles);
+        progress.clear();
+        warn_skipped(a, &mut cache);
+        if a.verbose {
+            eprintln!(
+                "tiles: {} selected, {} splats (budget {}), {} held back by the budget",
+                sel.tiles.len(),
+                cloud.len(),
+                select.splat_budget,
+                sel.held_back
+            );
+        }
+        engine.upload(&cloud)?;
+        progress.stage("rendering");
+        let (img, v) = engine.render(&cloud, cam, opts)?;
+        (visible, drawn) = (v, cloud.len());
+        out.write(&img, i)?;
+        progress.clear();
+        report_view(a, out, i, cam, *distance, &mut entries);
+    }
+    if a.batch() && a.cam.print_camera_json {
+        println!("{}", serde_json::Value::Array(entries));
+    }
+    Ok((visible, drawn))
 }
 
 /// Refuses views whose image size is outside `1..=16384` per side.

@@ -1,0 +1,236 @@
+//! Choosing the tiles to draw for one camera: by screen-space error, coarse to fine, never more
+//! than a splat budget ([`select`]); and the clouds of the chosen tiles, loaded once, in the
+//! tileset's frame ([`TileCache`]).
+
+use super::{Refine, Tile, Tileset};
+use crate::camera::Camera;
+use crate::cloud::SplatCloud;
+use crate::load::{LoadOptions, load_path};
+use glam::{DMat4, DVec3};
+use std::collections::HashMap;
+
+/// What [`select`] aims for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SelectOptions {
+    /// At most this many splats are selected (`--splat-budget`).
+    pub splat_budget: u64,
+    /// A tile is refined while its screen-space error is above this many pixels.
+    pub max_screen_error: f64,
+}
+
+impl SelectOptions {
+    /// The default budget: 1,000,000 splats, which software GL (llvmpipe) still draws at
+    /// interactive rates; a desktop GPU takes 2.5M and more.
+    pub const DEFAULT_SPLAT_BUDGET: u64 = 1_000_000;
+    /// The default screen-space error: 16 px (CesiumJS's `maximumScreenSpaceError`).
+    pub const DEFAULT_MAX_SCREEN_ERROR: f64 = 16.0;
+}
+
+impl Default for SelectOptions {
+    fn default() -> Self {
+        SelectOptions {
+            splat_budget: Self::DEFAULT_SPLAT_BUDGET,
+            max_screen_error: Self::DEFAULT_MAX_SCREEN_ERROR,
+        }
+    }
+}
+
+/// The tiles chosen for one camera.
+#[derive(Debug, Clone)]
+pub struct Selection<'a> {
+    /// The tiles to draw (their content together is the view's scene).
+    pub tiles: Vec<&'a Tile>,
+    /// Their splats.
+    pub splats: u64,
+    /// Tiles whose screen-space error is still above the target because refining them would
+    /// have passed the budget.
+    pub held_back: usize,
+}
+
+/// The screen-space error of `t` seen by `cam` (pixels): its geometric error over the distance
+/// from the eye to its bounding sphere, times the focal length; infinite inside the sphere, 0
+/// without a volume.
+pub fn screen_space_error(t: &Tile, cam: &Camera) -> f64 {
+    let Some(b) = t.bounds else {
+        return 0.0;
+    };
+    let (c, r) = b.sphere();
+    let eye = cam.eye();
+    let d = (c - DVec3::new(eye.x as f64, eye.y as f64, eye.z as f64)).length() - r;
+    if d <= 0.0 {
+        return f64::INFINITY;
+    }
+    t.geometric_error * cam.fy.max(cam.fx) as f64 / d
+}
+
+/// Whether `t`'s bounding sphere reaches into `cam`'s view (the four side planes and the
+/// plane of the eye; tiles without a volume are taken as visible).
+pub fn visible(t: &Tile, cam: &Camera) -> bool {
+    let Some(b) = t.bounds else {
+        return true;
+    };
+    let (c, r) = b.sphere();
+    let m = cam.world_to_camera.as_dmat4();
+    let p = m.transform_point3(c); // OpenCV axes: +z ahead
+    let (w, h) = (cam.width as f64, cam.height as f64);
+    let (fx, fy, cx, cy) = (cam.fx as f64, cam.fy as f64, cam.cx as f64, cam.cy as f64);
+    let side = |n: DVec3| n.normalize().dot(p) <= r;
+    p.z >= -r
+        && side(DVec3::new(1.0, 0.0, -(w - cx) / fx))
+        && side(DVec3::new(-1.0, 0.0, -cx / fx))
+        && side(DVec3::new(0.0, 1.0, -(h - cy) / fy))
+        && side(DVec3::new(0.0, -1.0, -cy / fy))
+}
+
+/// The tiles to draw for `cam`: the root, then — largest screen-space error first — each
+/// visible tile above `o.max_screen_error` is refined (its visible children added; with
+/// `REPLACE` the tile itself leaves) when the selection stays within `o.splat_budget`
+/// splats. `splats(tile)` counts a tile's content (loading it). `Err` when the root alone
+/// holds more than the budget.
+pub fn select<'a>(
+    ts: &'a Tileset,
+    cam: &Camera,
+    o: &SelectOptions,
+    splats: &mut dyn FnMut(&Tile) -> u64,
+) -> Result<Selection<'a>, String> {
+    let root = &ts.root;
+    let mut used = splats(root);
+    if used > o.splat_budget {
+        return Err(format!(
+            "the root tile alone holds {used} splats, more than the budget of {}",
+            o.splat_budget
+        ));
+    }
+    let mut chosen: Vec<&Tile> = vec![root];
+    let mut open: Vec<(f64, &Tile)> = vec![(screen_space_error(root, cam), root)];
+    let mut held_back = 0;
+    while let Some(i) = largest(&open) {
+        let (sse, t) = open.swap_remove(i);
+        if sse <= o.max_screen_error || t.children.is_empty() || !visible(t, cam) {
+            continue;
+        }
+        let kids: Vec<&Tile> = t.children.iter().filter(|c| visible(c, cam)).collect();
+        let cost: u64 = kids.iter().map(|c| splats(c)).sum();
+        let freed = match t.refine {
+            Refine::Replace => splats(t),
+            Refine::Add => 0,
+        };
+        if used - freed + cost > o.splat_budget {
+            held_back += 1;
+            continue;
+        }
+        used = used - freed + cost;
+        if t.refine == Refine::Replace {
+            chosen.retain(|c| !std::ptr::eq(*c, t));
+        }
+        for c in kids {
+            chosen.push(c);
+            open.push((screen_space_error(c, cam), c));
+        }
+    }
+    Ok(Selection {
+        tiles: chosen,
+        splats: used,
+        held_back,
+    })
+}
+
+/// The index of the largest error in `open`.
+fn largest(open: &[(f64, &Tile)]) -> Option<usize> {
+    (0..open.len()).max_by(|&a, &b| open[a].0.total_cmp(&open[b].0))
+}
+
+/// glTF content is y-up; 3D Tiles turns it to z-up before the tile's transform.
+pub(super) const Y_UP_TO_Z_UP: DMat4 = DMat4::from_cols_array(&[
+    1.0, 0.0, 0.0, 0.0, //
+    0.0, 0.0, 1.0, 0.0, //
+    0.0, -1.0, 0.0, 0.0, //
+    0.0, 0.0, 0.0, 1.0,
+]);
+
+/// Each tile's content, loaded once, in the tileset's frame (`Y_UP_TO_Z_UP`, then the tile's
+/// transform). A content file that is missing, outside the tileset's folder or does not load
+/// is skipped with a warning, so the rest still draws.
+pub struct TileCache<'a> {
+    ts: &'a Tileset,
+    opts: LoadOptions,
+    clouds: HashMap<String, SplatCloud>,
+    /// What was skipped, one line per content file.
+    pub warnings: Vec<String>,
+}
+
+impl<'a> TileCache<'a> {
+    /// A cache for `ts`, loading with `opts` (limits, containment).
+    pub fn new(ts: &'a Tileset, opts: &LoadOptions) -> Self {
+        TileCache {
+            ts,
+            opts: opts.clone(),
+            clouds: HashMap::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// Tile `t`'s content (all its content files), loaded the first time.
+    pub fn cloud(&mut self, t: &Tile) -> &SplatCloud {
+        if !self.clouds.contains_key(&t.path) {
+            let c = self.load(t);
+            self.clouds.insert(t.path.clone(), c);
+        }
+        &self.clouds[&t.path]
+    }
+
+    /// The splats of tile `t`'s content.
+    pub fn splats(&mut self, t: &Tile) -> u64 {
+        self.cloud(t).len() as u64
+    }
+
+    /// The content of `tiles` as one cloud (SH degrees unified by zero-padding; the metadata —
+    /// colour space, kernel — of the first tile with splats).
+    pub fn merged(&mut self, tiles: &[&Tile]) -> SplatCloud {
+        let mut out = SplatCloud::new(0);
+        for t in tiles {
+            join(&mut out, self.cloud(t).clone());
+        }
+        out
+    }
+
+    fn load(&mut self, t: &Tile) -> SplatCloud {
+        let mut out = SplatCloud::new(0);
+        for uri in &t.content {
+            match self.load_one(t, uri) {
+                Ok(c) => join(&mut out, c),
+                Err(e) => self
+                    .warnings
+                    .push(format!("{}: {uri:?} skipped: {e}", t.path)),
+            }
+        }
+        out
+    }
+
+    fn load_one(&self, t: &Tile, uri: &str) -> Result<SplatCloud, String> {
+        if uri.ends_with(".json") {
+            return Err("external tilesets are not read yet".into());
+        }
+        let file = crate::files::contained(self.ts.folder(), uri, self.opts.allow_outside_paths)?;
+        let scene = load_path(&file, &self.opts).map_err(|e| e.to_string())?;
+        let mut findings = Vec::new();
+        crate::load::gltf::apply_node_transform(
+            &scene.cloud,
+            t.transform * Y_UP_TO_Z_UP,
+            0,
+            &mut findings,
+        )
+        .ok_or_else(|| {
+            let why: Vec<String> = findings.iter().map(|f| f.message.clone()).collect();
+            format!("the tile transform breaks its splats: {}", why.join("; "))
+        })
+    }
+}
+
+/// Appends `c` to `out`, taking `c`'s metadata when `out` has no splats yet.
+fn join(out: &mut SplatCloud, c: SplatCloud) {
+    if out.is_empty() {
+        out.meta = c.meta.clone();
+    }
+    out.append(c);
+}
