@@ -7,8 +7,10 @@
 //! asset fails by far; its vertex shader drops splats whose centre is outside 1.2× the clip
 //! box (the off-screen profile asset differs) and splats whose quad is under a pixel (the
 //! sub-pixel profile asset is empty) but keeps those just behind its near plane's 0.91·znear
-//! mark out (the near-plane profile asset matches); its quad is a 2.83σ square, so the cut-off
-//! asset fails; its sort key is view depth, so the sort asset fails.
+//! mark out (the near-plane profile asset matches); its quad is a 2.83σ square drawing every
+//! fragment, so the cut-off asset fails and the diagnosis names `square_cutoff`; its sort key
+//! is view depth, so the sort asset fails. Graded as SPZ input (`--input-precision spz`), the
+//! assets that test none of this pass.
 //!
 //! Needs node, chromium and the npm tools (`.ci/run` and `scripts/test.sh` install them);
 //! without them the test is skipped, which fails under `SPLATGL_REQUIRE=all`.
@@ -73,14 +75,18 @@ fn cesium_is_graded_by_the_rules_its_source_breaks() {
     // axes of the footprint and exp(−4|v|²) is cut only beyond it (|v|² > 4 never happens
     // inside), a 2.83σ square rather than the 3σ ellipse.
     assert!(!pass("cutoff_three_sigma"));
-    // That square is the model the cut-off asset comes nearest to (or is explained by).
-    let cut = asset("cutoff_three_sigma");
-    let square = cut["cameras"][0]["nearest"]["rules"]
-        .as_array()
-        .is_some_and(|r| r.iter().any(|x| x == "square_cutoff"))
-        || named_for(&json, "square_cutoff")
-            .is_some_and(|a| a.contains(&"cutoff_three_sigma".to_owned()));
-    assert!(square, "{cut:#}");
+    // The diagnosis names that square (`square_cutoff`) for the cut-off asset.
+    let square = named_for(&json, "square_cutoff").unwrap_or_default();
+    assert!(
+        square.contains(&"cutoff_three_sigma".to_owned()),
+        "{:?}",
+        named(&json)
+    );
+    // Graded by what its SPZ copies carry, the square cut (admitted wherever the cut-off is
+    // not what an asset tests), its near-zero dilation and 8-bit colour pass most assets:
+    // measured 17 of 29 (docs/conformance.md).
+    let passed = json["passed"].as_u64().unwrap();
+    assert!(passed >= 14, "{passed} RC assets pass");
     // wasm-splats src/radix.rs:25-33: the key is view-space z (positions · the model-view
     // matrix's third row), not the distance to the camera.
     assert!(!pass("sort_distance_not_depth"));

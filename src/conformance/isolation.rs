@@ -74,6 +74,43 @@ pub(crate) fn admitted_errata(spec: &AssetSpec) -> Vec<Erratum> {
         .collect()
 }
 
+/// Whether two term fields are the same one (alternatives such as the cut-off shapes).
+fn same_term(a: TermField, b: TermField) -> bool {
+    let mut t = model::Terms::default();
+    *a(&mut t) = 1.0;
+    *b(&mut t) == 1.0
+}
+
+/// The deviations an asset that catches `catches` and detects `detects` admits (its bound is
+/// widened for them), singly and in pairs of different terms, as the diagnosis names them:
+/// what an image rendered from an SPZ copy may still show and pass (`--input-precision spz`),
+/// since the bound was widened on the float asset and the copy's footprints differ a little.
+pub(crate) fn admitted_sets(
+    catches: &[Erratum],
+    detects: &[String],
+) -> Vec<Vec<super::diagnosis::Deviation>> {
+    use super::diagnosis::Deviation;
+    let admitted: Vec<(Deviation, TermField)> = ISOLATED
+        .iter()
+        .filter_map(|&(d, f)| match d {
+            Admitted::Erratum(e) if !catches.contains(&e) => Some((Deviation::Erratum(e), f)),
+            Admitted::Variant(v) if !detects.iter().any(|n| n == v.name()) => {
+                Some((Deviation::Variant(v), f))
+            }
+            _ => None,
+        })
+        .collect();
+    let mut out: Vec<Vec<Deviation>> = admitted.iter().map(|(d, _)| vec![*d]).collect();
+    for (i, (a, fa)) in admitted.iter().enumerate() {
+        for (b, fb) in &admitted[i + 1..] {
+            if !same_term(*fa, *fb) {
+                out.push(vec![*a, *b]);
+            }
+        }
+    }
+    out
+}
+
 /// The model image with the deviations `ds` at once.
 fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> Image {
     let errata: Vec<Erratum> = ds
@@ -157,11 +194,7 @@ fn admit_combined(
             }
         }
     }
-    let same_term = |a: usize, b: usize| {
-        let mut t = model::Terms::default();
-        *(admitted[a].1)(&mut t) = 1.0;
-        *(admitted[b].1)(&mut t) == 1.0
-    };
+    let same_term = |a: usize, b: usize| same_term(admitted[a].1, admitted[b].1);
     sets.retain(|s| {
         s.iter()
             .enumerate()

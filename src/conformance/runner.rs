@@ -96,25 +96,41 @@ pub struct RunOptions {
     pub input: InputPrecision,
 }
 
+/// What an image that differs from the reference may still pass as.
+enum Allowed {
+    /// A renderer that ignores SH above some degree (the RC allows it).
+    ShCap(Deviation),
+    /// With SPZ input: what the SPZ copy carries, drawn with these choices the asset admits
+    /// (none: the copy as it is).
+    SpzCopy(Vec<Deviation>),
+}
+
 /// The choices an image may pass with although it differs from the reference: the RC allows
 /// ignoring SH coefficients above some degree, and with SPZ input the image is judged by what
-/// the SPZ copy carries (`loaded` holds that copy then). `None`: it matches none; `Some(None)`:
-/// it matches the SPZ copy as it is.
+/// the SPZ copy carries (`loaded` holds that copy then), alone or with the deviations the
+/// asset admits ([`super::isolation::admitted_sets`]). `None`: it matches none.
 fn allowed_choice(
     loaded: &(crate::load::Scene, Vec<crate::camera::Camera>),
     (ci, input): (usize, InputPrecision),
-    c: &CameraEntry,
+    (a, c): (&AssetEntry, &CameraEntry),
     img: &Image,
     bound: &[f64],
-) -> Option<Option<Deviation>> {
+) -> Option<Allowed> {
     let degree = loaded.0.cloud.sh_degree as usize;
-    let exact = (input == InputPrecision::Spz).then_some(None);
+    let mut spz = Vec::new();
+    if input == InputPrecision::Spz {
+        spz.push(Vec::new());
+        spz.extend(super::isolation::admitted_sets(&a.catches, &a.detects));
+    }
     let caps = [Variant::ShDegree2, Variant::ShDegree1, Variant::ShDegree0]
         .into_iter()
         .skip(3 - degree.min(3))
-        .map(|v| Some(Deviation::Variant(v)));
-    exact.into_iter().chain(caps).find(|d| {
-        let devs: Vec<Deviation> = d.iter().copied().collect();
+        .map(|v| Allowed::ShCap(Deviation::Variant(v)));
+    spz.into_iter().map(Allowed::SpzCopy).chain(caps).find(|d| {
+        let devs = match d {
+            Allowed::ShCap(d) => vec![*d],
+            Allowed::SpzCopy(ds) => ds.clone(),
+        };
         let m = diagnosis::model_image(&loaded.0.cloud, &loaded.1[ci], &devs);
         !fails(img, &m, bound, &c.tolerance)
     })
@@ -293,7 +309,14 @@ fn camera_result(
     r.comparison = Some(cmp);
     if !r.pass {
         let l = loaded.get_or_insert_with(|| load_for_models(dir, m, ai, budget.input));
-        let note = allow_or_explain(l.as_ref(), ci, &img, &bound, budget, &mut r);
+        let note = allow_or_explain(
+            l.as_ref(),
+            (&m.assets[ai], ci),
+            &img,
+            &bound,
+            budget,
+            &mut r,
+        );
         if !r.pass {
             r.cause = Some(format!(
                 "{} pixels over their bound (worst {ratio:.2}×); {note}",
@@ -342,7 +365,7 @@ fn not_compared(c: &CameraEntry, want: &Image) -> CameraResult {
 /// diagnosed (else empty).
 fn allow_or_explain(
     l: Option<&(crate::load::Scene, Vec<crate::camera::Camera>)>,
-    ci: usize,
+    (asset, ci): (&AssetEntry, usize),
     img: &Image,
     bound: &[f64],
     budget: &mut Budget,
@@ -354,15 +377,19 @@ fn allow_or_explain(
     });
     match l {
         Some(l) if work <= MAX_MODEL_WORK => {
-            if let Some(d) = allowed_choice(l, (ci, budget.input), c, img, bound) {
+            if let Some(d) = allowed_choice(l, (ci, budget.input), (asset, c), img, bound) {
                 r.pass = true;
                 r.cause = Some(match d {
-                    Some(d) => format!(
+                    Allowed::ShCap(d) => format!(
                         "passes as a renderer that {} (the RC allows it: {})",
                         d.describe().to_lowercase(),
                         d.rc_section()
                     ),
-                    None => "passes against the SPZ copy it was rendered from (--input-precision spz: the model of what KHR_gaussian_splatting_compression_spz_2 carries)".into(),
+                    Allowed::SpzCopy(ds) if ds.is_empty() => "passes against the SPZ copy it was rendered from (--input-precision spz: the model of what KHR_gaussian_splatting_compression_spz_2 carries)".into(),
+                    Allowed::SpzCopy(ds) => format!(
+                        "passes against the SPZ copy it was rendered from (--input-precision spz) drawn by a renderer with {}, which this asset admits (it does not test it)",
+                        rule_names(&ds)
+                    ),
                 });
             } else if budget.cameras_left > 0 {
                 budget.cameras_left -= 1;

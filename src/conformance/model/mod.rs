@@ -88,6 +88,8 @@ pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant
         },
         no_cap: x.contains(&Erratum::K),
         alpha_squared: x.contains(&Erratum::G),
+        // CesiumJS's square quads draw every fragment they cover: no 1/255 skip.
+        every_fragment: v.contains(&Variant::SquareCut),
     };
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut image = Image::filled(cam.width, cam.height, [0.0, 0.0, 0.0, 1.0]);
@@ -114,12 +116,13 @@ pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant
     }
 }
 
-/// How the layers are blended: the cut-off (Mahalanobis²), and the errata k (no α cap) and g
-/// (α² weighting).
+/// How the layers are blended: the cut-off (Mahalanobis²), the errata k (no α cap) and g
+/// (α² weighting), and whether fragments under the 1/255 threshold are drawn too.
 struct Blending {
     cut: f64,
     no_cap: bool,
     alpha_squared: bool,
+    every_fragment: bool,
 }
 
 /// One pixel centre: the blended linear colour, the alpha and the error terms, walking the
@@ -166,7 +169,7 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
         if raw > ALPHA_MAX as f64 * (1.0 - EDGE_BAND) {
             t.cap += (raw.min(1.0) - ALPHA_MAX as f64).max(0.0);
         }
-        if alpha < ALPHA_MIN as f64 {
+        if alpha < ALPHA_MIN as f64 && !b.every_fragment {
             continue;
         }
         layers_here += 1;

@@ -7,8 +7,9 @@ pub enum Variant {
     /// Splats cut by their oriented 3.33σ bounding box instead of the 3σ ellipse.
     BoxCut,
     /// Splats cut by a 2√2σ ≈ 2.83σ square along the footprint's axes, its corners at 4σ
-    /// (CesiumJS: quads of ±√(2λ) in its units, never discarded inside) instead of the 3σ
-    /// ellipse: the ring 2.83σ–3σ lost along the axes, faint corners up to 4σ drawn.
+    /// (CesiumJS: quads of ±√(2λ) in its units, never discarded inside, every fragment drawn —
+    /// no 1/255 skip) instead of the 3σ ellipse: the ring 2.83σ–3σ lost along the axes, faint
+    /// corners up to 4σ drawn.
     SquareCut,
     /// Blending order by view depth (camera-space z; per tile or global, the same per pixel)
     /// instead of camera distance.
@@ -91,7 +92,7 @@ impl Variant {
         match self {
             Variant::BoxCut => "splats cut by a 3.33σ bounding box instead of the 3σ ellipse",
             Variant::SquareCut => {
-                "splats cut by a 2.83σ square along the footprint's axes (corners at 4σ) instead of the 3σ ellipse"
+                "splats cut by a 2.83σ square along the footprint's axes (corners at 4σ, every fragment drawn) instead of the 3σ ellipse"
             }
             Variant::ViewDepthOrder => {
                 "splats ordered by view depth (camera-space z) instead of distance to the camera"
