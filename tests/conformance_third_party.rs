@@ -48,11 +48,18 @@ fn gaussian_splats_3d_is_graded_by_the_rules_its_source_breaks() {
     // src/worker/sorter.cpp: the key is clip-space z (view depth), not camera distance.
     assert!(!passes(&json, "sort_distance_not_depth"));
     assert!(named_for("view_depth_order").contains(&"sort_distance_not_depth".to_owned()));
-    // The diagnosis names its three deviations that an asset decides, and nothing else (the
-    // eigenvalue floor rather than erratum d, which 30 passing assets contradict).
+    // The diagnosis names its three deviations that an asset decides (the eigenvalue floor
+    // rather than erratum d, which 30 passing assets contradict), and the colour space the
+    // PLY the adapter gives it cannot carry (the linear asset shown as display values), and
+    // nothing else.
     assert_eq!(
         named(&json),
-        ["eigenvalue_floor", "erratum_f", "view_depth_order"]
+        [
+            "color_space_ignored",
+            "eigenvalue_floor",
+            "erratum_f",
+            "view_depth_order"
+        ]
     );
     // :12364 "Valid values are 0 - 2": degree 3 ignored, which the RC allows.
     for a in ["sh_degree_3", "sh_rotated_node"] {

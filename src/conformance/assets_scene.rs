@@ -436,12 +436,17 @@ pub(super) fn color_space(linear: bool) -> AssetSpec {
             "too bright or wrong overlaps: the values are decoded/encoded although they are display values",
         )
     };
-    AssetSpec::new(
+    let spec = AssetSpec::new(
         name,
         rule,
         "RC Color Space (all blending before any transfer-function conversion)",
         fail,
         single(vec![prim(c)]),
         vec![cam("front", [0.0, 0.0, 3.0])],
-    )
+    );
+    if linear {
+        spec.detects(&[Variant::ColorSpaceIgnored])
+    } else {
+        spec
+    }
 }

@@ -79,7 +79,8 @@ pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant
     };
     let cloud = quantized.as_ref().unwrap_or(cloud);
     let layers = project(cloud, cam, x, v);
-    let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display;
+    let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display
+        && !v.contains(&Variant::ColorSpaceIgnored);
     let blend = Blending {
         cut: if x.contains(&Erratum::F) {
             8.0

@@ -43,6 +43,9 @@ pub enum Variant {
     /// what a renderer given the SPZ-compressed asset draws. `conformance run
     /// --input-precision spz` accepts it (the images were rendered from SPZ copies).
     SpzPrecision,
+    /// The asset's `colorSpace` ignored: `lin_rec709_display` values blended and shown as if
+    /// they were display values (no sRGB encoding at the end).
+    ColorSpaceIgnored,
     /// Spark's default packed splats (half-float centres, 8-bit colour, opacity in steps of
     /// 2/255, 8-bit ln scales over [−12, 9], 8+8+8-bit octahedral quaternions, SH 7/8/6 bits).
     PackedSplat,
@@ -50,7 +53,7 @@ pub enum Variant {
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 15] = [
+    pub const ALL: [Variant; 16] = [
         Variant::BoxCut,
         Variant::SquareCut,
         Variant::ViewDepthOrder,
@@ -66,6 +69,7 @@ impl Variant {
         Variant::HalfCovariance,
         Variant::SpzPrecision,
         Variant::PackedSplat,
+        Variant::ColorSpaceIgnored,
     ];
     /// A short identifier (the diagnosis's `rule`).
     pub fn name(self) -> &'static str {
@@ -85,6 +89,7 @@ impl Variant {
             Variant::HalfCovariance => "covariance_f16",
             Variant::SpzPrecision => "spz_precision",
             Variant::PackedSplat => "packed_splat_precision",
+            Variant::ColorSpaceIgnored => "color_space_ignored",
         }
     }
     /// What a renderer with this variant does, for reports.
@@ -119,6 +124,9 @@ impl Variant {
             Variant::PackedSplat => {
                 "packed splats (Spark): 8-bit ln scales, 8-bit octahedral quaternions, opacity in steps of 2/255, half-float centres"
             }
+            Variant::ColorSpaceIgnored => {
+                "colorSpace ignored: lin_rec709_display blended and shown as display values"
+            }
         }
     }
     /// The RC section whose rule the variant departs from.
@@ -145,6 +153,9 @@ impl Variant {
             }
             Variant::PackedSplat => {
                 "RC Attributes (float SCALE, ROTATION, OPACITY); the RC does not specify a renderer's precision, but scales off by up to ±4 % change footprints beyond any bound"
+            }
+            Variant::ColorSpaceIgnored => {
+                "RC Color Space (all blending before any transfer-function conversion)"
             }
         }
     }
