@@ -3,10 +3,11 @@
 //! parent's, content that is missing, outside the tileset's folder, not loadable, not splats,
 //! or with splats outside its tile's volume.
 
+use super::ContentError;
 use super::select::Y_UP_TO_Z_UP;
 use super::{Tile, Tileset};
 use crate::load::validate::Report;
-use crate::load::{Finding, Format, LoadOptions, load_path};
+use crate::load::{Finding, Format, LoadOptions};
 use glam::DVec3;
 use std::path::Path;
 
@@ -134,24 +135,14 @@ fn contents(ts: &Tileset, t: &Tile, opts: &LoadOptions, findings: &mut Vec<Findi
             1 => format!("{}.content", t.path),
             _ => format!("{}.contents[{i}]", t.path),
         };
-        if uri.ends_with(".json") {
-            findings.push(Finding::unsupported(
-                &at,
-                format!("{uri:?}: external tilesets are not read by splatgl yet"),
-            ));
-            continue;
-        }
-        let file = match crate::files::contained(ts.folder(), uri, opts.allow_outside_paths) {
-            Ok(f) => f,
-            Err(e) => {
-                findings.push(Finding::error(&at, e));
+        let scene = match ts.load_content(uri, opts) {
+            Ok(s) => s,
+            Err(ContentError::Unsupported(m)) => {
+                findings.push(Finding::unsupported(&at, m));
                 continue;
             }
-        };
-        let scene = match load_path(&file, opts) {
-            Ok(s) => s,
-            Err(e) => {
-                findings.push(Finding::error(&at, format!("{uri:?} does not load: {e}")));
+            Err(ContentError::Unreadable(m)) => {
+                findings.push(Finding::error(&at, m));
                 continue;
             }
         };

@@ -170,6 +170,41 @@ impl Tileset {
     pub fn folder(&self) -> &Path {
         self.file.parent().unwrap_or(Path::new("."))
     }
+
+    /// The scene a tile's content URI names, loaded with `opts` inside [`Tileset::folder`]
+    /// (the one way `check` and the tile cache read content).
+    pub fn load_content(
+        &self,
+        uri: &str,
+        opts: &LoadOptions,
+    ) -> Result<crate::load::Scene, ContentError> {
+        if uri.ends_with(".json") {
+            return Err(ContentError::Unsupported(format!(
+                "{uri:?}: external tilesets are not read by splatgl yet"
+            )));
+        }
+        let file = crate::files::contained(self.folder(), uri, opts.allow_outside_paths)
+            .map_err(ContentError::Unreadable)?;
+        crate::load::load_path(&file, opts)
+            .map_err(|e| ContentError::Unreadable(format!("{uri:?} does not load: {e}")))
+    }
+}
+
+/// Why [`Tileset::load_content`] gave no scene.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ContentError {
+    /// 3D Tiles allows it, splatgl does not read it yet (an external tileset).
+    Unsupported(String),
+    /// Outside the tileset's folder, missing, or not loadable.
+    Unreadable(String),
+}
+
+impl std::fmt::Display for ContentError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ContentError::Unsupported(m) | ContentError::Unreadable(m) => f.write_str(m),
+        }
+    }
 }
 
 /// Whether `bytes` look like a 3D Tiles `tileset.json`: a JSON object with `asset` and

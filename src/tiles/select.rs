@@ -5,7 +5,7 @@
 use super::{Refine, Tile, Tileset};
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
-use crate::load::{LoadOptions, load_path};
+use crate::load::LoadOptions;
 use glam::{DMat4, DVec3};
 use std::collections::HashMap;
 
@@ -208,11 +208,10 @@ impl<'a> TileCache<'a> {
     }
 
     fn load_one(&self, t: &Tile, uri: &str) -> Result<SplatCloud, String> {
-        if uri.ends_with(".json") {
-            return Err("external tilesets are not read yet".into());
-        }
-        let file = crate::files::contained(self.ts.folder(), uri, self.opts.allow_outside_paths)?;
-        let scene = load_path(&file, &self.opts).map_err(|e| e.to_string())?;
+        let scene = self
+            .ts
+            .load_content(uri, &self.opts)
+            .map_err(|e| e.to_string())?;
         let mut findings = Vec::new();
         crate::load::gltf::apply_node_transform(
             &scene.cloud,
