@@ -15,7 +15,8 @@ pub struct Args {
     /// Input file (any format splatgl reads).
     pub input: PathBuf,
     /// Output file: .glb, .gltf (KHR_gaussian_splatting RC), .ply (INRIA 3DGS), .spz (Niantic)
-    /// or .splat (antimatter15).
+    /// or .splat (antimatter15); or a 3D Tiles 1.1 LOD tileset, OUT ending in .json
+    /// (e.g. out/tileset.json, its tiles' .glb content in out/tiles/; docs/lod.md).
     pub output: PathBuf,
     /// Store an attribute as an integer type (glTF outputs), ATTR=TYPE, comma-separated or
     /// repeated: position=i8|i8n|u8|u8n|i16|i16n|u16|u16n (KHR_mesh_quantization with a
@@ -82,6 +83,10 @@ pub struct Args {
     /// `render IN --crop` draws them; both ends included; splat-transform's --filter-box order).
     #[arg(long, value_name = "minx,miny,minz,maxx,maxy,maxz", value_parser = splatgl::cull::CropBox::parse, allow_hyphen_values = true)]
     pub crop: Option<splatgl::cull::CropBox>,
+    /// Tileset output: at most N splats per tile (leaves hold the original splats, coarser
+    /// tiles their moment-matched merges). Default 65536.
+    #[arg(long, value_name = "N")]
+    pub chunk_splats: Option<usize>,
     /// Overwrite OUT if it exists.
     #[arg(short, long)]
     pub force: bool,
@@ -104,18 +109,18 @@ const CHUNK: usize = 1 << 16;
 const LARGE: usize = 200_000;
 
 /// Progress on stderr: a bar on a terminal, one line per stage otherwise.
-struct Progress {
+pub(super) struct Progress {
     on: bool,
     tty: bool,
 }
 
 impl Progress {
-    fn stage(&self, what: &str) {
+    pub(super) fn stage(&self, what: &str) {
         if self.on {
             eprintln!("splatgl convert: {what}");
         }
     }
-    fn bar(&self, what: &str, done: usize, total: usize) {
+    pub(super) fn bar(&self, what: &str, done: usize, total: usize) {
         if !(self.on && self.tty) {
             return;
         }
@@ -191,7 +196,7 @@ fn rotate(cloud: SplatCloud, r: glam::DMat3, p: &Progress) -> Result<SplatCloud,
 
 /// Refuses an output that exists without --force, and one that is the input (same file by
 /// any name) even with it.
-fn check_output(path: &Path, input: &Path, force: bool) -> Result<(), String> {
+pub(super) fn check_output(path: &Path, input: &Path, force: bool) -> Result<(), String> {
     splatgl::write::refuse_overwriting_inputs(path, &[input])
         .map_err(|e| format!("{}: {e}", path.display()))?;
     if !force && path.exists() {
@@ -206,7 +211,12 @@ fn check_output(path: &Path, input: &Path, force: bool) -> Result<(), String> {
 /// Writes the file: checked again ([`check_output`]), then written atomically (a temporary
 /// file in the same folder renamed into place, so a failed or interrupted write leaves the
 /// previous file as it was).
-fn write_output(path: &Path, input: &Path, bytes: &[u8], force: bool) -> Result<(), String> {
+pub(super) fn write_output(
+    path: &Path,
+    input: &Path,
+    bytes: &[u8],
+    force: bool,
+) -> Result<(), String> {
     check_output(path, input, force)?;
     splatgl::write::write_bytes_atomic(path, &[input], bytes)
         .map_err(|e| format!("{}: {e}", path.display()))
@@ -214,20 +224,29 @@ fn write_output(path: &Path, input: &Path, bytes: &[u8], force: bool) -> Result<
 
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
-    let format = OutputFormat::from_path(&a.output).ok_or_else(|| {
-        let exts: Vec<&str> = convert::OUTPUTS.iter().map(|(e, _)| *e).collect();
-        format!(
-            "{}: output must end in .{}",
-            a.output.display(),
-            exts.join(", .")
-        )
-    })?;
+    let tileset = super::convert_lod::is_tileset_output(&a.output)?;
+    let format = if tileset {
+        super::convert_lod::check_args(a)?;
+        OutputFormat::Glb
+    } else {
+        OutputFormat::from_path(&a.output).ok_or_else(|| {
+            let exts: Vec<&str> = convert::OUTPUTS.iter().map(|(e, _)| *e).collect();
+            format!(
+                "{}: output must end in .{}",
+                a.output.display(),
+                exts.join(", .")
+            )
+        })?
+    };
     let o = options(a)?;
     if o.quantize.any() && (!format.is_gltf() || o.spz_compress) {
         return Err("--quantize applies to uncompressed .glb/.gltf outputs only".into());
     }
     if o.spz_compress && format != OutputFormat::Glb {
         return Err("--spz-compress applies to .glb outputs only".into());
+    }
+    if a.chunk_splats.is_some() && !tileset {
+        return Err("--chunk-splats applies to tileset outputs (OUT ending in .json) only".into());
     }
     if a.spz_version.is_some() && format != OutputFormat::Spz {
         return Err("--spz-version applies to .spz outputs only".into());
@@ -271,6 +290,9 @@ fn go(a: &Args) -> Result<(), String> {
         cameras.push(node);
     }
     let cloud = rotate(cloud, r, &p)?;
+    if tileset {
+        return super::convert_lod::write_tileset(a, &cloud, &o, &p, t0);
+    }
     p.stage("encoding");
     let (bytes, notes) = convert::encode_with_cameras(&cloud, format, &o, &cameras)?;
     for n in notes {

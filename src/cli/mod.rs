@@ -8,6 +8,7 @@ mod camera_args;
 mod compare;
 mod conformance;
 mod convert;
+mod convert_lod;
 mod info;
 mod kernel;
 mod progress;

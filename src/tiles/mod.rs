@@ -13,8 +13,14 @@
 //! tilesets (content that is itself a `tileset.json`), implicit tiling, HTTP and a cache that
 //! evicts are not done yet (issue 21).
 
+mod build;
 mod check;
 mod select;
+
+pub use build::{
+    BuildOptions, BuiltTile, ContentSink, ERROR_QUANTILE, ERROR_SIGMAS, Merged, Reduced, build,
+    merge, reduce, tileset_json,
+};
 
 pub use check::{LevelSummary, TilesetReport, check};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};

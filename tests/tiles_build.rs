@@ -1,0 +1,173 @@
+//! Level-of-detail tilesets built by `splatgl convert IN out/tileset.json`
+//! (`splatgl::tiles::build`): they pass `validate`, their leaves are the input exactly, a far
+//! view of a real scene drawn from the coarse tiles stays close to the whole scene and closer
+//! than the same number of splats picked uniformly, and a close view selects the finest tiles
+//! around the eye.
+#![cfg(feature = "cli")]
+
+mod common;
+use common::cli::run;
+use glam::Vec3;
+use splatgl::SplatCloud;
+use splatgl::camera::Camera;
+use splatgl::tiles::{SelectOptions, TileCache, Tileset};
+use std::path::{Path, PathBuf};
+
+/// A fresh folder for one test.
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("splatgl-lod-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// `convert input d/tileset.json` with `extra`; the tileset read back.
+fn build(input: &Path, d: &Path, extra: &[&str]) -> Tileset {
+    let out = d.join("tileset.json");
+    let mut args = vec!["convert", input.to_str().unwrap(), out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let r = run(&args);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(r.stderr.contains("tiles in"), "{}", r.all());
+    splatgl::tiles::read(&out, &Default::default()).unwrap()
+}
+
+/// Every leaf of the tileset (its finest level: the input's splats) as one cloud.
+fn leaves(ts: &Tileset, cache: &mut TileCache) -> SplatCloud {
+    let leaves: Vec<_> = ts
+        .root
+        .walk()
+        .into_iter()
+        .filter(|t| t.children.is_empty())
+        .collect();
+    cache.merged(&leaves)
+}
+
+fn render(cloud: &SplatCloud, cam: &Camera) -> splatgl::image::Image {
+    splatgl::reference::render(cloud, cam, &Default::default())
+}
+
+fn psnr(a: &splatgl::image::Image, b: &splatgl::image::Image) -> f64 {
+    splatgl::compare::compare(a, b, 1.0 / 255.0).unwrap().psnr
+}
+
+/// A camera at `distance` × the cloud's bounding radius from its centre, looking at it.
+fn camera_at(cloud: &SplatCloud, dir: Vec3, distance: f32) -> Camera {
+    let b = cloud.bounds().unwrap();
+    let c = Vec3::from(b.center());
+    let r = b.diagonal() / 2.0;
+    Camera::look_at(
+        c + dir.normalize() * r * distance,
+        c,
+        Vec3::Z,
+        50f32.to_radians(),
+        320,
+        240,
+    )
+}
+
+#[test]
+fn a_built_tileset_validates_and_its_leaves_are_the_input() {
+    let d = dir("leaves");
+    let input = d.join("in.glb");
+    let cloud = common::random_cloud(3000, 2, 1.0, 11);
+    std::fs::write(&input, splatgl::write::to_glb(&cloud, &Default::default())).unwrap();
+    let ts = build(&input, &d, &["--chunk-splats", "256"]);
+    let v = run(&["validate", d.join("tileset.json").to_str().unwrap()]);
+    assert!(
+        v.out().contains("valid (0 errors, 0 warnings)"),
+        "{}",
+        v.all()
+    );
+    let mut cache = TileCache::new(&ts, &Default::default());
+    let all = leaves(&ts, &mut cache);
+    assert_eq!(all.len(), cloud.len());
+    assert!(cache.warnings.is_empty(), "{:?}", cache.warnings);
+    // Every tile within the chunk size; geometric errors shrink towards the leaves.
+    for t in ts.root.walk() {
+        assert!(cache.splats(t) <= 256, "{}", t.path);
+        for c in &t.children {
+            assert!(c.geometric_error < t.geometric_error, "{}", c.path);
+        }
+    }
+    // The leaves hold the input's splats (turned z-up, as 3D Tiles turns glTF content): the
+    // same multiset of opacities and of SH degree-0 colours.
+    let key = |c: &SplatCloud| {
+        let mut v: Vec<(u32, u32)> = (0..c.len())
+            .map(|i| (c.opacities[i].to_bits(), c.sh_of(i)[0][0].to_bits()))
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    assert_eq!(key(&all), key(&cloud));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_finest() {
+    let Some(biker) = common::real("playcanvas_biker.compressed.ply") else {
+        return;
+    };
+    let d = dir("biker");
+    let ts = build(&biker, &d, &["--chunk-splats", "8192"]);
+    let mut cache = TileCache::new(&ts, &Default::default());
+    let full = leaves(&ts, &mut cache);
+    let select = SelectOptions::default();
+    let mut report = Vec::new();
+    for distance in [6.0, 3.0, 2.0, 1.5, 1.2] {
+        let cam = camera_at(&full, Vec3::new(0.3, -1.0, 0.4), distance);
+        let sel = splatgl::tiles::select(&ts, &cam, &select, &mut |t| cache.splats(t)).unwrap();
+        let lod = cache.merged(&sel.tiles);
+        assert!(
+            lod.len() < full.len() / 2,
+            "{} of {}",
+            lod.len(),
+            full.len()
+        );
+        // The same number of splats, every k-th of the whole scene.
+        let step = full.len() as f64 / lod.len() as f64;
+        let picked: Vec<u32> = (0..lod.len()).map(|i| (i as f64 * step) as u32).collect();
+        let uniform = full.select(&picked);
+        let reference = render(&full, &cam);
+        let (p_lod, p_uniform) = (
+            psnr(&render(&lod, &cam), &reference),
+            psnr(&render(&uniform, &cam), &reference),
+        );
+        report.push(format!(
+            "{distance}× radius: {} tiles, {} of {} splats: LOD {p_lod:.1} dB, uniform {p_uniform:.1} dB",
+            sel.tiles.len(),
+            lod.len(),
+            full.len()
+        ));
+        eprintln!("{}", report.last().unwrap());
+        assert!(p_lod >= 30.0, "{report:?}");
+        assert!(p_lod > p_uniform + 1.0, "{report:?}");
+    }
+    // Inside the scene every tile in view refines: the selection is leaves only.
+    let b = full.bounds().unwrap();
+    let inside = Camera::look_at(
+        Vec3::from(b.center()),
+        Vec3::from(b.center()) + Vec3::Y,
+        Vec3::Z,
+        50f32.to_radians(),
+        320,
+        240,
+    );
+    let sel = splatgl::tiles::select(&ts, &inside, &select, &mut |t| cache.splats(t)).unwrap();
+    // Close up, the tiles around the eye are the finest; a coarser tile is drawn only where
+    // its error on screen is within the bound (far parts of the scene).
+    let around_eye = |t: &splatgl::tiles::Tile| {
+        let (c, r) = t.bounds.unwrap().sphere();
+        (c - inside.eye().as_dvec3()).length() <= r
+    };
+    assert!(sel.tiles.iter().any(|t| around_eye(t)));
+    for t in &sel.tiles {
+        let sse = splatgl::tiles::screen_space_error(t, &inside);
+        assert!(
+            t.children.is_empty() || (!around_eye(t) && sse <= select.max_screen_error),
+            "{} (error {sse} px) is drawn instead of its children",
+            t.path
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
