@@ -92,14 +92,7 @@ fn a_built_tileset_validates_and_its_leaves_are_the_input() {
     }
     // The leaves hold the input's splats (turned z-up, as 3D Tiles turns glTF content): the
     // same multiset of opacities and of SH degree-0 colours.
-    let key = |c: &SplatCloud| {
-        let mut v: Vec<(u32, u32)> = (0..c.len())
-            .map(|i| (c.opacities[i].to_bits(), c.sh_of(i)[0][0].to_bits()))
-            .collect();
-        v.sort_unstable();
-        v
-    };
-    assert_eq!(key(&all), key(&cloud));
+    assert_eq!(splat_keys(&all), splat_keys(&cloud));
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -168,6 +161,90 @@ fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_f
             "{} (error {sse} px) is drawn instead of its children",
             t.path
         );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The leaves' splats as sortable keys (opacity and DC colour bits).
+fn splat_keys(c: &SplatCloud) -> Vec<(u32, u32)> {
+    let mut v: Vec<(u32, u32)> = (0..c.len())
+        .map(|i| (c.opacities[i].to_bits(), c.sh_of(i)[0][0].to_bits()))
+        .collect();
+    v.sort_unstable();
+    v
+}
+
+#[test]
+fn a_streamed_build_holds_the_same_splats_as_one_in_memory_and_leaves_no_scratch() {
+    let d = dir("streamed");
+    let input = d.join("in.ply");
+    let cloud = common::random_cloud(5000, 1, 3.0, 12);
+    std::fs::write(&input, splatgl::write::to_inria_ply(&cloud)).unwrap();
+    let scratch = d.join("scratch");
+    let (mem, streamed) = (d.join("mem"), d.join("streamed"));
+    std::fs::create_dir_all(&mem).unwrap();
+    std::fs::create_dir_all(&streamed).unwrap();
+    let ts_mem = build(&input, &mem, &["--chunk-splats", "200"]);
+    let s = scratch.to_str().unwrap();
+    let ts = build(
+        &input,
+        &streamed,
+        &[
+            "--chunk-splats",
+            "200",
+            "--scratch-dir",
+            s,
+            "--bucket-splats",
+            "600",
+        ],
+    );
+    let v = run(&["validate", streamed.join("tileset.json").to_str().unwrap()]);
+    assert!(
+        v.out().contains("valid (0 errors, 0 warnings)"),
+        "{}",
+        v.all()
+    );
+    let mut cache = TileCache::new(&ts, &Default::default());
+    let mut cache_mem = TileCache::new(&ts_mem, &Default::default());
+    let (a, b) = (leaves(&ts, &mut cache), leaves(&ts_mem, &mut cache_mem));
+    assert_eq!(splat_keys(&a), splat_keys(&b));
+    assert_eq!(a.len(), 5000);
+    for t in ts.root.walk() {
+        assert!(cache.splats(t) <= 200, "{}", t.path);
+    }
+    // Eight or more buckets of about 600 splats: the tree's top levels came from the planes.
+    assert!(ts.root.walk().iter().map(|t| t.level).max().unwrap() >= 5);
+    let left: Vec<_> = std::fs::read_dir(&scratch).unwrap().collect();
+    assert!(left.is_empty(), "scratch files left: {left:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_streamed_build_of_a_file_it_cannot_stream_says_why() {
+    let d = dir("unstreamable");
+    let out = d.join("tileset.json");
+    let scratch = d.join("scratch");
+    let truncated = d.join("short.ply");
+    let whole = splatgl::write::to_inria_ply(&common::random_cloud(100, 0, 1.0, 1));
+    std::fs::write(&truncated, &whole[..whole.len() - 10]).unwrap();
+    let mut cases: Vec<(PathBuf, &str)> = vec![(truncated, "vertex")];
+    if let Some(p) = common::real("playcanvas_biker.compressed.ply") {
+        cases.push((p, "compressed PLY is not read in chunks"));
+    }
+    if let Some(p) = common::real("jsplat_unitCube-ascii.ply") {
+        cases.push((p, "ASCII PLY is not read in chunks"));
+    }
+    for (input, why) in &cases {
+        let r = run(&[
+            "convert",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--scratch-dir",
+            scratch.to_str().unwrap(),
+        ]);
+        assert_eq!(r.code, 2, "{}", r.all());
+        assert!(r.stderr.contains(why), "{why}: {}", r.all());
+        assert!(!out.exists());
     }
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -87,6 +87,14 @@ pub struct Args {
     /// tiles their moment-matched merges). Default 65536.
     #[arg(long, value_name = "N")]
     pub chunk_splats: Option<usize>,
+    /// Tileset output from a binary PLY too large for memory: read it in passes, never whole,
+    /// sorting its splats into bucket files in DIR (removed as they are read).
+    #[arg(long, value_name = "DIR")]
+    pub scratch_dir: Option<PathBuf>,
+    /// With --scratch-dir: about N splats per bucket, what is built in memory at once
+    /// (default 2097152).
+    #[arg(long, value_name = "N")]
+    pub bucket_splats: Option<usize>,
     /// Overwrite OUT if it exists.
     #[arg(short, long)]
     pub force: bool,
@@ -115,6 +123,13 @@ pub(super) struct Progress {
 }
 
 impl Progress {
+    /// Progress that shows (when `on`) as a bar on a terminal, as stage lines otherwise.
+    pub(super) fn new(on: bool) -> Self {
+        Progress {
+            on,
+            tty: std::io::stderr().is_terminal(),
+        }
+    }
     pub(super) fn stage(&self, what: &str) {
         if self.on {
             eprintln!("splatgl convert: {what}");
@@ -245,8 +260,11 @@ fn go(a: &Args) -> Result<(), String> {
     if o.spz_compress && format != OutputFormat::Glb {
         return Err("--spz-compress applies to .glb outputs only".into());
     }
-    if a.chunk_splats.is_some() && !tileset {
-        return Err("--chunk-splats applies to tileset outputs (OUT ending in .json) only".into());
+    if (a.chunk_splats.is_some() || a.scratch_dir.is_some()) && !tileset {
+        return Err(
+            "--chunk-splats and --scratch-dir apply to tileset outputs (OUT ending in .json) only"
+                .into(),
+        );
     }
     if a.spz_version.is_some() && format != OutputFormat::Spz {
         return Err("--spz-version applies to .spz outputs only".into());
@@ -255,6 +273,9 @@ fn go(a: &Args) -> Result<(), String> {
         return Err("--camera applies to .glb/.gltf outputs only (camera nodes)".into());
     }
     check_output(&a.output, &a.input, a.force)?;
+    if let (true, Some(dir)) = (tileset, &a.scratch_dir) {
+        return super::convert_lod::write_tileset_streamed(a, &o, dir, t0);
+    }
     let limits = a.load.options().limits;
     let views = match &a.camera {
         Some(path) => splatgl::camera::load_cameras_json_limited(path, &limits)

@@ -5,9 +5,11 @@
 use super::convert::{Args, Progress, check_output, write_output};
 use splatgl::SplatCloud;
 use splatgl::convert::{self, ConvertOptions, OutputFormat};
-use splatgl::tiles::BuildOptions;
+use splatgl::load::Format;
+use splatgl::load::ply::PlyRows;
+use splatgl::tiles::{BuildOptions, BuiltTile, SplatSource, StreamOptions};
 use std::collections::BTreeSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -36,6 +38,9 @@ pub(super) fn check_args(a: &Args) -> Result<(), String> {
     if a.camera.is_some() {
         return Err("--camera does not apply to tileset outputs".into());
     }
+    if a.bucket_splats.is_some() && a.scratch_dir.is_none() {
+        return Err("--bucket-splats applies with --scratch-dir only".into());
+    }
     if a.chunk_splats.unwrap_or(BuildOptions::DEFAULT_CHUNK_SPLATS) < BuildOptions::MIN_CHUNK_SPLATS
     {
         return Err(format!(
@@ -58,9 +63,109 @@ fn content_extensions(o: &ConvertOptions) -> Vec<&'static str> {
     e
 }
 
-/// Builds the tree over `cloud` (already in glTF's +Y-up frame), writes each tile's `.glb`
-/// into `tiles/` beside OUT, then OUT itself (last, atomically: an interrupted build leaves
-/// no tileset.json).
+/// Writes each tile's `.glb` as the builder hands it over, counting files and bytes.
+struct TileWriter<'a> {
+    a: &'a Args,
+    o: &'a ConvertOptions,
+    p: &'a Progress,
+    tiles: PathBuf,
+    expected: usize,
+    written: AtomicUsize,
+    bytes: AtomicUsize,
+    notes: Mutex<BTreeSet<String>>,
+}
+
+impl<'a> TileWriter<'a> {
+    /// Creates `tiles/` beside OUT; `splats` sizes the progress bar.
+    fn new(
+        a: &'a Args,
+        o: &'a ConvertOptions,
+        p: &'a Progress,
+        splats: u64,
+    ) -> Result<Self, String> {
+        let folder = match a.output.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => ".".into(),
+        };
+        let tiles = folder.join(TILES_DIR);
+        std::fs::create_dir_all(&tiles).map_err(|e| format!("{}: {e}", tiles.display()))?;
+        // A k-d tree of ⌈n / chunk⌉ leaves, rounded up to a power of two (median splits).
+        let leaves = splats.div_ceil(chunk(a) as u64).max(1).next_power_of_two();
+        let expected = (2 * leaves - 1) as usize;
+        p.stage(&format!(
+            "building a tileset of about {expected} tiles of at most {} splats",
+            chunk(a)
+        ));
+        Ok(TileWriter {
+            a,
+            o,
+            p,
+            tiles,
+            expected,
+            written: AtomicUsize::new(0),
+            bytes: AtomicUsize::new(0),
+            notes: Mutex::new(BTreeSet::new()),
+        })
+    }
+
+    fn write(&self, name: &str, c: &SplatCloud) -> Result<(), String> {
+        let (glb, n) = convert::encode_with_cameras(c, OutputFormat::Glb, self.o, &[])?;
+        let path = self.tiles.join(format!("{name}.glb"));
+        write_output(&path, &self.a.input, &glb, true)?;
+        self.notes
+            .lock()
+            .map_err(|_| "a tile writer failed")?
+            .extend(n);
+        self.bytes.fetch_add(glb.len(), Ordering::Relaxed);
+        let done = self.written.fetch_add(1, Ordering::Relaxed) + 1;
+        self.p
+            .bar("writing tiles", done.min(self.expected), self.expected);
+        Ok(())
+    }
+
+    /// Writes OUT (last, atomically: an interrupted build leaves no tileset.json) and says
+    /// what was built.
+    fn finish(self, root: &BuiltTile, splats: u64, t0: Instant) -> Result<(), String> {
+        for n in self.notes.into_inner().unwrap_or_default() {
+            eprintln!("note: {n}");
+        }
+        let uri = |name: &str| format!("{TILES_DIR}/{name}.glb");
+        // SPZ rounds positions to its fixed point: the boxes keep one step of room.
+        let margin = if self.o.spz_compress {
+            let bits = splatgl::write::SpzWriteOptions::default().fractional_bits;
+            1.0 / f64::from(1u32 << bits)
+        } else {
+            0.0
+        };
+        let doc = splatgl::tiles::tileset_json(root, &uri, &content_extensions(self.o), margin);
+        let text = serde_json::to_vec_pretty(&doc).map_err(|e| e.to_string())?;
+        let a = self.a;
+        check_output(&a.output, &a.input, a.force)?;
+        write_output(&a.output, &a.input, &text, a.force)?;
+        let all = root.walk();
+        let levels = all.iter().map(|t| t.name.len()).max().unwrap_or(1);
+        eprintln!(
+            "splatgl convert: {splats} splats -> {} ({} tiles in {levels} levels, {} bytes of \
+             content in {}/; root: {} splats, geometric error {:.4}) in {:.1} s{}",
+            a.output.display(),
+            all.len(),
+            self.bytes.load(Ordering::Relaxed),
+            self.tiles.display(),
+            root.splats,
+            root.geometric_error,
+            t0.elapsed().as_secs_f64(),
+            super::progress::peak_memory_note()
+        );
+        Ok(())
+    }
+}
+
+/// `--chunk-splats` or its default.
+fn chunk(a: &Args) -> usize {
+    a.chunk_splats.unwrap_or(BuildOptions::DEFAULT_CHUNK_SPLATS)
+}
+
+/// Builds the tree over `cloud` (already in glTF's +Y-up frame) in memory.
 pub(super) fn write_tileset(
     a: &Args,
     cloud: &SplatCloud,
@@ -68,63 +173,107 @@ pub(super) fn write_tileset(
     p: &Progress,
     t0: Instant,
 ) -> Result<(), String> {
-    let folder = match a.output.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => ".".into(),
-    };
-    let tiles = folder.join(TILES_DIR);
-    std::fs::create_dir_all(&tiles).map_err(|e| format!("{}: {e}", tiles.display()))?;
-    let chunk = a.chunk_splats.unwrap_or(BuildOptions::DEFAULT_CHUNK_SPLATS);
-    // A k-d tree with ⌈n / chunk⌉ leaves has about twice as many tiles.
-    let expected = 2 * cloud.len().div_ceil(chunk) - 1;
-    let written = AtomicUsize::new(0);
-    let bytes = AtomicUsize::new(0);
-    let notes = Mutex::new(BTreeSet::new());
-    p.stage(&format!(
-        "building a tileset of about {expected} tiles of at most {chunk} splats"
-    ));
-    let sink = |name: &str, c: &SplatCloud| -> Result<(), String> {
-        let (glb, n) = convert::encode_with_cameras(c, OutputFormat::Glb, o, &[])?;
-        let path = tiles.join(format!("{name}.glb"));
-        write_output(&path, &a.input, &glb, true)?;
-        notes.lock().map_err(|_| "a tile writer failed")?.extend(n);
-        bytes.fetch_add(glb.len(), Ordering::Relaxed);
-        let done = written.fetch_add(1, Ordering::Relaxed) + 1;
-        p.bar("writing tiles", done.min(expected), expected);
-        Ok(())
-    };
+    let w = TileWriter::new(a, o, p, cloud.len() as u64)?;
     let opts = BuildOptions {
-        chunk_splats: chunk,
+        chunk_splats: chunk(a),
     };
-    let root = splatgl::tiles::build(cloud, &opts, &sink)?;
-    for n in notes.into_inner().unwrap_or_default() {
-        eprintln!("note: {n}");
+    let root = splatgl::tiles::build(cloud, &opts, &|n: &str, c: &SplatCloud| w.write(n, c))?;
+    w.finish(&root, cloud.len() as u64, t0)
+}
+
+/// A binary PLY read in chunks, each cropped, relabelled and turned as the in-memory path
+/// turns the whole cloud.
+struct PlySource<'a> {
+    rows: PlyRows,
+    o: &'a ConvertOptions,
+    crop: Option<splatgl::cull::CropBox>,
+    rotation: Option<glam::DMat3>,
+    format: Format,
+    dropped: u64,
+}
+
+/// Rows per chunk of a streamed read.
+const READ_ROWS: usize = 1 << 20;
+
+impl SplatSource for PlySource<'_> {
+    fn len(&self) -> u64 {
+        self.rows.len()
     }
-    let uri = |name: &str| format!("{TILES_DIR}/{name}.glb");
-    // SPZ rounds positions to its fixed point: the boxes keep one step of room.
-    let margin = if o.spz_compress {
-        let bits = splatgl::write::SpzWriteOptions::default().fractional_bits;
-        1.0 / f64::from(1u32 << bits)
-    } else {
-        0.0
+    fn sh_degree(&self) -> u8 {
+        self.o
+            .sh_degree
+            .map_or(self.rows.sh_degree(), |d| d.min(self.rows.sh_degree()))
+    }
+    fn rewind(&mut self) -> Result<(), String> {
+        self.rows.rewind();
+        self.dropped = 0;
+        Ok(())
+    }
+    fn next_chunk(&mut self) -> Option<Result<SplatCloud, String>> {
+        let c = match self.rows.next_chunk(READ_ROWS)? {
+            Ok(c) => c,
+            Err(e) => return Some(Err(e)),
+        };
+        let n = c.len();
+        let mut c = match self.crop.and_then(|b| b.apply(&c)) {
+            Some(kept) => kept,
+            None => c,
+        };
+        self.dropped += (n - c.len()) as u64;
+        convert::relabel(&mut c, self.o);
+        // The up axis is decided on the first chunk, as it would be on the whole cloud.
+        let r = *self
+            .rotation
+            .get_or_insert_with(|| self.o.rotation_for(self.format, &c, OutputFormat::Glb));
+        Some(convert::rotate(&c, r))
+    }
+}
+
+/// Builds the tree from a binary PLY read in passes, never whole (`--scratch-dir`).
+pub(super) fn write_tileset_streamed(
+    a: &Args,
+    o: &ConvertOptions,
+    scratch: &Path,
+    t0: Instant,
+) -> Result<(), String> {
+    let rows = PlyRows::open(&a.input, &a.load.options())
+        .map_err(|e| format!("--scratch-dir reads binary PLY in chunks: {e}"))?;
+    let mut src = PlySource {
+        rows,
+        o,
+        crop: a.crop,
+        rotation: None,
+        format: Format::Ply,
+        dropped: 0,
     };
-    let doc = splatgl::tiles::tileset_json(&root, &uri, &content_extensions(o), margin);
-    let text = serde_json::to_vec_pretty(&doc).map_err(|e| e.to_string())?;
-    check_output(&a.output, &a.input, a.force)?;
-    write_output(&a.output, &a.input, &text, a.force)?;
-    let all = root.walk();
-    let levels = all.iter().map(|t| t.name.len()).max().unwrap_or(1);
-    eprintln!(
-        "splatgl convert: {} splats -> {} ({} tiles in {levels} levels, {} bytes of content in \
-         {}/; root: {} splats, geometric error {:.4}) in {:.1} s",
-        cloud.len(),
-        a.output.display(),
-        all.len(),
-        bytes.load(Ordering::Relaxed),
-        tiles.display(),
-        root.splats,
-        root.geometric_error,
-        t0.elapsed().as_secs_f64()
-    );
-    Ok(())
+    let p = Progress::new(true);
+    let w = TileWriter::new(a, o, &p, src.len())?;
+    let opts = StreamOptions {
+        chunk_splats: chunk(a),
+        bucket_splats: a
+            .bucket_splats
+            .unwrap_or(StreamOptions::DEFAULT_BUCKET_SPLATS),
+        scratch_dir: scratch.to_owned(),
+    };
+    let shown = |stage: &str, done: u64, total: u64| p.bar(stage, done as usize, total as usize);
+    let (root, report) = splatgl::tiles::build_streamed(
+        &mut src,
+        &opts,
+        &|n: &str, c: &SplatCloud| w.write(n, c),
+        &shown,
+    )?;
+    for f in &src.rows.findings {
+        eprintln!("warning: {}: {f}", a.input.display());
+    }
+    if src.dropped > 0 {
+        eprintln!("--crop: dropped {} splats outside the box", src.dropped);
+    }
+    p.stage(&format!(
+        "{} buckets (largest {} splats), {} bytes of scratch in {}",
+        report.buckets,
+        report.largest_bucket,
+        report.scratch_bytes,
+        scratch.display()
+    ));
+    w.finish(&root, report.splats, t0)
 }

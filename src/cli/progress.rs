@@ -71,6 +71,22 @@ impl Progress {
     }
 }
 
+/// The process's peak resident memory so far, in bytes (`VmHWM` of `/proc/self/status`;
+/// `None` where there is no such file).
+pub fn peak_memory() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// [`peak_memory`] for a message: `", peak memory 123 MB"`, or nothing.
+pub fn peak_memory_note() -> String {
+    peak_memory().map_or(String::new(), |b| {
+        format!(", peak memory {} MB", b.div_ceil(1 << 20))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::Progress;

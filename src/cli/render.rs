@@ -350,6 +350,11 @@ fn go(a: &Args) -> Result<(), String> {
         engine.name(),
         t0.elapsed().as_secs_f64() * 1e3,
     ));
+    if a.verbose
+        && let Some(b) = super::progress::peak_memory()
+    {
+        eprintln!("peak memory: {} MB", b.div_ceil(1 << 20));
+    }
     Ok(())
 }
 

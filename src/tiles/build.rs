@@ -110,15 +110,15 @@ pub fn build(
 }
 
 /// Builds the subtree over `idx`; returns it with its content.
-fn node(
+pub(super) fn node(
     cloud: &SplatCloud,
     idx: &mut [u32],
     name: String,
     chunk: usize,
     sink: &ContentSink,
 ) -> Result<(BuiltTile, SplatCloud), String> {
-    let (min, max) = extent(cloud, idx);
     if idx.len() <= chunk {
+        let (min, max) = extent(cloud, idx);
         let content = cloud.select(idx);
         sink(&name, &content)?;
         let tile = BuiltTile {
@@ -137,7 +137,18 @@ fn node(
         || node(cloud, left, format!("{name}0"), chunk, sink),
         || node(cloud, right, format!("{name}1"), chunk, sink),
     );
-    let ((ta, ca), (tb, cb)) = (a?, b?);
+    parent(name, a?, b?, chunk, sink)
+}
+
+/// The tile `name` over two built subtrees: their content together, [reduced](reduce) to
+/// `chunk` splats; its error grows by the merges' spread, its extent is theirs together.
+pub(super) fn parent(
+    name: String,
+    (ta, ca): (BuiltTile, SplatCloud),
+    (tb, cb): (BuiltTile, SplatCloud),
+    chunk: usize,
+    sink: &ContentSink,
+) -> Result<(BuiltTile, SplatCloud), String> {
     let mut both = ca;
     both.append(cb);
     let reduced = reduce(&both, chunk);
@@ -146,8 +157,8 @@ fn node(
         name,
         splats: reduced.cloud.len(),
         geometric_error: ta.geometric_error.max(tb.geometric_error) + ERROR_SIGMAS * reduced.error,
-        min,
-        max,
+        min: std::array::from_fn(|k| ta.min[k].min(tb.min[k])),
+        max: std::array::from_fn(|k| ta.max[k].max(tb.max[k])),
         children: vec![ta, tb],
     };
     Ok((tile, reduced.cloud))

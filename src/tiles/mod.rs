@@ -15,6 +15,7 @@
 
 mod build;
 mod check;
+mod scratch;
 mod select;
 
 pub use build::{
@@ -23,6 +24,7 @@ pub use build::{
 };
 
 pub use check::{LevelSummary, TilesetReport, check};
+pub use scratch::{SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
 
 use crate::load::LoadOptions;

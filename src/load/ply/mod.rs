@@ -21,8 +21,10 @@ mod ascii;
 mod binary;
 mod compressed;
 mod header;
+mod stream;
 use binary::{decode_binary, skip_binary};
 use header::{Element, Encoding, Property, Scalar, parse_header};
+pub use stream::PlyRows;
 
 /// Which columns feed which output: offsets (binary) or column indices (ASCII) per field.
 struct Layout {
