@@ -361,3 +361,41 @@ fn a_missing_tile_is_skipped_with_a_warning_while_the_rest_draws() {
     assert!(r.stderr.contains(&line), "{line}: {}", r.all());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn required_extensions_splatgl_cannot_honour_are_unsupported_at_their_path() {
+    let d = dir("required");
+    content(&d, "a.glb", 10, 0.5, 9);
+    let p = d.join("tileset.json");
+    let doc = json!({
+        "asset": { "version": "1.1" }, "geometricError": 10.0,
+        "extensionsUsed": ["3DTILES_content_gltf", "VENDOR_tiles_magic"],
+        "extensionsRequired": ["3DTILES_content_gltf", "VENDOR_tiles_magic"],
+        "extensions": { "3DTILES_content_gltf": {
+            "extensionsUsed": ["KHR_gaussian_splatting", "EXT_meshopt_compression"],
+            "extensionsRequired": ["KHR_gaussian_splatting", "EXT_meshopt_compression"],
+        } },
+        "root": { "geometricError": 0.0, "refine": "ADD",
+                  "boundingVolume": bx([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+                  "content": { "uri": "a.glb" } },
+    });
+    std::fs::write(&p, serde_json::to_vec(&doc).unwrap()).unwrap();
+    let (code, v) = json_of(&["validate", p.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "unsupported is not invalid: {v:#}");
+    let (s, m) = finding(&v, "extensionsRequired[1]").unwrap_or_else(|| panic!("{v:#}"));
+    assert!(
+        s == "unsupported" && m.contains("VENDOR_tiles_magic"),
+        "{m}"
+    );
+    let at = "extensions.3DTILES_content_gltf.extensionsRequired[1]";
+    let (s, m) = finding(&v, at).unwrap_or_else(|| panic!("{v:#}"));
+    assert!(
+        s == "unsupported" && m.contains("EXT_meshopt_compression"),
+        "{m}"
+    );
+    // The extensions splatgl reads are no finding.
+    assert!(finding(&v, "extensionsRequired[0]").is_none(), "{v:#}");
+    let at0 = "extensions.3DTILES_content_gltf.extensionsRequired[0]";
+    assert!(finding(&v, at0).is_none(), "{v:#}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -3,7 +3,9 @@
 //! their global transforms and bounding volumes; [`check`] applies the structural rules of
 //! 3D Tiles and loads each tile's content through [`crate::load`], for `info` and `validate`;
 //! [`select`] chooses the tiles one camera needs within a splat budget, and [`TileCache`]
-//! loads their content once, in the tileset's frame, for `render`.
+//! loads their content once, in the tileset's frame, for `render`. [`build`] makes a LOD
+//! tree from one cloud (moment-matched merges, `convert … tileset.json`), [`build_streamed`]
+//! the same from a [`SplatSource`] read in passes, and [`tileset_json`] its `tileset.json`.
 //!
 //! What is read: `asset.version` (1.0 or 1.1), `geometricError`, `refine` (`ADD` / `REPLACE`,
 //! inherited from the parent), `transform` (column-major, composed parent × child),
@@ -257,6 +259,7 @@ pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
             unsupported: true,
         });
     }
+    extensions_required(&v, &mut problems);
     let root = v
         .get("root")
         .ok_or_else(|| format!("{shown}: root: missing"))?;
@@ -285,6 +288,42 @@ pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
         root: root.tile,
         problems,
     })
+}
+
+/// The 3D Tiles extensions splatgl reads: glTF content declared by `3DTILES_content_gltf`.
+const TILES_EXTENSIONS: &[&str] = &["3DTILES_content_gltf"];
+
+/// `extensionsRequired` of the tileset (3D Tiles extensions) and of `3DTILES_content_gltf`
+/// (glTF extensions every content may require): each one splatgl cannot honour is an
+/// `unsupported` problem at its path.
+fn extensions_required(v: &Value, problems: &mut Vec<Problem>) {
+    let lists = [
+        (
+            "extensionsRequired",
+            "/extensionsRequired",
+            TILES_EXTENSIONS,
+        ),
+        (
+            "extensions.3DTILES_content_gltf.extensionsRequired",
+            "/extensions/3DTILES_content_gltf/extensionsRequired",
+            crate::load::gltf::SUPPORTED_REQUIRED,
+        ),
+    ];
+    for (path, pointer, known) in lists {
+        let Some(list) = v.pointer(pointer).and_then(Value::as_array) else {
+            continue;
+        };
+        for (i, e) in list.iter().enumerate() {
+            let name = e.as_str().unwrap_or("");
+            if !known.contains(&name) {
+                problems.push(Problem {
+                    path: format!("{path}[{i}]"),
+                    message: format!("{e} is required but splatgl does not implement it"),
+                    unsupported: true,
+                });
+            }
+        }
+    }
 }
 
 /// What a tile inherits from its parent.

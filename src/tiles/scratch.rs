@@ -2,17 +2,19 @@
 //! read in passes from a [`SplatSource`], and never held whole.
 //!
 //! 1. **Sample**: one pass keeps every k-th mean (at most [`SAMPLE`]), and splits the sample
-//!    by median planes along the longest axis into B = 2^d buckets of about
-//!    [`StreamOptions::bucket_splats`] splats each — the top d levels of the k-d tree.
+//!    by planes along the longest axis into B = ⌈n / [`StreamOptions::bucket_splats`]⌉
+//!    buckets of nearly equal size (a side with g of a plane's buckets gets that share of its
+//!    splats) — the top levels of the k-d tree.
 //! 2. **Scatter**: a second pass sends each splat through the planes to its bucket's file in
 //!    the scratch folder (raw little-endian `f32`s).
 //! 3. **Build**: bucket by bucket, its file is read back and built in memory as [`build`]
 //!    builds a cloud, its tile named by its path through the planes; then deleted. As soon
 //!    as both halves of a plane are built, their parent tile is made from their coarse
-//!    content (as every inner tile is), so at most d coarse contents wait at any time.
+//!    content (as every inner tile is), so at most one coarse content per level of planes
+//!    waits at any time.
 //!
-//! Peak memory is one bucket and its subtree's build, plus d coarse tiles: independent of
-//! the scene's size for a fixed bucket size.
+//! Peak memory is one bucket and its subtree's build, plus a coarse tile per level of planes:
+//! independent of the scene's size for a fixed bucket size.
 //!
 //! [`build`]: super::build
 
@@ -89,26 +91,35 @@ pub fn build_streamed(
         ));
     }
     let n = src.len();
-    let wanted = n
+    let buckets = n
         .div_ceil(o.bucket_splats.max(o.chunk_splats) as u64)
-        .max(1);
-    let depth = (64 - (wanted - 1).leading_zeros()).min(12) as usize;
-    let planes = sample_planes(src, depth, progress)?;
+        .clamp(1, 4096) as usize;
+    let planes = sample_planes(src, buckets, progress)?;
     std::fs::create_dir_all(&o.scratch_dir)
         .map_err(|e| format!("{}: {e}", o.scratch_dir.display()))?;
-    let mut buckets = Buckets::create(&o.scratch_dir, 1 << depth, src.sh_degree())?;
-    let result = scatter_and_build(src, &planes, &mut buckets, o.chunk_splats, sink, progress);
-    buckets.remove_all();
+    let mut files = Buckets::create(&o.scratch_dir, buckets, src.sh_degree())?;
+    let result = scatter_and_build(src, &planes, &mut files, o.chunk_splats, sink, progress);
+    files.remove_all();
     result
 }
 
-/// Median planes in heap order (`planes[i]` for i in 1..2^depth: `(axis, value)`), from a
-/// sample of the source's means.
+/// The top of the tree: a plane over two sides, or a bucket.
+enum Plane {
+    Split {
+        axis: usize,
+        value: f32,
+        below: Box<Plane>,
+        above: Box<Plane>,
+    },
+    Bucket(usize),
+}
+
+/// Planes over `buckets` buckets from a sample of the source's means.
 fn sample_planes(
     src: &mut dyn SplatSource,
-    depth: usize,
+    buckets: usize,
     progress: &dyn Fn(&str, u64, u64),
-) -> Result<Vec<(usize, f32)>, String> {
+) -> Result<Plane, String> {
     let n = src.len();
     let stride = n.div_ceil(SAMPLE as u64).max(1);
     let mut sample: Vec<[f32; 3]> = Vec::new();
@@ -127,14 +138,15 @@ fn sample_planes(
     if seen == 0 {
         return Err("no splats to build a tileset from".into());
     }
-    let mut planes = vec![(0, 0.0); 1 << depth];
-    split_sample(&mut sample, 1, depth, &mut planes);
-    Ok(planes)
+    let mut next = 0;
+    Ok(split_sample(&mut sample, buckets, &mut next))
 }
 
-fn split_sample(s: &mut [[f32; 3]], i: usize, depth: usize, planes: &mut [(usize, f32)]) {
-    if depth == 0 {
-        return;
+/// Splits `s` for `buckets` buckets, numbered from `next` left to right.
+fn split_sample(s: &mut [[f32; 3]], buckets: usize, next: &mut usize) -> Plane {
+    if buckets <= 1 {
+        *next += 1;
+        return Plane::Bucket(*next - 1);
     }
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
@@ -147,28 +159,38 @@ fn split_sample(s: &mut [[f32; 3]], i: usize, depth: usize, planes: &mut [(usize
     let axis = (0..3)
         .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
         .unwrap_or(0);
-    let mid = s.len() / 2;
-    let value = if s.is_empty() {
-        0.0
+    let left = buckets / 2;
+    let at = s.len() * left / buckets;
+    let value = if at < s.len() {
+        s.select_nth_unstable_by(at, |a, b| a[axis].total_cmp(&b[axis]));
+        s[at][axis]
     } else {
-        s.select_nth_unstable_by(mid, |a, b| a[axis].total_cmp(&b[axis]));
-        s[mid][axis]
+        f32::INFINITY
     };
-    planes[i] = (axis, value);
-    let (l, r) = s.split_at_mut(mid);
-    split_sample(l, 2 * i, depth - 1, planes);
-    split_sample(r, 2 * i + 1, depth - 1, planes);
+    let (l, r) = s.split_at_mut(at);
+    let below = Box::new(split_sample(l, left, next));
+    let above = Box::new(split_sample(r, buckets - left, next));
+    Plane::Split {
+        axis,
+        value,
+        below,
+        above,
+    }
 }
 
 /// The bucket of `p`: its path through the planes.
-fn route(planes: &[(usize, f32)], p: [f32; 3]) -> usize {
-    let b = planes.len();
-    let mut i = 1;
-    while i < b {
-        let (axis, value) = planes[i];
-        i = 2 * i + usize::from(p[axis] >= value);
+fn route(mut plane: &Plane, p: [f32; 3]) -> usize {
+    loop {
+        match plane {
+            Plane::Bucket(b) => return *b,
+            Plane::Split {
+                axis,
+                value,
+                below,
+                above,
+            } => plane = if p[*axis] >= *value { above } else { below },
+        }
     }
-    i - b
 }
 
 /// The buckets' scratch files.
@@ -277,7 +299,7 @@ impl Buckets {
 /// Passes 2 and 3 (see the module docs).
 fn scatter_and_build(
     src: &mut dyn SplatSource,
-    planes: &[(usize, f32)],
+    planes: &Plane,
     buckets: &mut Buckets,
     chunk: usize,
     sink: &ContentSink,
@@ -297,57 +319,63 @@ fn scatter_and_build(
         progress("scattering", seen, n);
     }
     buckets.finish_writing()?;
-    let count = planes.len();
-    let depth = count.trailing_zeros() as usize;
-    // Built subtrees waiting for their sibling, by heap index.
-    let mut waiting: Vec<(usize, Option<(BuiltTile, SplatCloud)>)> = Vec::new();
-    for b in 0..count {
-        let mut cloud = buckets.read(b)?;
-        cloud.meta = meta.clone().unwrap_or_default();
-        let name = format!(
-            "r{}",
-            (0..depth)
-                .rev()
-                .map(|k| if b >> k & 1 == 1 { '1' } else { '0' })
-                .collect::<String>()
-        );
-        let built = if cloud.is_empty() {
-            None
-        } else {
-            let mut idx: Vec<u32> = (0..cloud.len() as u32).collect();
-            Some(node(&cloud, &mut idx, name, chunk, sink)?)
-        };
-        let mut at = count + b;
-        let mut here = built;
-        // Climb while this is a right child whose left sibling is waiting.
-        while at > 1 && at % 2 == 1 {
-            let (_, left) = waiting.pop().ok_or("bucket order broken")?;
-            let parent_name = format!("r{}", heap_path(at / 2));
-            here = match (left, here) {
-                (Some(l), Some(r)) => Some(parent(parent_name, l, r, chunk, sink)?),
-                (one, None) | (None, one) => one,
-            };
-            at /= 2;
-        }
-        waiting.push((at, here));
-        progress("building", b as u64 + 1, count as u64);
-    }
-    let (_, root) = waiting.pop().ok_or("no buckets")?;
-    let (root, _) = root.ok_or("no splats to build a tileset from")?;
+    let mut b = BucketBuild {
+        buckets,
+        meta: meta.unwrap_or_default(),
+        chunk,
+        sink,
+        progress,
+        done: 0,
+    };
+    let (root, _) = b
+        .build(planes, "r".into())?
+        .ok_or("no splats to build a tileset from")?;
     let report = StreamReport {
         splats: seen,
-        buckets: count,
+        buckets: buckets.counts.len(),
         largest_bucket: buckets.counts.iter().copied().max().unwrap_or(0),
         scratch_bytes: buckets.bytes,
     };
     Ok((root, report))
 }
 
-/// The path of heap node `i` (1 = root) as binary digits after the leading 1.
-fn heap_path(i: usize) -> String {
-    let bits = usize::BITS - i.leading_zeros() - 1;
-    (0..bits)
-        .rev()
-        .map(|k| if i >> k & 1 == 1 { '1' } else { '0' })
-        .collect()
+/// Pass 3: the tree built bucket by bucket, depth first.
+struct BucketBuild<'a> {
+    buckets: &'a Buckets,
+    meta: crate::cloud::SplatMeta,
+    chunk: usize,
+    sink: &'a ContentSink<'a>,
+    progress: &'a dyn Fn(&str, u64, u64),
+    done: u64,
+}
+
+impl BucketBuild<'_> {
+    /// The subtree under `plane`, named `name` (`None` when its buckets are empty).
+    fn build(
+        &mut self,
+        plane: &Plane,
+        name: String,
+    ) -> Result<Option<(BuiltTile, SplatCloud)>, String> {
+        match plane {
+            Plane::Bucket(b) => {
+                let mut cloud = self.buckets.read(*b)?;
+                cloud.meta = self.meta.clone();
+                self.done += 1;
+                (self.progress)("building", self.done, self.buckets.counts.len() as u64);
+                if cloud.is_empty() {
+                    return Ok(None);
+                }
+                let mut idx: Vec<u32> = (0..cloud.len() as u32).collect();
+                node(&cloud, &mut idx, name, self.chunk, self.sink).map(Some)
+            }
+            Plane::Split { below, above, .. } => {
+                let l = self.build(below, format!("{name}0"))?;
+                let r = self.build(above, format!("{name}1"))?;
+                Ok(match (l, r) {
+                    (Some(l), Some(r)) => Some(parent(name, l, r, self.chunk, self.sink)?),
+                    (one, None) | (None, one) => one,
+                })
+            }
+        }
+    }
 }

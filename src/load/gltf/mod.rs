@@ -27,6 +27,7 @@ mod transform;
 /// (positions, Σ = M C Cᵀ Mᵀ, SH rotated by the polar factor); findings name `nodes[node]`;
 /// `None` when a value becomes non-finite or overflows (a blocking finding names the first
 /// splat: what the loader would drop, or refuse in strict mode).
+pub use container::SUPPORTED_REQUIRED;
 pub use transform::apply_checked as apply_node_transform;
 
 use super::{Finding, Format, LoadOptions, LoadReport, ScaleSeen, Severity, hygiene};
