@@ -339,6 +339,14 @@ fn a_far_view_or_a_small_budget_keeps_the_coarse_tile() {
         "{}",
         r.all()
     );
+    let r = render(&d.join("whole.glb"), "0,1,4", &out, &["--cache-mb", "5"]);
+    assert_eq!(r.code, 2, "{}", r.all());
+    assert!(
+        r.stderr
+            .contains("--cache-mb applies to 3D Tiles tilesets only"),
+        "{}",
+        r.all()
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -248,3 +248,90 @@ fn a_streamed_build_of_a_file_it_cannot_stream_says_why() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn a_small_cache_evicts_yet_every_frame_draws_the_same_splats_whatever_the_load_order() {
+    let d = dir("cache");
+    let input = d.join("in.glb");
+    let cloud = common::random_cloud(4000, 1, 4.0, 13);
+    std::fs::write(&input, splatgl::write::to_glb(&cloud, &Default::default())).unwrap();
+    let ts = build(&input, &d, &["--chunk-splats", "128"]);
+    let opts = SelectOptions {
+        max_screen_error: 1.0,
+        ..Default::default()
+    };
+    // A flight from one side of the scene to the other, close enough to refine.
+    let cams: Vec<Camera> = (0..12)
+        .map(|i| {
+            let x = -4.0 + 8.0 * i as f32 / 11.0;
+            Camera::look_at(
+                Vec3::new(x, -2.0, 1.0),
+                Vec3::new(x, 2.0, 0.0),
+                Vec3::Z,
+                0.9,
+                160,
+                120,
+            )
+        })
+        .collect();
+    let frames = |cache: &mut TileCache| -> Vec<SplatCloud> {
+        cams.iter()
+            .map(|cam| {
+                cache.next_frame();
+                let sel =
+                    splatgl::tiles::select(&ts, cam, &opts, &mut |t| cache.splats(t)).unwrap();
+                cache.merged(&sel.tiles)
+            })
+            .collect()
+    };
+    let mut unlimited = TileCache::new(&ts, &Default::default());
+    let want = frames(&mut unlimited);
+    assert_eq!(unlimited.evictions, 0);
+    // Tiles loaded in another order first: every tile, finest first.
+    let mut reversed = TileCache::new(&ts, &Default::default());
+    for t in ts.root.walk().into_iter().rev() {
+        reversed.splats(t);
+    }
+    assert!(
+        frames(&mut reversed) == want,
+        "another load order drew other splats"
+    );
+    // A cap of a quarter of what the flight touches: tiles are evicted and loaded again.
+    let cap = unlimited.resident_bytes() / 4;
+    let mut small = TileCache::with_max_bytes(&ts, &Default::default(), cap);
+    for (cam, want) in cams.iter().zip(&want) {
+        small.next_frame();
+        // The tiles this frame touches (selection counts the children it weighs).
+        let mut touched = std::collections::HashMap::new();
+        let sel = splatgl::tiles::select(&ts, cam, &opts, &mut |t| {
+            let n = small.splats(t);
+            touched.insert(t.path.clone(), n);
+            n
+        })
+        .unwrap();
+        // 44 bytes a splat and SH degree 1's 4 RGB coefficients.
+        let frame_bytes: u64 = touched.values().map(|n| n * (44 + 4 * 12)).sum();
+        assert!(
+            small.merged(&sel.tiles) == *want,
+            "an evicting cache drew other splats"
+        );
+        // Over the cap only by what this frame itself needs.
+        assert!(
+            small.resident_bytes() <= cap + frame_bytes,
+            "{} resident, cap {cap}, frame {frame_bytes}, {} tiles touched",
+            small.resident_bytes(),
+            touched.len()
+        );
+    }
+    assert!(
+        small.evictions > 0,
+        "nothing was evicted under a {cap}-byte cap"
+    );
+    assert!(
+        small.loads > unlimited.loads,
+        "{} vs {}",
+        small.loads,
+        unlimited.loads
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

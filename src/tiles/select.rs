@@ -151,32 +151,120 @@ pub(super) const Y_UP_TO_Z_UP: DMat4 = DMat4::from_cols_array(&[
 /// Each tile's content, loaded once, in the tileset's frame (`Y_UP_TO_Z_UP`, then the tile's
 /// transform). A content file that is missing, outside the tileset's folder or does not load
 /// is skipped with a warning, so the rest still draws.
+///
+/// With a memory cap ([`TileCache::with_max_bytes`]) the least recently used tiles are
+/// evicted when a frame starts or a load takes it over the cap — except tiles used since the last
+/// [`TileCache::next_frame`], which the frame being assembled needs (so the cache can hold
+/// more than the cap while one frame's selection alone is larger).
 pub struct TileCache<'a> {
     ts: &'a Tileset,
     opts: LoadOptions,
-    clouds: HashMap<String, SplatCloud>,
+    clouds: HashMap<String, Entry>,
+    max_bytes: u64,
+    bytes: u64,
+    frame: u64,
+    tick: u64,
+    /// Tiles evicted so far.
+    pub evictions: u64,
+    /// Tile loads so far (a tile evicted and needed again counts again).
+    pub loads: u64,
     /// What was skipped, one line per content file.
     pub warnings: Vec<String>,
 }
 
+/// A resident tile: its content and when it was last used.
+struct Entry {
+    cloud: SplatCloud,
+    bytes: u64,
+    frame: u64,
+    tick: u64,
+}
+
+/// Bytes a cloud holds in memory (its arrays).
+fn cloud_bytes(c: &SplatCloud) -> u64 {
+    (c.len() * (12 + 12 + 16 + 4) + c.sh.len() * 12) as u64
+}
+
 impl<'a> TileCache<'a> {
-    /// A cache for `ts`, loading with `opts` (limits, containment).
+    /// A cache for `ts`, loading with `opts` (limits, containment), without a memory cap.
     pub fn new(ts: &'a Tileset, opts: &LoadOptions) -> Self {
         TileCache {
             ts,
             opts: opts.clone(),
             clouds: HashMap::new(),
+            max_bytes: u64::MAX,
+            bytes: 0,
+            frame: 0,
+            tick: 0,
+            evictions: 0,
+            loads: 0,
             warnings: Vec::new(),
         }
     }
 
-    /// Tile `t`'s content (all its content files), loaded the first time.
-    pub fn cloud(&mut self, t: &Tile) -> &SplatCloud {
-        if !self.clouds.contains_key(&t.path) {
-            let c = self.load(t);
-            self.clouds.insert(t.path.clone(), c);
+    /// The same, keeping at most about `max_bytes` of tile content resident.
+    pub fn with_max_bytes(ts: &'a Tileset, opts: &LoadOptions, max_bytes: u64) -> Self {
+        TileCache {
+            max_bytes,
+            ..Self::new(ts, opts)
         }
-        &self.clouds[&t.path]
+    }
+
+    /// Starts a new frame: tiles used before it may be evicted again, and are, least
+    /// recently used first, while the cache is over its cap.
+    pub fn next_frame(&mut self) {
+        self.frame += 1;
+        self.evict();
+    }
+
+    /// Bytes of tile content resident now.
+    pub fn resident_bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Tiles resident now.
+    pub fn resident_tiles(&self) -> usize {
+        self.clouds.len()
+    }
+
+    /// Tile `t`'s content (all its content files), loaded when it is not resident.
+    pub fn cloud(&mut self, t: &Tile) -> &SplatCloud {
+        self.tick += 1;
+        let (frame, tick) = (self.frame, self.tick);
+        if let Some(e) = self.clouds.get_mut(&t.path) {
+            (e.frame, e.tick) = (frame, tick);
+        } else {
+            let cloud = self.load(t);
+            self.loads += 1;
+            let bytes = cloud_bytes(&cloud);
+            self.bytes += bytes;
+            self.evict();
+            let e = Entry {
+                cloud,
+                bytes,
+                frame,
+                tick,
+            };
+            self.clouds.insert(t.path.clone(), e);
+        }
+        &self.clouds[&t.path].cloud
+    }
+
+    /// Evicts least recently used tiles of earlier frames while the cache is over its cap.
+    fn evict(&mut self) {
+        while self.bytes > self.max_bytes {
+            let oldest = self
+                .clouds
+                .iter()
+                .filter(|(_, e)| e.frame < self.frame)
+                .min_by_key(|(_, e)| e.tick)
+                .map(|(k, _)| k.clone());
+            let Some(k) = oldest else { break };
+            if let Some(e) = self.clouds.remove(&k) {
+                self.bytes -= e.bytes;
+                self.evictions += 1;
+            }
+        }
     }
 
     /// The splats of tile `t`'s content.

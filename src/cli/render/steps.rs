@@ -78,6 +78,7 @@ fn tiles_only_options(a: &Args) -> Result<(), String> {
             "--max-screen-error",
             a.max_screen_error != d.max_screen_error,
         ),
+        ("--cache-mb", a.cache_mb != super::DEFAULT_CACHE_MB),
     ];
     match given.iter().find(|(_, g)| *g) {
         Some((flag, _)) => Err(format!("{flag} applies to 3D Tiles tilesets only")),
@@ -153,22 +154,32 @@ pub(super) fn render_tileset_views(
         splat_budget: a.splat_budget,
         max_screen_error: a.max_screen_error,
     };
-    let mut cache = splatgl::tiles::TileCache::new(ts, &a.load.options());
+    let mut cache = splatgl::tiles::TileCache::with_max_bytes(
+        ts,
+        &a.load.options(),
+        a.cache_mb.saturating_mul(1 << 20),
+    );
     let (mut visible, mut drawn) = (None, 0);
     let mut entries = Vec::new();
     for (i, (cam, distance)) in views.iter().enumerate() {
         progress.step("selecting tiles", i, views.len());
+        cache.next_frame();
         let sel = splatgl::tiles::select(ts, cam, &select, &mut |t| cache.splats(t))?;
         let cloud = cache.merged(&sel.tiles);
         progress.clear();
         warn_skipped(a, &mut cache);
         if a.verbose {
             eprintln!(
-                "tiles: {} selected, {} splats (budget {}), {} held back by the budget",
+                "tiles: {} selected, {} splats (budget {}), {} held back by the budget; cache: {} \
+                 tiles, {} MB resident, {} loads, {} evicted",
                 sel.tiles.len(),
                 cloud.len(),
                 select.splat_budget,
-                sel.held_back
+                sel.held_back,
+                cache.resident_tiles(),
+                cache.resident_bytes().div_ceil(1 << 20),
+                cache.loads,
+                cache.evictions
             );
         }
         engine.upload(&cloud)?;
