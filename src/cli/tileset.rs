@@ -4,9 +4,14 @@ use splatgl::load::LoadOptions;
 use std::path::Path;
 use std::process::ExitCode;
 
-/// Whether `file` is a tileset: a `.json` within the size limit whose object has `asset` and
-/// `root` (anything else goes to the scene loaders, which name their own errors).
+/// Whether `file` is a tileset: an http(s) URL, or a `.json` within the size limit whose
+/// object has `asset` and `root` (anything else goes to the scene loaders, which name their
+/// own errors).
 pub fn is_tileset_file(file: &Path, opts: &LoadOptions) -> bool {
+    // A URL is read as a tileset (the one kind of scene splatgl fetches); its errors say why.
+    if file.to_str().is_some_and(splatgl::files::http::is_url) {
+        return true;
+    }
     let json = file
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));

@@ -20,6 +20,7 @@
 //! first, then the size against the limit before mapping), used for scene files (`map.rs`).
 
 mod format;
+pub mod http;
 mod limits;
 mod map;
 pub use format::Format;

@@ -164,7 +164,8 @@ pub struct Problem {
 /// A tileset as read.
 #[derive(Debug, Clone)]
 pub struct Tileset {
-    /// The `tileset.json` read.
+    /// The `tileset.json` read: a path, or an `http://` / `https://` URL as given (its
+    /// content is then fetched relative to it, [`crate::files::http`]).
     pub file: PathBuf,
     /// `asset.version`.
     pub version: String,
@@ -193,11 +194,38 @@ impl Tileset {
                 "{uri:?}: external tilesets are not read by splatgl yet"
             )));
         }
+        if let Some(base) = self.url() {
+            return load_url_content(base, uri, opts);
+        }
         let file = crate::files::contained(self.folder(), uri, opts.allow_outside_paths)
             .map_err(ContentError::Unreadable)?;
         crate::load::load_path(&file, opts)
             .map_err(|e| ContentError::Unreadable(format!("{uri:?} does not load: {e}")))
     }
+
+    /// The URL it was fetched from, if it was.
+    pub fn url(&self) -> Option<&str> {
+        self.file.to_str().filter(|s| crate::files::http::is_url(s))
+    }
+}
+
+/// A tile's content fetched relative to the tileset's URL (kept under its folder).
+fn load_url_content(
+    base: &str,
+    uri: &str,
+    opts: &LoadOptions,
+) -> Result<crate::load::Scene, ContentError> {
+    use crate::files::http;
+    let url = http::resolve(base, uri, opts.allow_outside_paths)
+        .map_err(|e| ContentError::Unreadable(e.to_string()))?;
+    let bytes = http::fetch_bounded(&url, opts.limits.max_bytes, "the tile content")
+        .map_err(|e| ContentError::Unreadable(e.to_string()))?;
+    // No path: the format is told by the bytes, and nothing the content names is read from
+    // disk (external glTF buffers of fetched content are not fetched: use .glb or data URIs).
+    let mut o = opts.clone();
+    o.resolver = None;
+    crate::load::load_bytes(&bytes, None, &o)
+        .map_err(|e| ContentError::Unreadable(format!("{uri:?} does not load: {e}")))
 }
 
 /// Why [`Tileset::load_content`] gave no scene.
@@ -241,8 +269,12 @@ pub fn is_tileset(bytes: &[u8]) -> bool {
 /// [`Tileset::problems`].
 pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
     let shown = path.display();
-    let bytes = crate::files::read_bounded(path, opts.limits.max_bytes, "the tileset")
-        .map_err(|e| format!("{shown}: {e}"))?;
+    let bytes = match path.to_str().filter(|s| crate::files::http::is_url(s)) {
+        Some(url) => crate::files::http::fetch_bounded(url, opts.limits.max_bytes, "the tileset")
+            .map_err(|e| e.to_string())?,
+        None => crate::files::read_bounded(path, opts.limits.max_bytes, "the tileset")
+            .map_err(|e| format!("{shown}: {e}"))?,
+    };
     crate::files::check_json_depth(&bytes, opts.limits.max_json_depth)
         .map_err(|e| format!("{shown}: {e}"))?;
     let v: Value = serde_json::from_slice(&bytes).map_err(|e| format!("{shown}: not JSON: {e}"))?;
