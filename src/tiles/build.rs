@@ -293,7 +293,7 @@ fn weight_and_area(cloud: &SplatCloud, i: usize) -> (f64, f64) {
 }
 
 /// Merges the splats `members` of `cloud` into one Gaussian by moment matching, weighted by
-/// [opacity × area](weight_and_area) `wᵢ`: the mean μ = Σwᵢμᵢ / W, the covariance
+/// opacity × area (the product of its two largest standard deviations) `wᵢ`: the mean μ = Σwᵢμᵢ / W, the covariance
 /// Σ = Σwᵢ(Σᵢ + (μᵢ−μ)(μᵢ−μ)ᵀ) / W, the SH coefficients the weighted mean of theirs, and
 /// the opacity W / area(Σ) — the combined weight over the merged area — but never more than
 /// 1 − Π(1 − αᵢ), their opacity stacked on one another (splats that overlap composite, they

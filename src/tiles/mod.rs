@@ -26,7 +26,7 @@ pub use build::{
 };
 
 pub use check::{LevelSummary, TilesetReport, check};
-pub use scratch::{SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
+pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
 
 use crate::load::LoadOptions;

@@ -41,6 +41,9 @@ pub trait SplatSource {
     fn next_chunk(&mut self) -> Option<Result<SplatCloud, String>>;
 }
 
+/// At most this many buckets (files open at once while scattering); past it buckets grow.
+pub const MAX_BUCKETS: usize = 256;
+
 /// At most this many means are kept to place the bucket planes.
 pub const SAMPLE: usize = 1 << 20;
 

@@ -15,6 +15,9 @@ use std::path::{Path, PathBuf};
 /// The most header bytes read looking for `end_header`.
 const MAX_HEADER: usize = 1 << 20;
 
+/// A chunk's rows take at most this many bytes (fewer rows when they are wide).
+const MAX_CHUNK_BYTES: u64 = 64 << 20;
+
 /// A binary PLY's `vertex` rows, read a chunk at a time.
 pub struct PlyRows {
     path: PathBuf,
@@ -118,14 +121,17 @@ impl PlyRows {
         self.findings.clear();
     }
 
-    /// The next at most `rows` rows (`None` after the last). Unusable rows are dropped (and
+    /// The next at most `rows` rows (`None` after the last; fewer when `rows` of them would
+    /// take more than 64 MiB). Unusable rows are dropped (and
     /// counted in [`Self::findings`]) or, with `strict`, an error naming the row.
     pub fn next_chunk(&mut self, rows: usize) -> Option<Result<SplatCloud, String>> {
         let left = self.len() - self.next;
         if left == 0 {
             return None;
         }
-        let n = left.min(rows.max(1) as u64);
+        // At most MAX_CHUNK_BYTES a chunk, however wide the rows.
+        let fit = (MAX_CHUNK_BYTES / (self.layout.stride as u64).max(1)).max(1);
+        let n = left.min(rows.max(1) as u64).min(fit);
         Some(self.read(n))
     }
 
