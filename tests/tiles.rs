@@ -8,12 +8,8 @@ use common::cli::run;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
-/// A fresh folder for one test.
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("splatgl-tiles-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("tiles", name)
 }
 
 /// Writes `n` random splats within ±`extent` (glTF, y-up) as `dir/name`.
@@ -257,24 +253,7 @@ fn lod(d: &Path, child_b: &str) -> PathBuf {
 /// `render SCENE` from `eye` towards the origin with the reference backend into `out`.
 fn render(scene: &Path, eye: &str, out: &Path, extra: &[&str]) -> common::cli::Run {
     let look = format!("{eye},0,0,0");
-    let mut args = vec![
-        "render",
-        scene.to_str().unwrap(),
-        "--backend",
-        "reference",
-        "--look-at",
-        &look,
-        "--width",
-        "96",
-        "--height",
-        "72",
-        "-f",
-        "-v",
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    run(&args)
+    common::cli::render_small(scene.to_str().unwrap(), &look, out, extra)
 }
 
 #[test]

@@ -13,12 +13,8 @@ use splatgl::camera::Camera;
 use splatgl::tiles::{SelectOptions, TileCache, Tileset};
 use std::path::{Path, PathBuf};
 
-/// A fresh folder for one test.
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("splatgl-lod-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("lod", name)
 }
 
 /// `convert input d/tileset.json` with `extra`; the tileset read back.

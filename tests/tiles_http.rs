@@ -11,12 +11,8 @@ use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-/// A fresh folder for one test.
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("splatgl-http-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("http", name)
 }
 
 /// Serves `root` over HTTP/1.1 on a free local port until the test ends (GET only, one
@@ -79,22 +75,7 @@ fn built(d: &Path, n: usize) -> PathBuf {
 }
 
 fn render(scene: &str, out: &Path) -> common::cli::Run {
-    run(&[
-        "render",
-        scene,
-        "--backend",
-        "reference",
-        "--look-at",
-        "0,-3,1,0,0,0,0,0,1",
-        "--width",
-        "96",
-        "--height",
-        "72",
-        "-f",
-        "-v",
-        "-o",
-        out.to_str().unwrap(),
-    ])
+    common::cli::render_small(scene, "0,-3,1,0,0,0,0,0,1", out, &[])
 }
 
 #[test]

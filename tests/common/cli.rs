@@ -47,3 +47,27 @@ fn run_command(cmd: &mut Command) -> Run {
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     }
 }
+
+/// `render SCENE --look-at LOOK` with the reference backend, 96×72, `-f -v`, into `out`, then
+/// `extra`: the small render the tileset tests compare.
+pub fn render_small(scene: &str, look: &str, out: &Path, extra: &[&str]) -> Run {
+    let out = out.to_str().unwrap();
+    let mut args = vec![
+        "render",
+        scene,
+        "--backend",
+        "reference",
+        "--look-at",
+        look,
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "-f",
+        "-v",
+        "-o",
+        out,
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}

@@ -148,3 +148,11 @@ pub fn frame_points_along(
 pub fn frame_points(points: &[[f32; 3]], fov_y: f32, w: u32, h: u32) -> Option<Camera> {
     frame_points_along(points, Vec3::new(0.0, -0.35, -1.0), Vec3::Y, fov_y, w, h)
 }
+
+/// A fresh, empty folder `splatgl-KIND-PID-NAME` in the temporary folder, for one test.
+pub fn fresh_dir(kind: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("splatgl-{kind}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
