@@ -96,7 +96,7 @@ pub fn build_streamed(
     let n = src.len();
     let buckets = n
         .div_ceil(o.bucket_splats.max(o.chunk_splats) as u64)
-        .clamp(1, 4096) as usize;
+        .clamp(1, MAX_BUCKETS as u64) as usize;
     let planes = sample_planes(src, buckets, progress)?;
     std::fs::create_dir_all(&o.scratch_dir)
         .map_err(|e| format!("{}: {e}", o.scratch_dir.display()))?;

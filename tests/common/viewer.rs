@@ -279,6 +279,26 @@ impl Viewer {
             .collect()
     }
 
+    /// The widest of every `layout: WHAT` rectangle the viewer has printed so far (it prints
+    /// one each time the layout changes: the panel widens with its statistics' text), so a
+    /// region beside it is clear of it in any frame shown until now.
+    pub fn widest_layout(&mut self, what: &str) -> Vec<i32> {
+        while let Ok(l) = self.rx.try_recv() {
+            self.log.push(l);
+        }
+        let prefix = format!("layout: {what} ");
+        self.log
+            .iter()
+            .filter_map(|l| l.strip_prefix(&prefix))
+            .map(|r| {
+                r.split_whitespace()
+                    .map(|v| v.parse().unwrap())
+                    .collect::<Vec<i32>>()
+            })
+            .max_by_key(|r| r[0] + r[2])
+            .unwrap_or_else(|| panic!("no {prefix:?} line: {}", self.log.join("\n")))
+    }
+
     /// `V`: eye and target of the printed `--look-at`.
     pub fn camera(&mut self) -> (Vec3, Vec3) {
         self.key("v");
