@@ -7,7 +7,8 @@
 //! over the terrain (tiles already loaded: the frame's own work). The first N is the
 //! baseline: the others are given as ratios to it (peak memory should not grow with N).
 //!
-//! `cargo bench --bench lod` (`SPLATGL_BENCH_LOD_SPLATS`, default `10000000,30000000`;
+//! `cargo bench --bench lod` (`SPLATGL_BENCH_LOD_SPLATS`, default `10000000,30000000`; run
+//! without `--bench`, as `cargo test --all-targets` does, 50,000 and 150,000;
 //! files under `target/tmp/lod-bench`, about 56 bytes a splat for the PLY and twice that for
 //! the tileset, removed at the end unless `SPLATGL_BENCH_KEEP=1`).
 
@@ -211,8 +212,15 @@ fn measure(dir: &Path, n: u64) -> Row {
 }
 
 fn main() {
+    // `cargo test --all-targets` runs this without `--bench`: a smoke run at small sizes.
+    let smoke = !std::env::args().any(|a| a == "--bench");
+    let default = if smoke {
+        "50000,150000"
+    } else {
+        "10000000,30000000"
+    };
     let sizes: Vec<u64> = std::env::var("SPLATGL_BENCH_LOD_SPLATS")
-        .unwrap_or_else(|_| "10000000,30000000".into())
+        .unwrap_or_else(|_| default.into())
         .split(',')
         .map(|s| s.trim().parse().expect("SPLATGL_BENCH_LOD_SPLATS: numbers"))
         .collect();
