@@ -43,7 +43,7 @@ pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
     let problems = t.report.summarized();
     let json = serde_json::json!({
         "file": a.file.display().to_string(),
-        "format": "3dtiles",
+        "format": ts.format.name(),
         "version": ts.version,
         "tiles": t.levels.iter().map(|l| l.tiles).sum::<usize>(),
         "levels": levels,
@@ -57,7 +57,17 @@ pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
         return ExitCode::SUCCESS;
     }
     println!("file:           {}", a.file.display());
-    println!("format:         3D Tiles {} tileset", ts.version);
+    match ts.format {
+        splatgl::tiles::TilesetFormat::Tiles3d => {
+            println!("format:         3D Tiles {} tileset", ts.version)
+        }
+        splatgl::tiles::TilesetFormat::StreamedSog => {
+            println!(
+                "format:         streamed SOG (lod-meta.json) version {}",
+                ts.version
+            )
+        }
+    }
     println!("tiles:          {}", json["tiles"]);
     println!("splats:         {}", t.report.splat_count.unwrap_or(0));
     if let Some((c, r)) = sphere {

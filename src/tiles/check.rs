@@ -4,8 +4,7 @@
 //! or with splats outside its tile's volume.
 
 use super::ContentError;
-use super::select::Y_UP_TO_Z_UP;
-use super::{Tile, Tileset};
+use super::{Tile, Tileset, TilesetFormat};
 use crate::load::validate::Report;
 use crate::load::{Finding, Format, LoadOptions};
 use glam::DVec3;
@@ -147,19 +146,23 @@ fn contents(ts: &Tileset, t: &Tile, opts: &LoadOptions, findings: &mut Vec<Findi
             }
         };
         let format = scene.report.format;
-        if !matches!(format, Format::Gltf | Format::Glb) {
+        let (expected, what) = match ts.format {
+            TilesetFormat::Tiles3d => (
+                matches!(format, Format::Gltf | Format::Glb),
+                "3D Tiles content is glTF (with KHR_gaussian_splatting for splats)",
+            ),
+            TilesetFormat::StreamedSog => (format == Format::Sog, "streamed SOG units are SOG"),
+        };
+        if !expected {
             findings.push(Finding::warning(
                 &at,
-                format!(
-                    "{uri:?} is {}: 3D Tiles content is glTF (with KHR_gaussian_splatting for splats)",
-                    format.name()
-                ),
+                format!("{uri:?} is {}: {what}", format.name()),
             ));
         }
         let cloud = &scene.cloud;
         total += cloud.len() as u64;
         if let Some(b) = t.bounds {
-            let m = t.transform * Y_UP_TO_Z_UP;
+            let m = t.transform * ts.content_frame();
             let outside = cloud
                 .positions
                 .iter()
@@ -172,8 +175,12 @@ fn contents(ts: &Tileset, t: &Tile, opts: &LoadOptions, findings: &mut Vec<Findi
                 findings.push(Finding::warning(
                     &at,
                     format!(
-                        "{outside} of its {} splat centres lie outside the tile's bounding volume (content turned y-up → z-up, then the tile transform)",
-                        cloud.len()
+                        "{outside} of its {} splat centres lie outside the tile's bounding volume{}",
+                        cloud.len(),
+                        match ts.format {
+                            TilesetFormat::Tiles3d => " (content turned y-up → z-up, then the tile transform)",
+                            TilesetFormat::StreamedSog => "",
+                        }
                     ),
                 ));
             }

@@ -11,14 +11,19 @@
 //! inherited from the parent), `transform` (column-major, composed parent × child),
 //! `boundingVolume` `box` and `sphere` (`region` is reported unsupported: it needs the WGS84
 //! ellipsoid), `content.uri` and 1.1's `contents[].uri`. Content URIs are resolved against the
-//! tileset's folder and must stay inside it ([`LoadOptions::allow_outside_paths`]); external
-//! tilesets (content that is itself a `tileset.json`), implicit tiling, HTTP and a cache that
-//! evicts are not done yet (issue 21).
+//! tileset's folder (or URL, [`crate::files::http`]) and must stay inside it
+//! ([`LoadOptions::allow_outside_paths`]); external tilesets (content that is itself a
+//! `tileset.json`) and implicit tiling are not read yet (issue 21).
+//!
+//! PlayCanvas's streamed SOG (`lod-meta.json`) is read into the same tree ([`TilesetFormat`];
+//! the mapping and its derived geometric error are in `lod_meta.rs`, [`level_error`]).
 
 mod build;
 mod check;
+mod lod_meta;
 mod scratch;
 mod select;
+mod units;
 
 pub use build::{
     BuildOptions, BuiltTile, ContentSink, ERROR_QUANTILE, ERROR_SIGMAS, Merged, Reduced, build,
@@ -26,6 +31,7 @@ pub use build::{
 };
 
 pub use check::{LevelSummary, TilesetReport, check};
+pub use lod_meta::{MAX_LOD_LEVELS, level_error};
 pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
 
@@ -161,19 +167,42 @@ pub struct Problem {
     pub unsupported: bool,
 }
 
+/// Which of the two tileset formats a [`Tileset`] was read from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TilesetFormat {
+    /// 3D Tiles 1.1 `tileset.json`, glTF content (y-up, turned to the tileset's z-up).
+    Tiles3d,
+    /// PlayCanvas streamed SOG `lod-meta.json`, SOG content in its own (PLY) frame.
+    StreamedSog,
+}
+
+impl TilesetFormat {
+    /// Its name in `info` (`"3dtiles"`, `"streamed-sog"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TilesetFormat::Tiles3d => "3dtiles",
+            TilesetFormat::StreamedSog => "streamed-sog",
+        }
+    }
+}
+
 /// A tileset as read.
 #[derive(Debug, Clone)]
 pub struct Tileset {
-    /// The `tileset.json` read: a path, or an `http://` / `https://` URL as given (its
-    /// content is then fetched relative to it, [`crate::files::http`]).
+    /// The `tileset.json` or `lod-meta.json` read: a path, or an `http://` / `https://` URL as
+    /// given (its content is then fetched relative to it, [`crate::files::http`]).
     pub file: PathBuf,
-    /// `asset.version`.
+    /// Which format it is.
+    pub format: TilesetFormat,
+    /// `asset.version` (3D Tiles), or `version` (streamed SOG; `"1"` when absent).
     pub version: String,
     /// The root tile.
     pub root: Tile,
     /// What was wrong in the JSON that did not stop reading (each tile that has it is still
     /// in the tree, with what could be read).
     pub problems: Vec<Problem>,
+    /// Decoded streamed-SOG units, shared by the leaves that slice them.
+    units: units::Units,
 }
 
 impl Tileset {
@@ -182,13 +211,40 @@ impl Tileset {
         self.file.parent().unwrap_or(Path::new("."))
     }
 
+    /// The frame change from a tile's content to the tile (before its transform): glTF's
+    /// y-up to 3D Tiles' z-up, or none for streamed SOG.
+    pub fn content_frame(&self) -> DMat4 {
+        match self.format {
+            TilesetFormat::Tiles3d => select::Y_UP_TO_Z_UP,
+            TilesetFormat::StreamedSog => DMat4::IDENTITY,
+        }
+    }
+
+    /// The tiles whose content is drawn when nothing is refined: on every path from the root,
+    /// the first tile with content (for framing a view before selecting).
+    pub fn coarsest(&self) -> Vec<&Tile> {
+        let mut out = Vec::new();
+        let mut stack = vec![&self.root];
+        while let Some(t) = stack.pop() {
+            match t.content.is_empty() {
+                false => out.push(t),
+                true => stack.extend(t.children.iter().rev()),
+            }
+        }
+        out
+    }
+
     /// The scene a tile's content URI names, loaded with `opts` inside [`Tileset::folder`]
-    /// (the one way `check` and the tile cache read content).
+    /// (the one way `check` and the tile cache read content). For a streamed SOG, the run of
+    /// splats the URI names in its SOG unit (decoded once for the leaves that share it).
     pub fn load_content(
         &self,
         uri: &str,
         opts: &LoadOptions,
     ) -> Result<crate::load::Scene, ContentError> {
+        if self.format == TilesetFormat::StreamedSog {
+            return self.units.rows(self, uri, opts);
+        }
         if uri.ends_with(".json") {
             return Err(ContentError::Unsupported(format!(
                 "{uri:?}: external tilesets are not read by splatgl yet"
@@ -245,25 +301,27 @@ impl std::fmt::Display for ContentError {
     }
 }
 
-/// Whether `bytes` look like a 3D Tiles `tileset.json`: a JSON object with `asset` and
-/// `root` — or, when it does not parse (nested too deep, truncated), text with the keys
-/// `"root"` and `"geometricError"`, so that [`read`] reports what is wrong with it as a
-/// tileset. What `info` and `validate` test before taking a `.json` file as one.
+/// Whether `bytes` look like a 3D Tiles `tileset.json` (a JSON object with `asset` and
+/// `root`) or a streamed SOG `lod-meta.json` (`lodLevels`, `filenames`, `tree`) — or, when it
+/// does not parse (nested too deep, truncated), text with the keys `"root"` and
+/// `"geometricError"` (or `"lodLevels"` and `"tree"`), so that [`read`] reports what is wrong
+/// with it as a tileset. What `info` and `validate` test before taking a `.json` file as one.
 pub fn is_tileset(bytes: &[u8]) -> bool {
     let head = bytes.iter().position(|b| !b.is_ascii_whitespace());
     if head.is_none_or(|i| bytes[i] != b'{') {
         return false;
     }
     match serde_json::from_slice::<Value>(bytes) {
-        Ok(v) => v.get("asset").is_some() && v.get("root").is_some(),
+        Ok(v) => (v.get("asset").is_some() && v.get("root").is_some()) || lod_meta::is_lod_meta(&v),
         Err(_) => {
             let has = |k: &[u8]| bytes.windows(k.len()).any(|w| w == k);
-            has(b"\"root\"") && has(b"\"geometricError\"")
+            (has(b"\"root\"") && has(b"\"geometricError\""))
+                || (has(b"\"lodLevels\"") && has(b"\"tree\""))
         }
     }
 }
 
-/// Reads `path` as a tileset: within the load limits (`max_bytes`, the JSON nesting depth),
+/// Reads `path` as a tileset (3D Tiles, or streamed SOG): within the load limits (`max_bytes`, the JSON nesting depth),
 /// at most [`MAX_TILES`] tiles [`MAX_DEPTH`] deep. `Err` when it cannot be read at all (not
 /// JSON, no `root`, no usable `asset.version`); rule breaks inside tiles are
 /// [`Tileset::problems`].
@@ -278,6 +336,18 @@ pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
     crate::files::check_json_depth(&bytes, opts.limits.max_json_depth)
         .map_err(|e| format!("{shown}: {e}"))?;
     let v: Value = serde_json::from_slice(&bytes).map_err(|e| format!("{shown}: not JSON: {e}"))?;
+    if lod_meta::is_lod_meta(&v) {
+        let mut problems = Vec::new();
+        let root = lod_meta::read(&v, &mut problems).map_err(|e| format!("{shown}: {e}"))?;
+        return Ok(Tileset {
+            file: path.to_owned(),
+            format: TilesetFormat::StreamedSog,
+            version: v.get("version").map_or("1".into(), |x| x.to_string()),
+            root,
+            problems,
+            units: Default::default(),
+        });
+    }
     let version = v
         .pointer("/asset/version")
         .and_then(Value::as_str)
@@ -316,9 +386,11 @@ pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
     }
     Ok(Tileset {
         file: path.to_owned(),
+        format: TilesetFormat::Tiles3d,
         version,
         root: root.tile,
         problems,
+        units: Default::default(),
     })
 }
 

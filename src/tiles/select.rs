@@ -85,7 +85,9 @@ pub fn visible(t: &Tile, cam: &Camera) -> bool {
 /// The tiles to draw for `cam`: the root, then — largest screen-space error first — each
 /// visible tile above `o.max_screen_error` is refined (its visible children added; with
 /// `REPLACE` the tile itself leaves) when the selection stays within `o.splat_budget`
-/// splats. `splats(tile)` counts a tile's content (loading it). `Err` when the root alone
+/// splats. A tile without splats (no content, or content that did not load) is refined
+/// first and whatever its error (as CesiumJS does with empty tiles): it draws nothing, so the
+/// coarsest content below it covers the view before any finer tile takes budget. `splats(tile)` counts a tile's content (loading it). `Err` when the root alone
 /// holds more than the budget.
 pub fn select<'a>(
     ts: &'a Tileset,
@@ -102,11 +104,12 @@ pub fn select<'a>(
         ));
     }
     let mut chosen: Vec<&Tile> = vec![root];
-    let mut open: Vec<(f64, &Tile)> = vec![(screen_space_error(root, cam), root)];
+    let mut open: Vec<(f64, &Tile)> = vec![(priority(root, used, cam), root)];
     let mut held_back = 0;
     while let Some(i) = largest(&open) {
         let (sse, t) = open.swap_remove(i);
-        if sse <= o.max_screen_error || t.children.is_empty() || !visible(t, cam) {
+        let fine_enough = sse <= o.max_screen_error && splats(t) > 0;
+        if fine_enough || t.children.is_empty() || !visible(t, cam) {
             continue;
         }
         let kids: Vec<&Tile> = t.children.iter().filter(|c| visible(c, cam)).collect();
@@ -125,7 +128,7 @@ pub fn select<'a>(
         }
         for c in kids {
             chosen.push(c);
-            open.push((screen_space_error(c, cam), c));
+            open.push((priority(c, splats(c), cam), c));
         }
     }
     Ok(Selection {
@@ -133,6 +136,15 @@ pub fn select<'a>(
         splats: used,
         held_back,
     })
+}
+
+/// The order in which open tiles are refined: tiles without splats first, then by
+/// screen-space error.
+fn priority(t: &Tile, splats: u64, cam: &Camera) -> f64 {
+    match splats {
+        0 => f64::INFINITY,
+        _ => screen_space_error(t, cam),
+    }
 }
 
 /// The index of the largest error in `open`.
@@ -148,8 +160,8 @@ pub(super) const Y_UP_TO_Z_UP: DMat4 = DMat4::from_cols_array(&[
     0.0, 0.0, 0.0, 1.0,
 ]);
 
-/// Each tile's content, loaded once, in the tileset's frame (`Y_UP_TO_Z_UP`, then the tile's
-/// transform). A content file that is missing, outside the tileset's folder or does not load
+/// Each tile's content, loaded once, in the tileset's frame ([`Tileset::content_frame`], then
+/// the tile's transform). A content file that is missing, outside the tileset's folder or does not load
 /// is skipped with a warning, so the rest still draws.
 ///
 /// With a memory cap ([`TileCache::with_max_bytes`]) the least recently used tiles are
@@ -168,8 +180,13 @@ pub struct TileCache<'a> {
     pub evictions: u64,
     /// Tile loads so far (a tile evicted and needed again counts again).
     pub loads: u64,
-    /// What was skipped, one line per content file.
+    /// What was skipped: one line per content file, except that content failing with the
+    /// same error as an earlier one (the leaves of one broken streamed-SOG unit) only counts
+    /// in [`TileCache::skipped_alike`].
     pub warnings: Vec<String>,
+    /// Content files skipped with an error already in `warnings`.
+    pub skipped_alike: u64,
+    errors_seen: std::collections::HashSet<String>,
 }
 
 /// A resident tile: its content and when it was last used.
@@ -199,6 +216,8 @@ impl<'a> TileCache<'a> {
             evictions: 0,
             loads: 0,
             warnings: Vec::new(),
+            skipped_alike: 0,
+            errors_seen: Default::default(),
         }
     }
 
@@ -287,9 +306,12 @@ impl<'a> TileCache<'a> {
         for uri in &t.content {
             match self.load_one(t, uri) {
                 Ok(c) => join(&mut out, c),
-                Err(e) => self
-                    .warnings
-                    .push(format!("{}: {uri:?} skipped: {e}", t.path)),
+                Err(e) if self.errors_seen.contains(&e) => self.skipped_alike += 1,
+                Err(e) => {
+                    self.warnings
+                        .push(format!("{}: {uri:?} skipped: {e}", t.path));
+                    self.errors_seen.insert(e);
+                }
             }
         }
         out
@@ -303,7 +325,7 @@ impl<'a> TileCache<'a> {
         let mut findings = Vec::new();
         crate::load::gltf::apply_node_transform(
             &scene.cloud,
-            t.transform * Y_UP_TO_Z_UP,
+            t.transform * self.ts.content_frame(),
             0,
             &mut findings,
         )

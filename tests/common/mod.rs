@@ -14,6 +14,8 @@ pub use splatgl::synthetic::{Rng, random_cloud};
 pub mod cli;
 #[cfg(feature = "gl")]
 pub mod gl;
+#[cfg(feature = "http")]
+pub mod http;
 pub mod packed;
 #[cfg(feature = "cli")]
 pub mod third_party;

@@ -103,14 +103,19 @@ fn load_tileset(
         }
     }
     let mut cache = splatgl::tiles::TileCache::new(&ts, opts);
-    let all = ts.root.walk();
-    let level = all
-        .iter()
-        .filter(|t| !t.content.is_empty())
-        .map(|t| t.level)
-        .min()
-        .ok_or_else(|| format!("{}: no tile has content", p.display()))?;
-    let coarse: Vec<&splatgl::tiles::Tile> = all.into_iter().filter(|t| t.level == level).collect();
+    // The coarsest content on every path; where it does not load, the tiles below it.
+    let mut open = ts.coarsest();
+    if open.is_empty() {
+        return Err(format!("{}: no tile has content", p.display()));
+    }
+    open.reverse();
+    let mut coarse = Vec::new();
+    while let Some(t) = open.pop() {
+        match cache.splats(t) {
+            0 => open.extend(t.children.iter().rev()),
+            _ => coarse.push(t),
+        }
+    }
     let cloud = cache.merged(&coarse);
     warn_skipped(a, &mut cache);
     if cloud.is_empty() {
@@ -120,9 +125,13 @@ fn load_tileset(
         ));
     }
     drop(cache);
+    let format = match ts.format {
+        splatgl::tiles::TilesetFormat::Tiles3d => Format::Glb,
+        splatgl::tiles::TilesetFormat::StreamedSog => Format::Sog,
+    };
     Ok(LoadedScene {
         cloud,
-        format: Some(Format::Glb),
+        format: Some(format),
         cameras: Vec::new(),
         trained_antialiased: false,
         tileset: Some(ts),
@@ -171,7 +180,7 @@ pub(super) fn render_tileset_views(
         if a.verbose {
             eprintln!(
                 "tiles: {} selected, {} splats (budget {}), {} held back by the budget; cache: {} \
-                 tiles, {} MB resident, {} loads, {} evicted",
+                 tiles, {} MB resident, {} loads, {} evicted, {} more skipped as warned",
                 sel.tiles.len(),
                 cloud.len(),
                 select.splat_budget,
@@ -179,7 +188,8 @@ pub(super) fn render_tileset_views(
                 cache.resident_tiles(),
                 cache.resident_bytes().div_ceil(1 << 20),
                 cache.loads,
-                cache.evictions
+                cache.evictions,
+                cache.skipped_alike
             );
         }
         engine.upload(&cloud)?;
