@@ -3,6 +3,8 @@
 //! say, a file that fails to load keeps the previous scene, and `--crop` removes what
 //! `render --crop` removes. Helpers in `tests/common/viewer.rs`.
 
+//! A tileset streams in the viewer to the selection `render` makes for the same camera.
+//!
 //! The interface is hidden (`--no-ui`) in these tests; `tests/viewer_panel.rs` tests it.
 
 mod common;
@@ -178,4 +180,56 @@ fn crop_box_removes_the_same_splats_in_view_and_render() {
     assert!(p_whole < 30.0, "the crop removed little: {p_whole} dB");
     v.quit();
     std::fs::remove_dir_all(&cwd).ok();
+}
+
+/// A tileset in the viewer: its tiles stream in the background (`tiles: … loading` lines) until
+/// nothing is pending, and what it then shows is what `render` of the tileset shows from the
+/// same camera and budget (the same selection, ≥ 40 dB).
+#[test]
+fn a_streamed_tileset_settles_on_the_selection_render_makes() {
+    let _x = X_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    if !tools_or_skip() {
+        return;
+    }
+    let cwd = dir("tiles");
+    let input = cwd.join("in.glb");
+    let cloud = common::random_cloud(3000, 1, 1.0, 5);
+    std::fs::write(&input, splatgl::write::to_glb(&cloud, &Default::default())).unwrap();
+    let ts = cwd.join("ts/tileset.json");
+    let (i, t) = (input.to_str().unwrap(), ts.to_str().unwrap());
+    let st = Command::new(env!("CARGO_BIN_EXE_splatgl"))
+        .args(["convert", i, t, "--chunk-splats", "256"])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let camera = [
+        "--look-at",
+        "0.4,-2.2,0.9,0,0,0,0,0,1",
+        "--fov",
+        "50",
+        "--width",
+        "320",
+        "--height",
+        "240",
+        "--splat-budget",
+        "1500",
+    ];
+    let Some(want) = render_gl(&cwd, &[&[t][..], &camera].concat()) else {
+        return;
+    };
+    let x = x_server();
+    let mut v = Viewer::start(
+        &x,
+        &cwd,
+        &[&[t][..], &camera, &["--sort-sync", "--no-ui"]].concat(),
+    );
+    let done = v.expect(|l| l.starts_with("tiles: ") && l.contains(", 0 loading;"));
+    let loads: Vec<&String> = v.log.iter().filter(|l| l.starts_with("tiles: ")).collect();
+    assert!(loads.len() >= 2, "the tiles streamed in steps: {loads:?}");
+    let shot = v.screenshot(&cwd);
+    let p = psnr(&shot, &want);
+    assert!(
+        p >= 40.0,
+        "viewer vs render of the tileset: {p} dB ({done})"
+    );
 }

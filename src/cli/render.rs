@@ -113,24 +113,11 @@ pub struct Args {
     /// Show progress even when stderr is not a terminal (one line per step).
     #[arg(long)]
     pub progress: bool,
-    /// For a 3D Tiles tileset: draw at most N splats per view (the tiles are chosen by
-    /// screen-space error, coarse to fine, within it).
-    #[arg(long, value_name = "N", default_value_t = splatgl::tiles::SelectOptions::DEFAULT_SPLAT_BUDGET)]
-    pub splat_budget: u64,
-    /// For a 3D Tiles tileset: refine tiles whose screen-space error is above PX pixels.
-    #[arg(long, value_name = "PX", default_value_t = splatgl::tiles::SelectOptions::DEFAULT_MAX_SCREEN_ERROR)]
-    pub max_screen_error: f64,
-    /// For a 3D Tiles tileset: keep at most about MB megabytes of tile content in memory
-    /// across views, evicting the least recently used tiles (a view's own tiles stay).
-    #[arg(long, value_name = "MB", default_value_t = DEFAULT_CACHE_MB)]
-    pub cache_mb: u64,
+    #[command(flatten)]
+    pub tiles: super::tileset::TileArgs,
     #[command(flatten)]
     pub load: super::LoadArgs,
 }
-
-/// `--cache-mb`'s default: 2 GB of resident tile content (about 36M splats at SH degree 0,
-/// 8M at degree 3).
-pub const DEFAULT_CACHE_MB: u64 = 2048;
 
 impl Args {
     /// The files read: the scene and the cameras.json (never written over).

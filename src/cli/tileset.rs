@@ -1,8 +1,42 @@
 //! `info` and `validate` of a 3D Tiles tileset (`splatgl::tiles`): a `.json` file with
 //! `asset` and `root`.
 use splatgl::load::LoadOptions;
+use splatgl::tiles::{SelectOptions, StreamSettings};
 use std::path::Path;
 use std::process::ExitCode;
+
+/// `--cache-mb`'s default: 2 GB of resident tile content (about 36M splats at SH degree 0,
+/// 8M at degree 3).
+pub const DEFAULT_CACHE_MB: u64 = 2048;
+
+/// The options of `render` and `view` that choose a tileset's tiles.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct TileArgs {
+    /// For a tileset (3D Tiles or streamed SOG): draw at most N splats per view (the tiles
+    /// are chosen by screen-space error, coarse to fine, within it).
+    #[arg(long, value_name = "N", default_value_t = SelectOptions::DEFAULT_SPLAT_BUDGET)]
+    pub splat_budget: u64,
+    /// For a tileset: refine tiles whose screen-space error is above PX pixels.
+    #[arg(long, value_name = "PX", default_value_t = SelectOptions::DEFAULT_MAX_SCREEN_ERROR)]
+    pub max_screen_error: f64,
+    /// For a tileset: keep at most about MB megabytes of tile content in memory across
+    /// views, evicting the least recently used tiles (a view's own tiles stay).
+    #[arg(long, value_name = "MB", default_value_t = DEFAULT_CACHE_MB)]
+    pub cache_mb: u64,
+}
+
+impl TileArgs {
+    /// As the library's streaming settings.
+    pub fn settings(&self) -> StreamSettings {
+        StreamSettings {
+            select: SelectOptions {
+                splat_budget: self.splat_budget,
+                max_screen_error: self.max_screen_error,
+            },
+            cache_bytes: self.cache_mb.saturating_mul(1 << 20),
+        }
+    }
+}
 
 /// Whether `file` is a tileset: an http(s) URL, or a `.json` within the size limit whose
 /// object has `asset` and `root` (anything else goes to the scene loaders, which name their

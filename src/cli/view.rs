@@ -34,7 +34,9 @@ fn scale(s: &str) -> Result<f32, String> {
 /// Arguments.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (.ply, .gltf, .glb). Without it: the bundled default scene. More files can be
+    /// Scene file (.ply, .gltf, .glb, …), or a tileset (3D Tiles tileset.json, streamed SOG
+    /// lod-meta.json; a path or an http(s) URL), streamed as the camera moves. Without it: the
+    /// bundled default scene. More files can be
     /// dropped on the window or opened with O.
     pub scene: Option<PathBuf>,
     #[command(flatten)]
@@ -105,6 +107,8 @@ pub struct Args {
     #[arg(long, hide = true, value_name = "FILE")]
     pub test_drop: Option<PathBuf>,
     #[command(flatten)]
+    pub tiles: super::tileset::TileArgs,
+    #[command(flatten)]
     pub load: super::LoadCommonArgs,
 }
 
@@ -147,6 +151,7 @@ fn go(a: Args) -> Result<(), String> {
         }),
         print_camera_json: a.cam.print_camera_json,
         no_ui: a.no_ui,
+        tiles: a.tiles.settings(),
         #[cfg(feature = "testing")]
         test_drop: a.test_drop,
     };

@@ -23,6 +23,7 @@ mod check;
 mod lod_meta;
 mod scratch;
 mod select;
+mod stream;
 mod units;
 
 pub use build::{
@@ -34,6 +35,7 @@ pub use check::{LevelSummary, TilesetReport, check};
 pub use lod_meta::{MAX_LOD_LEVELS, level_error};
 pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
+pub use stream::{LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover};
 
 use crate::load::LoadOptions;
 use glam::{DMat3, DMat4, DVec3};

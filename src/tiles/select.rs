@@ -93,7 +93,7 @@ pub fn select<'a>(
     ts: &'a Tileset,
     cam: &Camera,
     o: &SelectOptions,
-    splats: &mut dyn FnMut(&Tile) -> u64,
+    splats: &mut dyn FnMut(&'a Tile) -> u64,
 ) -> Result<Selection<'a>, String> {
     let root = &ts.root;
     let mut used = splats(root);
@@ -248,25 +248,53 @@ impl<'a> TileCache<'a> {
 
     /// Tile `t`'s content (all its content files), loaded when it is not resident.
     pub fn cloud(&mut self, t: &Tile) -> &SplatCloud {
-        self.tick += 1;
-        let (frame, tick) = (self.frame, self.tick);
-        if let Some(e) = self.clouds.get_mut(&t.path) {
-            (e.frame, e.tick) = (frame, tick);
-        } else {
-            let cloud = self.load(t);
-            self.loads += 1;
-            let bytes = cloud_bytes(&cloud);
-            self.bytes += bytes;
-            self.evict();
-            let e = Entry {
-                cloud,
-                bytes,
-                frame,
-                tick,
-            };
-            self.clouds.insert(t.path.clone(), e);
+        if self.peek(t).is_none() {
+            let (cloud, failed) = self.read(t);
+            self.note(t, failed);
+            self.insert(t, cloud);
         }
         &self.clouds[&t.path].cloud
+    }
+
+    /// The splats of `t` if it is resident (and marks it used), without loading it.
+    pub fn peek(&mut self, t: &Tile) -> Option<u64> {
+        self.tick += 1;
+        let (frame, tick) = (self.frame, self.tick);
+        let e = self.clouds.get_mut(&t.path)?;
+        (e.frame, e.tick) = (frame, tick);
+        Some(e.cloud.len() as u64)
+    }
+
+    /// Loads those of `tiles` that are not resident, reading their content in parallel (the
+    /// loading pool: rayon's threads), in the order given for what does not fit the cap.
+    pub fn load_all(&mut self, tiles: &[&Tile]) {
+        use rayon::prelude::*;
+        let todo: Vec<&Tile> = tiles
+            .iter()
+            .copied()
+            .filter(|t| !self.clouds.contains_key(&t.path))
+            .collect();
+        let read: Vec<_> = todo.par_iter().map(|t| self.read(t)).collect();
+        for (t, (cloud, failed)) in todo.into_iter().zip(read) {
+            self.note(t, failed);
+            self.insert(t, cloud);
+        }
+    }
+
+    /// Makes `cloud` tile `t`'s resident content, used now.
+    fn insert(&mut self, t: &Tile, cloud: SplatCloud) {
+        self.tick += 1;
+        self.loads += 1;
+        let bytes = cloud_bytes(&cloud);
+        self.bytes += bytes;
+        self.evict();
+        let e = Entry {
+            cloud,
+            bytes,
+            frame: self.frame,
+            tick: self.tick,
+        };
+        self.clouds.insert(t.path.clone(), e);
     }
 
     /// Evicts least recently used tiles of earlier frames while the cache is over its cap.
@@ -301,20 +329,30 @@ impl<'a> TileCache<'a> {
         out
     }
 
-    fn load(&mut self, t: &Tile) -> SplatCloud {
+    /// Tile `t`'s content files joined, and the ones that failed (URI, why).
+    fn read(&self, t: &Tile) -> (SplatCloud, Vec<(String, String)>) {
         let mut out = SplatCloud::new(0);
+        let mut failed = Vec::new();
         for uri in &t.content {
             match self.load_one(t, uri) {
                 Ok(c) => join(&mut out, c),
-                Err(e) if self.errors_seen.contains(&e) => self.skipped_alike += 1,
-                Err(e) => {
-                    self.warnings
-                        .push(format!("{}: {uri:?} skipped: {e}", t.path));
-                    self.errors_seen.insert(e);
-                }
+                Err(e) => failed.push((uri.clone(), e)),
             }
         }
-        out
+        (out, failed)
+    }
+
+    /// Warns of `t`'s failed content, once per distinct error.
+    fn note(&mut self, t: &Tile, failed: Vec<(String, String)>) {
+        for (uri, e) in failed {
+            if self.errors_seen.contains(&e) {
+                self.skipped_alike += 1;
+            } else {
+                self.warnings
+                    .push(format!("{}: {uri:?} skipped: {e}", t.path));
+                self.errors_seen.insert(e);
+            }
+        }
     }
 
     fn load_one(&self, t: &Tile, uri: &str) -> Result<SplatCloud, String> {

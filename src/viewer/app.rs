@@ -61,6 +61,8 @@ pub(super) struct Shown {
     home: Rig,
     /// What the panel says about the scene.
     facts: Facts,
+    /// A tileset's streaming thread, and the camera it was last given.
+    streamer: Option<(crate::tiles::Streamer, Option<crate::camera::Camera>)>,
 }
 
 /// The viewer's state.
@@ -327,6 +329,9 @@ impl ApplicationHandler<UserEvent> for App {
                     Ok(l) => self.install(el, *l),
                     Err(msg) => self.load_failed(el, msg),
                 }
+            }
+            UserEvent::Load(LoadEvent::Tiles { id, frame }) if id == self.load_id => {
+                self.install_tiles(el, *frame)
             }
             UserEvent::Load(_) => {} // a load superseded by a newer one
             UserEvent::Open(p) => self.start_load(Some(p)),

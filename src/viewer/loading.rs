@@ -17,6 +17,8 @@ use crate::load::{Format, LoadOptions, load_bytes};
 pub struct Keep {
     /// `--max-splats`.
     pub max_splats: Option<usize>,
+    /// A tileset's selection and cache (`--splat-budget`, `--max-screen-error`, `--cache-mb`).
+    pub tiles: crate::tiles::StreamSettings,
 }
 
 /// A scene ready to show.
@@ -38,6 +40,9 @@ pub struct Loaded {
     pub trained_antialiased: bool,
     /// Container, version and compression of a quantized format (`spz 3, gzip`).
     pub container: Option<String>,
+    /// For a tileset: its streaming thread (`cloud` is then its first selection, the coarsest
+    /// content; later ones arrive as [`LoadEvent::Tiles`]).
+    pub streamer: Option<crate::tiles::Streamer>,
 }
 
 impl Loaded {
@@ -74,6 +79,13 @@ pub enum LoadEvent {
         /// The load's id.
         id: u64,
     },
+    /// A tileset's streaming thread selected other tiles (or finished loading them).
+    Tiles {
+        /// The load's id.
+        id: u64,
+        /// The new selection and the counts.
+        frame: Box<crate::tiles::StreamFrame>,
+    },
     /// Finished.
     Done {
         /// The load's id.
@@ -84,16 +96,20 @@ pub enum LoadEvent {
 }
 
 /// Starts loading `path` (`None`: the bundled default scene) on a new thread; `send` delivers
-/// its events (throttled progress, then exactly one `Done`).
+/// its events (throttled progress, then exactly one `Done`; for a tileset, `Tiles` from its
+/// streaming thread after that).
 pub fn spawn(
     id: u64,
     path: Option<PathBuf>,
     opts: Arc<LoadOptions>,
     keep: Keep,
-    send: impl Fn(LoadEvent) + Send + 'static,
+    send: impl Fn(LoadEvent) + Send + Sync + Clone + 'static,
 ) {
     let body = move || {
-        let result = load(id, path, &opts, keep, &send);
+        let result = match path.as_deref().filter(|p| is_tileset(p, &opts)) {
+            Some(p) => load_tileset(id, p, &opts, keep, send.clone()),
+            None => load(id, path, &opts, keep, &send),
+        };
         send(LoadEvent::Done { id, result });
     };
     if let Err(e) = std::thread::Builder::new()
@@ -165,7 +181,70 @@ fn load(
         warnings,
         trained_antialiased,
         container,
+        streamer: None,
     }))
+}
+
+/// Whether `p` names a tileset: an http(s) URL, or a `.json` that reads as one.
+fn is_tileset(p: &Path, opts: &LoadOptions) -> bool {
+    #[cfg(feature = "http")]
+    if p.to_str().is_some_and(crate::files::http::is_url) {
+        return true;
+    }
+    p.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        && crate::files::read_bounded(p, opts.limits.max_bytes, "the file")
+            .is_ok_and(|b| crate::tiles::is_tileset(&b))
+}
+
+/// A tileset: read, and streamed from its coarsest content on (`keep.tiles`).
+fn load_tileset(
+    id: u64,
+    p: &Path,
+    opts: &LoadOptions,
+    keep: Keep,
+    send: impl Fn(LoadEvent) + Send + Sync + 'static,
+) -> Result<Box<Loaded>, String> {
+    send(LoadEvent::Decoding { id });
+    let ts = crate::tiles::read(p, opts)?;
+    let mut warnings: Vec<String> = ts
+        .problems
+        .iter()
+        .map(|pr| format!("{}: {}", pr.path, pr.message))
+        .collect();
+    let format = match ts.format {
+        crate::tiles::TilesetFormat::Tiles3d => Format::Glb,
+        crate::tiles::TilesetFormat::StreamedSog => Format::Sog,
+    };
+    let publish = Box::new(move |f: crate::tiles::StreamFrame| {
+        send(LoadEvent::Tiles {
+            id,
+            frame: Box::new(f),
+        })
+    });
+    let (streamer, first) =
+        crate::tiles::Streamer::start(Arc::new(ts), opts.clone(), keep.tiles, publish)
+            .map_err(|e| format!("{}: {e}", p.display()))?;
+    warnings.extend(first.warnings.iter().cloned());
+    let cloud = first.cloud.unwrap_or_default();
+    Ok(Box::new(Loaded {
+        path: Some(p.to_owned()),
+        file_len: cloud.len(),
+        cloud,
+        format: Some(format),
+        cameras: Vec::new(),
+        warnings,
+        trained_antialiased: false,
+        container: Some(format!("{} tileset", ts_name(format))),
+        streamer: Some(streamer),
+    }))
+}
+
+fn ts_name(f: Format) -> &'static str {
+    match f {
+        Format::Sog => "streamed SOG",
+        _ => "3D Tiles",
+    }
 }
 
 /// Reads a file in 1 MiB chunks, reporting progress at most every 100 ms: a regular file of at

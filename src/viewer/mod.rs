@@ -117,6 +117,9 @@ pub struct ViewerOptions {
     pub print_camera_json: bool,
     /// Start with the interface hidden (`--no-ui`; `G` shows it).
     pub no_ui: bool,
+    /// For a tileset: the splat budget, screen-space error and cache size its streaming keeps
+    /// to (`--splat-budget`, `--max-screen-error`, `--cache-mb`).
+    pub tiles: crate::tiles::StreamSettings,
     /// Test hook (feature `testing`): after the first scene has been shown for a few frames,
     /// deliver this path as a `DroppedFile` window event (the drag-and-drop code path).
     #[cfg(feature = "testing")]
@@ -144,6 +147,7 @@ impl Default for ViewerOptions {
             bench: None,
             print_camera_json: false,
             no_ui: false,
+            tiles: Default::default(),
             #[cfg(feature = "testing")]
             test_drop: None,
         }

@@ -73,12 +73,15 @@ pub(super) struct LoadedScene {
 fn tiles_only_options(a: &Args) -> Result<(), String> {
     let d = splatgl::tiles::SelectOptions::default();
     let given = [
-        ("--splat-budget", a.splat_budget != d.splat_budget),
+        ("--splat-budget", a.tiles.splat_budget != d.splat_budget),
         (
             "--max-screen-error",
-            a.max_screen_error != d.max_screen_error,
+            a.tiles.max_screen_error != d.max_screen_error,
         ),
-        ("--cache-mb", a.cache_mb != super::DEFAULT_CACHE_MB),
+        (
+            "--cache-mb",
+            a.tiles.cache_mb != super::super::tileset::DEFAULT_CACHE_MB,
+        ),
     ];
     match given.iter().find(|(_, g)| *g) {
         Some((flag, _)) => Err(format!("{flag} applies to 3D Tiles tilesets only")),
@@ -103,19 +106,11 @@ fn load_tileset(
         }
     }
     let mut cache = splatgl::tiles::TileCache::new(&ts, opts);
-    // The coarsest content on every path; where it does not load, the tiles below it.
-    let mut open = ts.coarsest();
-    if open.is_empty() {
+    if ts.coarsest().is_empty() {
         return Err(format!("{}: no tile has content", p.display()));
     }
-    open.reverse();
-    let mut coarse = Vec::new();
-    while let Some(t) = open.pop() {
-        match cache.splats(t) {
-            0 => open.extend(t.children.iter().rev()),
-            _ => coarse.push(t),
-        }
-    }
+    // The coarsest content on every path; where it does not load, the tiles below it.
+    let coarse = splatgl::tiles::coarse_cover(&ts, &mut cache);
     let cloud = cache.merged(&coarse);
     warn_skipped(a, &mut cache);
     if cloud.is_empty() {
@@ -160,13 +155,13 @@ pub(super) fn render_tileset_views(
     progress: Progress,
 ) -> Result<(Option<usize>, usize), String> {
     let select = splatgl::tiles::SelectOptions {
-        splat_budget: a.splat_budget,
-        max_screen_error: a.max_screen_error,
+        splat_budget: a.tiles.splat_budget,
+        max_screen_error: a.tiles.max_screen_error,
     };
     let mut cache = splatgl::tiles::TileCache::with_max_bytes(
         ts,
         &a.load.options(),
-        a.cache_mb.saturating_mul(1 << 20),
+        a.tiles.cache_mb.saturating_mul(1 << 20),
     );
     let (mut visible, mut drawn) = (None, 0);
     let mut entries = Vec::new();

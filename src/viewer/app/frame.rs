@@ -199,6 +199,12 @@ impl App {
             None => self.controls.update(rig, dt, render),
         };
         let camera = rig.camera(render.0, render.1);
+        if let Some((streamer, last)) = &mut shown.streamer
+            && *last != Some(camera)
+        {
+            streamer.set_camera(&camera);
+            *last = Some(camera);
+        }
         let eye = camera.eye();
         let Some((order, fresh)) = shown.orders.for_frame(eye) else {
             return Err(ViewerError::Window("the sorter thread stopped".into()));

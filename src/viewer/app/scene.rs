@@ -32,6 +32,7 @@ impl App {
         let opts = Arc::clone(&self.load_opts);
         let keep = loading::Keep {
             max_splats: self.opts.max_splats,
+            tiles: self.opts.tiles,
         };
         spawn(self.load_id, path, opts, keep, send);
         self.update_title(true);
@@ -78,7 +79,7 @@ impl App {
     }
 
     /// Shows a loaded scene (or keeps the previous one when it cannot be shown).
-    pub(super) fn install(&mut self, el: &ActiveEventLoop, l: Loaded) {
+    pub(super) fn install(&mut self, el: &ActiveEventLoop, mut l: Loaded) {
         let name = l.name();
         let up = (self.opts.view.up)
             .unwrap_or_else(|| crate::camera::UpAxis::for_cloud(l.format, &l.cloud));
@@ -130,7 +131,9 @@ impl App {
             }
         );
         let facts = self.facts_of(&l, &name);
+        let streamer = l.streamer.take().map(|s| (s, None));
         self.shown = Some(Shown {
+            streamer,
             facts,
             name,
             path: l.path,
@@ -152,6 +155,39 @@ impl App {
         if let Some(b) = self.opts.bench.filter(|_| self.bench.is_none()) {
             self.bench = Some(BenchRun::new(b, rig));
         }
+        self.update_title(true);
+        self.request_redraw();
+    }
+
+    /// A tileset's new selection: uploaded whole, with a sorter for its splats; the camera
+    /// stays. Prints the counts (`tiles: …`) and the tiles skipped.
+    pub(super) fn install_tiles(&mut self, el: &ActiveEventLoop, f: crate::tiles::StreamFrame) {
+        for w in &f.warnings {
+            eprintln!("warning: {w}");
+        }
+        println!("{}", f.summary());
+        self.status = (f.pending > 0).then(|| format!("loading {} tiles", f.pending));
+        let (Some(shown), Some(cloud)) = (&mut self.shown, f.cloud) else {
+            self.update_title(true);
+            return;
+        };
+        let positions: Arc<[[f32; 3]]> = cloud.positions.as_slice().into();
+        let tau = self.opts.stale.tolerance(&cloud);
+        let mut orders = match Orders::new(positions, tau, self.opts.sort_sync) {
+            Ok(o) => o,
+            Err(e) => return self.load_failed(el, format!("sorter thread: {e}")),
+        };
+        orders.set_crop(self.crop);
+        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+            return;
+        };
+        if let Err(e) = renderer.upload(&win.gl, &cloud) {
+            return self.load_failed(el, e.to_string());
+        }
+        shown.orders = orders;
+        shown.uploaded = None;
+        shown.len = cloud.len();
+        shown.sh_degree = cloud.sh_degree;
         self.update_title(true);
         self.request_redraw();
     }
