@@ -120,6 +120,11 @@ pub const FORMER_QUAD_MARGIN_PX: f64 = 0.5;
 // §8 GPU data layout (the GL backend's textures; docs/gl-backend.md "Data layout")
 // ---------------------------------------------------------------------------------------------
 
+/// Splat slots per page of the GL backend's paged storage (streamed tilesets: each tile
+/// holds whole pages, see `tiles::pages`). A multiple of every data-texture width the
+/// backend uses (≤ 8192 texels), so a page is whole texture rows.
+pub const PAGE_SPLATS: usize = 8192;
+
 /// `RGBA32F` texels per splat in the geometry texture.
 pub const GEOM_TEXELS: usize = 3;
 /// Geometry texel holding (position.xyz, opacity).

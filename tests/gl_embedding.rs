@@ -16,8 +16,8 @@ use glow::HasContext;
 use host_state::{Host, Piece, pieces, query_all};
 use splatgl::gl::state::{Contexts, LEFT_WITHOUT_RESTORE, Left, LeftValue};
 use splatgl::gl::{
-    ColorFormat, DepthFormat, DepthFunc, DrawPath, DrawSettings, Pipeline, ReadbackTarget,
-    SplatRenderer, SplatScene,
+    ColorFormat, DepthFormat, DepthFunc, DrawPath, DrawSettings, PAGE_SPLATS, Pipeline,
+    ReadbackTarget, SplatRenderer, SplatScene,
 };
 
 const APIS: [GlApi; 3] = [GlApi::Gles3, GlApi::DesktopCore33, GlApi::DesktopCompat];
@@ -66,6 +66,12 @@ fn every_call(gl: &glow::Context, settings: DrawSettings) {
     r.draw_current(gl, &cam).unwrap();
     assert!(r.last_draw_used_prepass());
     r.draw_with_matrices(gl, view, proj, [3, 4, 50, 60], &order)
+        .unwrap();
+    // Paged storage (streamed tilesets): allocated, a page written, drawn by slots.
+    r.allocate_pages(gl, 2, 3, Default::default()).unwrap();
+    r.write_page(gl, 1, &cloud, 0).unwrap();
+    let slots: Vec<u32> = order.iter().map(|i| i + PAGE_SPLATS as u32).collect();
+    r.draw_with_matrices(gl, view, proj, [3, 4, 50, 60], &slots)
         .unwrap();
     r.destroy(gl);
     for path in [DrawPath::default(), prepass()] {

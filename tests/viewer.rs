@@ -226,6 +226,26 @@ fn a_streamed_tileset_settles_on_the_selection_render_makes() {
     let done = v.expect(|l| l.starts_with("tiles: ") && l.contains(", 0 loading;"));
     let loads: Vec<&String> = v.log.iter().filter(|l| l.starts_with("tiles: ")).collect();
     assert!(loads.len() >= 2, "the tiles streamed in steps: {loads:?}");
+    // Each new selection writes only its new tiles' pages: some later selection wrote fewer
+    // splats than it selected, into the storage already allocated.
+    let lines: Vec<&String> = v
+        .log
+        .iter()
+        .filter(|l| l.starts_with("tiles: ") || l.starts_with("gpu: "))
+        .collect();
+    let number_after = |l: &str, key: &str| -> u64 {
+        let head = l.split(key).next().unwrap_or("");
+        let word = head.trim_end().rsplit([' ', '(']).next().unwrap_or("");
+        word.parse()
+            .unwrap_or_else(|_| panic!("no number before {key:?} in {l:?}"))
+    };
+    let partial = lines.windows(2).skip(1).any(|w| {
+        w[0].starts_with("tiles: ")
+            && w[1].starts_with("gpu: ")
+            && !w[1].contains("storage allocated")
+            && number_after(w[1], " splats)") < number_after(w[0], " splats (budget")
+    });
+    assert!(partial, "no selection kept its resident tiles: {lines:#?}");
     let shot = v.screenshot(&cwd);
     let p = psnr(&shot, &want);
     assert!(

@@ -39,12 +39,16 @@ use super::GlError;
 use super::fault;
 use super::objects::{Creating, Owned};
 use crate::cloud::SplatCloud;
+pub use crate::profile::PAGE_SPLATS;
 use crate::profile::{
     GEOM_TEXEL_POSITION_OPACITY, GEOM_TEXEL_ROTATION, GEOM_TEXEL_SCALE, GEOM_TEXELS, sh_texels,
 };
 
 /// log2 of the widest data texture used (8192 texels).
 const MAX_TEX_WIDTH_LOG2: u32 = 13;
+
+// Each page is whole rows of both textures, so writing one never touches another.
+const _: () = assert!(PAGE_SPLATS.is_multiple_of(1 << MAX_TEX_WIDTH_LOG2));
 
 /// Width, full-layer height and layer limit of the data textures on one context (fixed when
 /// the renderer is created: the shader is compiled with them).
@@ -205,35 +209,28 @@ impl<'a> CloudSet<'a> {
     }
 }
 
-/// Uploads a float array texture in `layout` whose linear texel stream is produced by `fill`
-/// (called per splat with a slice of `per_splat · 4` floats), a few rows at a time so the
-/// staging memory stays small for large clouds. The caller has set the unpack state to tight
-/// client-memory rows and restores the binding of `TEXTURE_2D_ARRAY`.
-fn upload_texture(
+/// A float array texture in `layout` with storage for `n` splats of `per_splat` texels
+/// (contents undefined), bound to `TEXTURE_2D_ARRAY`; returns it with its rows.
+fn allocate_texture(
     objects: &mut Creating<'_>,
     internal_format: u32,
     layout: &TextureLayout,
     n: usize,
     per_splat: usize,
-    mut fill: impl FnMut(usize, &mut [f32]),
-) -> Result<glow::Texture, GlError> {
-    let width = layout.width();
+) -> Result<(glow::Texture, RowTarget), GlError> {
     let (mut height, mut layers) = layout.shape(n, per_splat);
-    let allocated_layers = match fault::get(|f| f.oversize_layers) {
-        Some(l) => {
-            (height, layers) = (layout.layer_rows(), 1);
-            l as usize
-        }
-        None => layers,
-    };
+    let mut rows_total = height * layers;
+    if let Some(l) = fault::get(|f| f.oversize_layers) {
+        (height, layers) = (layout.layer_rows(), l as usize);
+        rows_total = height;
+    }
     let gl = objects.gl();
     let tex = objects.texture()?;
     // SAFETY: texture creation/allocation on the current context with sizes checked by the
-    // caller against the limits; sub-image uploads stay inside the allocated storage (row and
-    // layer ranges computed below) and read exactly width·rows·4 floats from `staging`.
+    // caller against the limits.
     unsafe {
         gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(tex));
-        let (w, h, d) = (width as i32, height as i32, allocated_layers as i32);
+        let (w, h, d) = (layout.width() as i32, height as i32, layers as i32);
         gl.tex_storage_3d(glow::TEXTURE_2D_ARRAY, 1, internal_format, w, h, d);
         for (pname, v) in [
             (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
@@ -243,30 +240,65 @@ fn upload_texture(
         ] {
             gl.tex_parameter_i32(glow::TEXTURE_2D_ARRAY, pname, v as i32);
         }
-        const ROWS_PER_CHUNK: usize = 64;
-        let floats_per_row = width * 4;
-        let mut staging = vec![0.0f32; ROWS_PER_CHUNK.min(height) * floats_per_row];
-        let mut tmp = vec![0.0f32; per_splat * 4];
-        let total_floats = n * per_splat * 4;
-        let stride = per_splat * 4;
-        let rows_used = (n * per_splat).div_ceil(width).max(1);
-        let mut row = 0; // global row
-        while row < rows_used.min(height * layers) {
-            let (layer, y) = (row / height, row % height);
-            let chunk_rows = ROWS_PER_CHUNK.min(height - y).min(rows_used - row);
-            let start = row * floats_per_row;
-            let end = start + chunk_rows * floats_per_row;
-            staging[..chunk_rows * floats_per_row].fill(0.0);
-            // Splats overlapping [start, end) of the linear float stream.
-            let first = start / stride;
-            let last = end.min(total_floats).div_ceil(stride);
-            for i in first..last {
-                fill(i, &mut tmp);
-                let s0 = i * stride;
-                let a = s0.max(start);
-                let b = (s0 + stride).min(end);
-                staging[a - start..b - start].copy_from_slice(&tmp[a - s0..b - s0]);
-            }
+    }
+    Ok((tex, RowTarget { height, rows_total }))
+}
+
+/// Where a write goes: the texture bound to `TEXTURE_2D_ARRAY`, `height` rows a layer, of
+/// which it may touch rows below `rows_total`.
+#[derive(Debug, Clone, Copy)]
+struct RowTarget {
+    height: usize,
+    rows_total: usize,
+}
+
+/// Writes splats `first .. first + n` (global indices; `first · per_splat` a whole number of
+/// rows) of the bound texture, whose texel stream is produced by `fill` (called per splat with
+/// a slice of `per_splat · 4` floats), a few rows at a time so the staging memory stays small;
+/// the rest of the last row is zeroed. The caller has set the unpack state to tight
+/// client-memory rows.
+fn write_rows(
+    gl: &glow::Context,
+    layout: &TextureLayout,
+    target: &RowTarget,
+    (first, n): (usize, usize),
+    per_splat: usize,
+    mut fill: impl FnMut(usize, &mut [f32]),
+) {
+    let width = layout.width();
+    let height = target.height;
+    debug_assert!((first * per_splat).is_multiple_of(width), "writes start on a row");
+    const ROWS_PER_CHUNK: usize = 64;
+    let floats_per_row = width * 4;
+    let mut staging = vec![0.0f32; ROWS_PER_CHUNK.min(height) * floats_per_row];
+    let mut tmp = vec![0.0f32; per_splat * 4];
+    let stride = per_splat * 4;
+    // Floats of the written splats, counted from the first written row.
+    let total_floats = n * stride;
+    let row0 = first * per_splat / width;
+    let rows_used = (n * per_splat).div_ceil(width).max(1);
+    let mut row = 0; // rows from row0
+    while row < rows_used && row0 + row < target.rows_total {
+        let global = row0 + row;
+        let (layer, y) = (global / height, global % height);
+        let chunk_rows = ROWS_PER_CHUNK
+            .min(height - y)
+            .min(rows_used - row)
+            .min(target.rows_total - global);
+        let start = row * floats_per_row;
+        let end = start + chunk_rows * floats_per_row;
+        staging[..chunk_rows * floats_per_row].fill(0.0);
+        // Splats overlapping [start, end) of the written float stream.
+        for i in start / stride..end.min(total_floats).div_ceil(stride) {
+            fill(first + i, &mut tmp);
+            let s0 = i * stride;
+            let a = s0.max(start);
+            let b = (s0 + stride).min(end);
+            staging[a - start..b - start].copy_from_slice(&tmp[a - s0..b - s0]);
+        }
+        // SAFETY: the rows written lie inside the bound texture's storage (`y + chunk_rows ≤
+        // height`, `global < rows_total`), reading exactly width·chunk_rows·4 floats.
+        unsafe {
             gl.tex_sub_image_3d(
                 glow::TEXTURE_2D_ARRAY,
                 0,
@@ -282,9 +314,8 @@ fn upload_texture(
                     &staging[..chunk_rows * floats_per_row],
                 ))),
             );
-            row += chunk_rows;
         }
-        Ok(tex)
+        row += chunk_rows;
     }
 }
 
@@ -297,41 +328,84 @@ pub(crate) struct SplatTextures {
     pub(crate) sh: glow::Texture,
     /// SH texels per splat.
     pub(crate) sh_texels: usize,
-    /// Splats uploaded.
+    /// SH degree the storage holds.
+    pub(crate) sh_degree: u8,
+    /// Splats uploaded (or slots allocated).
     pub(crate) len: usize,
+    rows: [RowTarget; 2],
     owned: Owned,
 }
 
 impl SplatTextures {
-    /// Uploads a set of clouds in `layout` (checks the capacity first). The caller holds the
-    /// error scope and the unpack / binding state (see `state::UploadState`).
+    /// Storage for `n` splats of SH degree up to `sh_degree` in `layout` (checks the capacity
+    /// first; contents undefined). The caller holds the error scope and the unpack / binding
+    /// state (see `state::UploadState`).
+    pub(crate) fn allocate(
+        gl: &glow::Context,
+        n: usize,
+        sh_degree: u8,
+        layout: &TextureLayout,
+    ) -> Result<Self, GlError> {
+        let sh_t = sh_texels(sh_degree);
+        layout.check(n, GEOM_TEXELS.max(sh_t))?;
+        let mut objects = Creating::new(gl);
+        let (geometry, g) = allocate_texture(&mut objects, glow::RGBA32F, layout, n, GEOM_TEXELS)?;
+        let (sh, h) = allocate_texture(&mut objects, glow::RGBA16F, layout, n, sh_t)?;
+        Ok(SplatTextures {
+            geometry,
+            sh,
+            sh_texels: sh_t,
+            sh_degree,
+            len: n,
+            rows: [g, h],
+            owned: objects.keep("SplatTextures"),
+        })
+    }
+
+    /// Uploads a set of clouds in `layout` (as [`SplatTextures::allocate`], then writes them).
     pub(crate) fn upload(
         gl: &glow::Context,
         set: &CloudSet<'_>,
         layout: &TextureLayout,
     ) -> Result<Self, GlError> {
-        let n = set.len();
-        let sh_t = sh_texels(set.sh_degree);
-        layout.check(n, GEOM_TEXELS.max(sh_t))?;
-        let mut objects = Creating::new(gl);
-        let geometry = upload_texture(
-            &mut objects,
-            glow::RGBA32F,
+        let t = Self::allocate(gl, set.len(), set.sh_degree, layout)?;
+        t.write(gl, layout, 0, set, 0..set.len());
+        Ok(t)
+    }
+
+    /// Writes splats `range` of `set` into slots `first ..` (`first` a multiple of the texture
+    /// width, e.g. of [`PAGE_SPLATS`]; the set's degree at most the storage's, the slots within
+    /// [`SplatTextures::len`]: checked by the caller). Binds `TEXTURE_2D_ARRAY`.
+    pub(crate) fn write(
+        &self,
+        gl: &glow::Context,
+        layout: &TextureLayout,
+        first: usize,
+        set: &CloudSet<'_>,
+        range: std::ops::Range<usize>,
+    ) {
+        let n = range.len();
+        let at = |i: usize| i - first + range.start;
+        // SAFETY: binds the renderer's own textures; the caller restores the binding.
+        unsafe { gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.geometry)) };
+        write_rows(
+            gl,
             layout,
-            n,
+            &self.rows[0],
+            (first, n),
             GEOM_TEXELS,
-            |i, o| set.geometry(i, o),
-        )?;
-        let sh = upload_texture(&mut objects, glow::RGBA16F, layout, n, sh_t, |i, o| {
-            set.sh(i, o)
-        })?;
-        Ok(SplatTextures {
-            geometry,
-            sh,
-            sh_texels: sh_t,
-            len: n,
-            owned: objects.keep("SplatTextures"),
-        })
+            |i, o| set.geometry(at(i), o),
+        );
+        // SAFETY: as above.
+        unsafe { gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.sh)) };
+        write_rows(
+            gl,
+            layout,
+            &self.rows[1],
+            (first, n),
+            self.sh_texels,
+            |i, o| set.sh(at(i), o),
+        );
     }
 
     /// Deletes both textures (once).

@@ -77,6 +77,7 @@ pub(crate) use glsl::Errata;
 pub use prepass::PREPASS_MIN_SPLATS;
 // Test and benchmark hooks (feature `testing`): host programs for the state tests, the draw
 // path, the state-call counts.
+pub use data::PAGE_SPLATS;
 #[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use program::build_program;

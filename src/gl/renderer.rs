@@ -8,7 +8,7 @@ use glow::HasContext;
 
 use super::GlError;
 use super::context::ContextInfo;
-use super::data::{CloudSet, SplatTextures, TextureLayout};
+use super::data::{CloudSet, PAGE_SPLATS, SplatTextures, TextureLayout};
 use super::error::ErrorScope;
 use super::fault;
 use super::glsl::{self, Errata, GlslVersion};
@@ -71,6 +71,8 @@ pub struct SplatRenderer {
     pub(super) owned: Owned,
     /// What [`SplatRenderer::draw_frame`] sorts (from [`SplatRenderer::upload`]).
     pub(super) host_sort: Option<super::host_sort::HostSort>,
+    /// Whether the storage is pages ([`SplatRenderer::allocate_pages`]).
+    paged: bool,
 }
 
 impl SplatRenderer {
@@ -149,6 +151,7 @@ impl SplatRenderer {
             used_prepass: Cell::new(false),
             owned: objects.keep("SplatRenderer"),
             host_sort: None,
+            paged: false,
         })
     }
 
@@ -236,7 +239,6 @@ impl SplatRenderer {
     ) -> Result<(), GlError> {
         self.owned.check()?;
         let set = CloudSet::new(clouds)?;
-        let n = set.len();
         let errors = ErrorScope::begin(gl)?;
         let host = Bindings::for_upload(gl, self.ctx);
         let mut textures = SplatTextures::upload(gl, &set, &self.layout)?;
@@ -245,6 +247,23 @@ impl SplatRenderer {
             textures.destroy(gl);
             return Err(e);
         }
+        let color_space = clouds
+            .first()
+            .map_or(ColorSpace::default(), |c| c.meta.color_space.effective());
+        self.replace_textures(gl, textures, color_space)?;
+        self.paged = false;
+        Ok(())
+    }
+
+    /// Makes `textures` the drawn storage (sizing the order buffer and the pre-pass for it);
+    /// on failure they are deleted and the previous storage stays.
+    fn replace_textures(
+        &mut self,
+        gl: &glow::Context,
+        mut textures: SplatTextures,
+        color_space: ColorSpace,
+    ) -> Result<(), GlError> {
+        let n = textures.len;
         if n > self.order_allocated
             && let Err(e) = self.grow_order_buffer(gl, n)
         {
@@ -255,17 +274,98 @@ impl SplatRenderer {
             textures.destroy(gl);
             return Err(e);
         }
+        self.cloud_degree = textures.sh_degree;
         if let Some(mut old) = self.textures.replace(textures) {
             old.destroy(gl);
         }
-        self.cloud_degree = set.sh_degree;
-        self.color_space = clouds
-            .first()
-            .map_or(ColorSpace::default(), |c| c.meta.color_space.effective());
+        self.color_space = color_space;
         self.instances = 0;
         self.order_capacity = n;
         self.host_sort = None;
         Ok(())
+    }
+
+    /// Allocates paged storage: `pages` pages of [`PAGE_SPLATS`] splat slots each, for clouds
+    /// of SH degree up to `sh_degree`, drawn in `color_space` (replaces any cloud or pages;
+    /// the slots' contents are undefined until written). For streamed tilesets: each tile
+    /// goes into pages of its own ([`SplatRenderer::write_page`]), loading or evicting one never
+    /// re-uploads the others, and [`SplatRenderer::set_order`] takes slot indices
+    /// (`page · PAGE_SPLATS + i`). GL state as [`SplatRenderer::upload`]; on failure the previous
+    /// storage stays.
+    pub fn allocate_pages(
+        &mut self,
+        gl: &glow::Context,
+        pages: usize,
+        sh_degree: u8,
+        color_space: ColorSpace,
+    ) -> Result<(), GlError> {
+        self.owned.check()?;
+        let n = pages.saturating_mul(PAGE_SPLATS);
+        let errors = ErrorScope::begin(gl)?;
+        let host = Bindings::for_upload(gl, self.ctx);
+        let mut textures = SplatTextures::allocate(gl, n, sh_degree.min(3), &self.layout)?;
+        drop(host);
+        if let Err(e) = errors.end("allocating splat pages") {
+            textures.destroy(gl);
+            return Err(e);
+        }
+        self.replace_textures(gl, textures, color_space)?;
+        self.models = Models::IDENTITY;
+        self.paged = true;
+        Ok(())
+    }
+
+    /// Writes splats `first .. first + PAGE_SPLATS` of `cloud` (fewer at its end) into page
+    /// `page` of the storage [`SplatRenderer::allocate_pages`] made. Errors: no pages
+    /// ([`GlError::NotUploaded`]), a page or range outside them or a cloud of a higher SH
+    /// degree than the storage ([`GlError::Upload`]), GL errors. GL state as
+    /// [`SplatRenderer::upload`].
+    pub fn write_page(
+        &mut self,
+        gl: &glow::Context,
+        page: usize,
+        cloud: &SplatCloud,
+        first: usize,
+    ) -> Result<(), GlError> {
+        self.owned.check()?;
+        let Some(textures) = &self.textures else {
+            return Err(GlError::NotUploaded);
+        };
+        let count = cloud.len().saturating_sub(first).min(PAGE_SPLATS);
+        if (page + 1).saturating_mul(PAGE_SPLATS) > textures.len || first > cloud.len() {
+            return Err(GlError::Upload(format!(
+                "page {page} (splats {first}.. of {}) is outside the {} pages allocated",
+                cloud.len(),
+                textures.len / PAGE_SPLATS
+            )));
+        }
+        if cloud.sh_degree > textures.sh_degree {
+            return Err(GlError::Upload(format!(
+                "a cloud of SH degree {} does not fit pages of degree {}",
+                cloud.sh_degree, textures.sh_degree
+            )));
+        }
+        let clouds = [cloud];
+        let set = CloudSet::new(&clouds)?;
+        let errors = ErrorScope::begin(gl)?;
+        let host = Bindings::for_upload(gl, self.ctx);
+        textures.write(
+            gl,
+            &self.layout,
+            page * PAGE_SPLATS,
+            &set,
+            first..first + count,
+        );
+        drop(host);
+        errors.end("writing a splat page")
+    }
+
+    /// Pages allocated by [`SplatRenderer::allocate_pages`] (0 after a plain upload).
+    pub fn pages(&self) -> usize {
+        match &self.textures {
+            Some(t) if self.paged => t.len / PAGE_SPLATS,
+            _ => 0,
+        }
     }
 
     /// Reallocates the order buffer for `n` indices. On failure its contents and size are

@@ -11,7 +11,8 @@
 //!   their passes): no queries; the pieces are set unconditionally and left as listed in
 //!   [Left afterwards](#left-afterwards-with-restore_state-false) ([`LEFT_WITHOUT_RESTORE`]).
 //!
-//! In both modes `SplatRenderer::new`, `upload`, `destroy` (and `SplatScene`'s) leave every
+//! In both modes `SplatRenderer::new`, `upload`, `allocate_pages`, `write_page`, `destroy`
+//! (and `SplatScene`'s) leave every
 //! piece of state as they found it: they run once, so their queries cost nothing per frame.
 //!
 //! # Set for every draw (never inherited)
@@ -111,7 +112,8 @@
 //! `GL_UNPACK_ROW_LENGTH`, `GL_UNPACK_IMAGE_HEIGHT`, `GL_UNPACK_SKIP_ROWS`,
 //! `GL_UNPACK_SKIP_PIXELS`, `GL_UNPACK_SKIP_IMAGES` and on desktop GL `GL_UNPACK_SWAP_BYTES`
 //! and `GL_UNPACK_LSB_FIRST` (set to tight client-memory rows for the upload, whatever the
-//! host left). `new` changes and puts back the `GL_VERTEX_ARRAY_BINDING` and
+//! host left). `allocate_pages` and `write_page` (paged storage) change and put back the
+//! same. `new` changes and puts back the `GL_VERTEX_ARRAY_BINDING` and
 //! `GL_ARRAY_BUFFER` bindings. `destroy` deletes only the renderer's own objects, none of which
 //! is bound afterwards in either mode.
 //!

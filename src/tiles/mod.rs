@@ -6,6 +6,8 @@
 //! loads their content once, in the tileset's frame, for `render`. [`build`] makes a LOD
 //! tree from one cloud (moment-matched merges, `convert … tileset.json`), [`build_streamed`]
 //! the same from a [`SplatSource`] read in passes, and [`tileset_json`] its `tileset.json`.
+//! For the viewer, a [`Streamer`] thread selects and loads while the camera moves, and
+//! [`pages::PageTable`] keeps each selected tile in GPU pages of its own.
 //!
 //! What is read: `asset.version` (1.0 or 1.1), `geometricError`, `refine` (`ADD` / `REPLACE`,
 //! inherited from the parent), `transform` (column-major, composed parent × child),
@@ -21,6 +23,7 @@
 mod build;
 mod check;
 mod lod_meta;
+pub mod pages;
 mod scratch;
 mod select;
 mod stream;
@@ -35,7 +38,7 @@ pub use check::{LevelSummary, TilesetReport, check};
 pub use lod_meta::{MAX_LOD_LEVELS, level_error};
 pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
-pub use stream::{LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover};
+pub use stream::{LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover, merged};
 
 use crate::load::LoadOptions;
 use glam::{DMat3, DMat4, DVec3};

@@ -191,7 +191,7 @@ pub struct TileCache<'a> {
 
 /// A resident tile: its content and when it was last used.
 struct Entry {
-    cloud: SplatCloud,
+    cloud: std::sync::Arc<SplatCloud>,
     bytes: u64,
     frame: u64,
     tick: u64,
@@ -256,6 +256,12 @@ impl<'a> TileCache<'a> {
         &self.clouds[&t.path].cloud
     }
 
+    /// Tile `t`'s content as [`TileCache::cloud`], shared (no copy).
+    pub fn shared(&mut self, t: &Tile) -> std::sync::Arc<SplatCloud> {
+        self.cloud(t);
+        self.clouds[&t.path].cloud.clone()
+    }
+
     /// The splats of `t` if it is resident (and marks it used), without loading it.
     pub fn peek(&mut self, t: &Tile) -> Option<u64> {
         self.tick += 1;
@@ -289,7 +295,7 @@ impl<'a> TileCache<'a> {
         self.bytes += bytes;
         self.evict();
         let e = Entry {
-            cloud,
+            cloud: cloud.into(),
             bytes,
             frame: self.frame,
             tick: self.tick,
@@ -324,7 +330,7 @@ impl<'a> TileCache<'a> {
     pub fn merged(&mut self, tiles: &[&Tile]) -> SplatCloud {
         let mut out = SplatCloud::new(0);
         for t in tiles {
-            join(&mut out, self.cloud(t).clone());
+            join(&mut out, SplatCloud::clone(self.cloud(t)));
         }
         out
     }
@@ -375,7 +381,7 @@ impl<'a> TileCache<'a> {
 }
 
 /// Appends `c` to `out`, taking `c`'s metadata when `out` has no splats yet.
-fn join(out: &mut SplatCloud, c: SplatCloud) {
+pub(super) fn join(out: &mut SplatCloud, c: SplatCloud) {
     if out.is_empty() {
         out.meta = c.meta.clone();
     }

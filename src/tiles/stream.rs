@@ -3,7 +3,7 @@
 //! already resident — so the view is never empty and never waits — while it loads the tiles that
 //! selection wanted next, a few at a time and in parallel, in the order selection asked for
 //! them (largest screen-space error first), then selects again. Each time the selection
-//! changes it publishes the selected splats as one cloud ([`StreamFrame`]), and the counts
+//! changes it publishes the selected tiles' content ([`StreamFrame`]), and the counts
 //! alone for the first camera and when nothing is left to load, so a caller knows the view is
 //! complete. Once nothing is pending for a camera, the selection is the one [`select`] makes
 //! loading everything at once (every tile it asked about is then resident): the same image as
@@ -42,8 +42,9 @@ impl Default for StreamSettings {
 /// One published state of the stream.
 #[derive(Debug, Clone)]
 pub struct StreamFrame {
-    /// The selected splats, when the selection changed (`None`: only the counts did).
-    pub cloud: Option<SplatCloud>,
+    /// The selected tiles (path, content in the tileset's frame), when the selection changed
+    /// (`None`: only the counts did).
+    pub selection: Option<Vec<(String, Arc<SplatCloud>)>>,
     /// Tiles selected.
     pub tiles: usize,
     /// Splats selected.
@@ -178,16 +179,16 @@ fn run(
     let mut cache = TileCache::with_max_bytes(ts, opts, settings.cache_bytes);
     let cover = coarse_cover(ts, &mut cache);
     let mut shown: Vec<&str> = cover.iter().map(|t| t.path.as_str()).collect();
-    let cloud = cache.merged(&cover);
-    if cloud.is_empty() {
+    let splats: u64 = cover.iter().map(|t| cache.splats(t)).sum();
+    if splats == 0 {
         let why = cache.warnings.join("; ");
         let _ = first.send(Err(format!("no tile at the top of the tree loads: {why}")));
         return;
     }
-    let splats = cloud.len() as u64;
+    let tiles = content_of(&mut cache, &cover);
     let _ = first.send(Ok(frame(
         &mut cache,
-        Some(cloud),
+        Some(tiles),
         cover.len(),
         splats,
         &settings,
@@ -241,10 +242,10 @@ fn run(
         pending = wanted.len();
         if changed {
             shown = paths;
-            let cloud = cache.merged(&sel.tiles);
+            let tiles = content_of(&mut cache, &sel.tiles);
             publish(frame(
                 &mut cache,
-                Some(cloud),
+                Some(tiles),
                 sel.tiles.len(),
                 sel.splats,
                 &settings,
@@ -266,16 +267,33 @@ fn run(
     }
 }
 
+/// A published selection's content as one cloud (the metadata of its first tile with splats).
+pub fn merged(selection: &[(String, Arc<SplatCloud>)]) -> SplatCloud {
+    let mut out = SplatCloud::new(0);
+    for (_, c) in selection {
+        super::select::join(&mut out, SplatCloud::clone(c));
+    }
+    out
+}
+
+/// The content of `tiles`, shared with the cache.
+fn content_of(cache: &mut TileCache<'_>, tiles: &[&Tile]) -> Vec<(String, Arc<SplatCloud>)> {
+    tiles
+        .iter()
+        .map(|t| (t.path.clone(), cache.shared(t)))
+        .collect()
+}
+
 fn frame(
     cache: &mut TileCache<'_>,
-    cloud: Option<SplatCloud>,
+    selection: Option<Vec<(String, Arc<SplatCloud>)>>,
     tiles: usize,
     splats: u64,
     settings: &StreamSettings,
     pending: usize,
 ) -> StreamFrame {
     StreamFrame {
-        cloud,
+        selection,
         tiles,
         splats,
         budget: settings.select.splat_budget,

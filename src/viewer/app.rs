@@ -17,6 +17,7 @@ use winit::window::{Fullscreen, Window, WindowId};
 mod commands;
 mod frame;
 mod interface;
+mod paging;
 mod scene;
 
 use super::controls::Controls;
@@ -63,6 +64,8 @@ pub(super) struct Shown {
     facts: Facts,
     /// A tileset's streaming thread, and the camera it was last given.
     streamer: Option<(crate::tiles::Streamer, Option<crate::camera::Camera>)>,
+    /// A tileset's GPU pages (`None`: the cloud is uploaded whole).
+    paged: Option<paging::Paged>,
 }
 
 /// The viewer's state.

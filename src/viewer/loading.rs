@@ -43,6 +43,8 @@ pub struct Loaded {
     /// For a tileset: its streaming thread (`cloud` is then its first selection, the coarsest
     /// content; later ones arrive as [`LoadEvent::Tiles`]).
     pub streamer: Option<crate::tiles::Streamer>,
+    /// For a tileset: the tiles of its first selection (`cloud` is them merged, for framing).
+    pub tiles: Vec<(String, Arc<SplatCloud>)>,
 }
 
 impl Loaded {
@@ -182,6 +184,7 @@ fn load(
         trained_antialiased,
         container,
         streamer: None,
+        tiles: Vec::new(),
     }))
 }
 
@@ -226,8 +229,10 @@ fn load_tileset(
         crate::tiles::Streamer::start(Arc::new(ts), opts.clone(), keep.tiles, publish)
             .map_err(|e| format!("{}: {e}", p.display()))?;
     warnings.extend(first.warnings.iter().cloned());
-    let cloud = first.cloud.unwrap_or_default();
+    let tiles = first.selection.unwrap_or_default();
+    let cloud = crate::tiles::merged(&tiles);
     Ok(Box::new(Loaded {
+        tiles,
         path: Some(p.to_owned()),
         file_len: cloud.len(),
         cloud,

@@ -213,7 +213,10 @@ impl App {
         self.live.drawn = order.order().len();
         if shown.uploaded != Some(order.generation()) {
             let t = Instant::now();
-            renderer.set_order(gl, order.order())?;
+            match &mut shown.paged {
+                Some(p) => renderer.set_order(gl, p.map(order.order()))?,
+                None => renderer.set_order(gl, order.order())?,
+            }
             self.live.upload_ms = t.elapsed().as_secs_f32() * 1e3;
             shown.uploaded = Some(order.generation());
         } else {

@@ -9,6 +9,7 @@ use std::time::Instant;
 use winit::event_loop::ActiveEventLoop;
 
 use super::frame::BenchRun;
+use super::paging;
 use super::{App, Shown, UserEvent};
 use crate::camera::{Camera, Extent, SceneView, UpAxis};
 use crate::load::Format;
@@ -100,8 +101,17 @@ impl App {
         let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
             return;
         };
-        if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
-            return self.load_failed(el, format!("{name}: {e}"));
+        let mut paged = None;
+        if l.tiles.is_empty() {
+            if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
+                return self.load_failed(el, format!("{name}: {e}"));
+            }
+        } else {
+            let budget = self.opts.tiles.select.splat_budget;
+            match paging::place(renderer, &win.gl, &mut paged, &l.tiles, budget) {
+                Ok(p) => println!("{}", p.summary()),
+                Err(e) => return self.load_failed(el, format!("{name}: {e}")),
+            }
         }
         for w in &l.warnings {
             eprintln!("warning: {w}");
@@ -134,6 +144,7 @@ impl App {
         let streamer = l.streamer.take().map(|s| (s, None));
         self.shown = Some(Shown {
             streamer,
+            paged,
             facts,
             name,
             path: l.path,
@@ -159,21 +170,29 @@ impl App {
         self.request_redraw();
     }
 
-    /// A tileset's new selection: uploaded whole, with a sorter for its splats; the camera
-    /// stays. Prints the counts (`tiles: …`) and the tiles skipped.
+    /// A tileset's new selection: its new tiles written into GPU pages (the others stay where
+    /// they are), with a sorter for its splats; the camera stays. Prints the counts (`tiles:
+    /// …`, `gpu: …`) and the tiles skipped.
     pub(super) fn install_tiles(&mut self, el: &ActiveEventLoop, f: crate::tiles::StreamFrame) {
         for w in &f.warnings {
             eprintln!("warning: {w}");
         }
         println!("{}", f.summary());
         self.status = (f.pending > 0).then(|| format!("loading {} tiles", f.pending));
-        let (Some(shown), Some(cloud)) = (&mut self.shown, f.cloud) else {
+        let (Some(shown), Some(tiles)) = (&mut self.shown, f.selection) else {
             self.update_title(true);
             return;
         };
-        let positions: Arc<[[f32; 3]]> = cloud.positions.as_slice().into();
-        let tau = self.opts.stale.tolerance(&cloud);
-        let mut orders = match Orders::new(positions, tau, self.opts.sort_sync) {
+        let positions: Vec<[f32; 3]> = tiles
+            .iter()
+            .flat_map(|(_, c)| c.positions.iter().copied())
+            .collect();
+        let len = positions.len();
+        let tau = match tiles.iter().max_by_key(|(_, c)| c.len()) {
+            Some((_, c)) => self.opts.stale.tolerance(c),
+            None => 0.0,
+        };
+        let mut orders = match Orders::new(positions.into(), tau, self.opts.sort_sync) {
             Ok(o) => o,
             Err(e) => return self.load_failed(el, format!("sorter thread: {e}")),
         };
@@ -181,13 +200,15 @@ impl App {
         let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
             return;
         };
-        if let Err(e) = renderer.upload(&win.gl, &cloud) {
-            return self.load_failed(el, e.to_string());
+        let budget = self.opts.tiles.select.splat_budget;
+        match paging::place(renderer, &win.gl, &mut shown.paged, &tiles, budget) {
+            Ok(p) => println!("{}", p.summary()),
+            Err(e) => return self.load_failed(el, e),
         }
         shown.orders = orders;
         shown.uploaded = None;
-        shown.len = cloud.len();
-        shown.sh_degree = cloud.sh_degree;
+        shown.len = len;
+        shown.sh_degree = tiles.iter().map(|(_, c)| c.sh_degree).max().unwrap_or(0);
         self.update_title(true);
         self.request_redraw();
     }
