@@ -276,6 +276,46 @@ fn a_near_view_refines_to_the_children_and_matches_the_whole_cloud() {
 }
 
 #[test]
+fn max_wait_draws_what_has_loaded_and_a_long_wait_the_whole_selection() {
+    let d = dir("wait");
+    let ts = lod(&d, "b.glb");
+    let read = |n: &str| splatgl::image::Image::read(d.join(n)).unwrap();
+    // No time to load the children: the coarse tile is drawn, and the warning says so.
+    let r = render(&ts, "0,1,4", &d.join("w0.png"), &["--max-wait", "0"]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(
+        r.stderr.contains("tiles: 1 selected, 10 splats"),
+        "{}",
+        r.all()
+    );
+    assert!(
+        r.stderr
+            .contains("--max-wait 0: 2 tiles of this view's selection had not loaded"),
+        "{}",
+        r.all()
+    );
+    let r = render(
+        &ts,
+        "0,1,4",
+        &d.join("coarse.png"),
+        &["--max-screen-error", "1e9"],
+    );
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert_eq!(read("w0.png").pixels, read("coarse.png").pixels);
+    // Time enough: the same image as waiting for everything, without a warning.
+    let r = render(&ts, "0,1,4", &d.join("w60.png"), &["--max-wait", "60"]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert!(!r.stderr.contains("--max-wait"), "{}", r.all());
+    let r = render(&ts, "0,1,4", &d.join("all.png"), &[]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert_eq!(read("w60.png").pixels, read("all.png").pixels);
+    // Not a number of seconds: refused by the parser.
+    let r = render(&ts, "0,1,4", &d.join("x.png"), &["--max-wait", "-1"]);
+    assert_eq!(r.code, 2, "{}", r.all());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn a_far_view_or_a_small_budget_keeps_the_coarse_tile() {
     let d = dir("far");
     let ts = lod(&d, "b.glb");

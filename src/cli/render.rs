@@ -115,8 +115,21 @@ pub struct Args {
     pub progress: bool,
     #[command(flatten)]
     pub tiles: super::tileset::TileArgs,
+    /// For a tileset: wait at most S seconds per view for the tiles its selection wants, then
+    /// draw what has loaded (coarser tiles where finer ones are still missing) and warn.
+    /// Without it each view waits until its selection is complete.
+    #[arg(long, value_name = "S", value_parser = parse_seconds)]
+    pub max_wait: Option<f64>,
     #[command(flatten)]
     pub load: super::LoadArgs,
+}
+
+/// A number of seconds ≥ 0.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a number of seconds ≥ 0")),
+    }
 }
 
 impl Args {

@@ -267,7 +267,10 @@ fn write_rows(
 ) {
     let width = layout.width();
     let height = target.height;
-    debug_assert!((first * per_splat).is_multiple_of(width), "writes start on a row");
+    debug_assert!(
+        (first * per_splat).is_multiple_of(width),
+        "writes start on a row"
+    );
     const ROWS_PER_CHUNK: usize = 64;
     let floats_per_row = width * 4;
     let mut staging = vec![0.0f32; ROWS_PER_CHUNK.min(height) * floats_per_row];

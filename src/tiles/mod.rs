@@ -38,7 +38,9 @@ pub use check::{LevelSummary, TilesetReport, check};
 pub use lod_meta::{MAX_LOD_LEVELS, level_error};
 pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
-pub use stream::{LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover, merged};
+pub use stream::{
+    LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover, merged, select_resident,
+};
 
 use crate::load::LoadOptions;
 use glam::{DMat3, DMat4, DVec3};

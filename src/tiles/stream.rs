@@ -9,7 +9,7 @@
 //! loading everything at once (every tile it asked about is then resident): the same image as
 //! `render` of that camera, whatever order the tiles arrived in.
 
-use super::select::{SelectOptions, TileCache, select};
+use super::select::{SelectOptions, Selection, TileCache, select};
 use super::{Tile, Tileset};
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
@@ -167,6 +167,31 @@ pub fn coarse_cover<'t>(ts: &'t Tileset, cache: &mut TileCache<'_>) -> Vec<&'t T
     out
 }
 
+/// [`select`] among the resident tiles alone (it loads nothing): a tile that is not resident
+/// counts as too large to add, so what covers it stays drawn, and is returned in `wanted`, in
+/// the order selection asked for it (largest screen-space error first). Once `wanted` comes
+/// back empty, the selection is the one [`select`] makes loading every tile it asks about.
+pub fn select_resident<'t>(
+    ts: &'t Tileset,
+    cam: &Camera,
+    o: &SelectOptions,
+    cache: &mut TileCache<'_>,
+) -> Result<(Selection<'t>, Vec<&'t Tile>), String> {
+    let mut wanted: Vec<&Tile> = Vec::new();
+    let sel = select(ts, cam, o, &mut |t| {
+        if t.content.is_empty() {
+            return 0;
+        }
+        cache.peek(t).unwrap_or_else(|| {
+            if !wanted.iter().any(|w| std::ptr::eq(*w, t)) {
+                wanted.push(t);
+            }
+            u64::MAX / 4
+        })
+    })?;
+    Ok((sel, wanted))
+}
+
 /// The thread: the cover first, then select / publish / load until stopped.
 fn run(
     ts: &Tileset,
@@ -219,19 +244,7 @@ fn run(
             cache.next_frame();
         }
         cache.load_all(&root);
-        let mut wanted: Vec<&Tile> = Vec::new();
-        let sel = select(ts, &cam, &settings.select, &mut |t| {
-            if t.content.is_empty() {
-                return 0;
-            }
-            cache.peek(t).unwrap_or_else(|| {
-                if !wanted.iter().any(|w| std::ptr::eq(*w, t)) {
-                    wanted.push(t);
-                }
-                u64::MAX / 4
-            })
-        });
-        let Ok(sel) = sel else {
+        let Ok((sel, mut wanted)) = select_resident(ts, &cam, &settings.select, &mut cache) else {
             // The root alone is over the budget: keep what is shown.
             pending = 0;
             continue;

@@ -12,6 +12,7 @@ use splatgl::engine::Engine;
 use splatgl::load::Format;
 use splatgl::reference::{RenderOptions, SortMode};
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 /// The scene to render (the file's cloud, format and camera nodes, or the bundled default
 /// scene), with the load options checked against its format.
@@ -82,6 +83,7 @@ fn tiles_only_options(a: &Args) -> Result<(), String> {
             "--cache-mb",
             a.tiles.cache_mb != super::super::tileset::DEFAULT_CACHE_MB,
         ),
+        ("--max-wait", a.max_wait.is_some()),
     ];
     match given.iter().find(|(_, g)| *g) {
         Some((flag, _)) => Err(format!("{flag} applies to 3D Tiles tilesets only")),
@@ -142,6 +144,39 @@ fn warn_skipped(a: &Args, cache: &mut splatgl::tiles::TileCache<'_>) {
     }
 }
 
+/// The selection for `cam` as far as it loads within `wait` (`--max-wait`): the coarsest
+/// content first, then the tiles selection wants, a batch at a time, until none is missing or
+/// the time is up (then a warning says how many were left).
+fn select_within<'t>(
+    a: &Args,
+    ts: &'t splatgl::tiles::Tileset,
+    cam: &Camera,
+    select: &splatgl::tiles::SelectOptions,
+    cache: &mut splatgl::tiles::TileCache<'_>,
+    wait: Duration,
+) -> Result<splatgl::tiles::Selection<'t>, String> {
+    let deadline = Instant::now() + wait;
+    splatgl::tiles::coarse_cover(ts, cache);
+    loop {
+        let (sel, wanted) = splatgl::tiles::select_resident(ts, cam, select, cache)?;
+        if wanted.is_empty() {
+            return Ok(sel);
+        }
+        if Instant::now() >= deadline {
+            if !a.quiet {
+                eprintln!(
+                    "warning: --max-wait {}: {} tiles of this view's selection had not loaded; \
+                     drawn with the coarser tiles that had",
+                    wait.as_secs_f64(),
+                    wanted.len()
+                );
+            }
+            return Ok(sel);
+        }
+        cache.load_all(&wanted[..wanted.len().min(splatgl::tiles::LOAD_BATCH)]);
+    }
+}
+
 /// [`render_views`] for a tileset: per view, the tiles chosen by screen-space error within
 /// `--splat-budget`, their content uploaded and drawn. Returns the last view's visible count
 /// and its selected splats.
@@ -168,7 +203,10 @@ pub(super) fn render_tileset_views(
     for (i, (cam, distance)) in views.iter().enumerate() {
         progress.step("selecting tiles", i, views.len());
         cache.next_frame();
-        let sel = splatgl::tiles::select(ts, cam, &select, &mut |t| cache.splats(t))?;
+        let sel = match a.max_wait {
+            None => splatgl::tiles::select(ts, cam, &select, &mut |t| cache.splats(t))?,
+            Some(s) => select_within(a, ts, cam, &select, &mut cache, Duration::from_secs_f64(s))?,
+        };
         let cloud = cache.merged(&sel.tiles);
         progress.clear();
         warn_skipped(a, &mut cache);
