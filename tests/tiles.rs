@@ -426,3 +426,24 @@ fn required_extensions_splatgl_cannot_honour_are_unsupported_at_their_path() {
     assert!(finding(&v, at0).is_none(), "{v:#}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn automatic_framing_takes_the_tilesets_up_axis_from_its_root_transform() {
+    use splatgl::camera::UpAxis;
+    let d = dir("up");
+    let opts = splatgl::load::LoadOptions::default();
+    // 3D Tiles are z-up; a root transform that turns the tileset y-up makes it y-up.
+    let up = |root: Value| {
+        splatgl::tiles::read(&tileset(&d, root), &opts)
+            .unwrap()
+            .up()
+    };
+    content(&d, "c.glb", 10, 1.0, 3);
+    let plain = json!({ "geometricError": 0.0, "boundingVolume": bx([0.0; 3], [2.0; 3]),
+                        "content": { "uri": "c.glb" } });
+    assert_eq!(up(plain.clone()), Some(UpAxis::Z));
+    let mut turned = plain;
+    turned["transform"] = json!(Z_UP_TO_Y_UP);
+    assert_eq!(up(turned), Some(UpAxis::Y));
+    let _ = std::fs::remove_dir_all(&d);
+}

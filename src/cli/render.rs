@@ -208,11 +208,16 @@ impl Args {
 }
 
 /// The views to render, each with the distance to print its target at.
-fn views(a: &Args, scene: SceneView<'_>) -> Result<Vec<(Camera, f32)>, String> {
-    let opts = splatgl::camera::ViewOptions {
+fn views(
+    a: &Args,
+    scene: SceneView<'_>,
+    up: Option<splatgl::camera::UpAxis>,
+) -> Result<Vec<(Camera, f32)>, String> {
+    let mut opts = splatgl::camera::ViewOptions {
         limits: a.load.options().limits,
         ..a.cam.options()?
     };
+    opts.up = opts.up.or(up);
     // One extent for every view of a batch (it walks the whole cloud).
     let extent = opts.focus_extent(scene.cloud);
     let focus = |cam: Camera| (cam, opts.focus_distance_in(&cam, extent.as_ref()));
@@ -322,7 +327,7 @@ fn go(a: &Args) -> Result<(), String> {
         format: loaded.format,
         cameras: &loaded.cameras,
     };
-    let views = views(a, scene)?;
+    let views = views(a, scene, loaded.tileset.as_ref().and_then(|t| t.up()))?;
     check_image_sizes(&views)?;
     out.check_files(views.len(), &inputs, a.force)?;
     let opts = render_options(a, bg, loaded.trained_antialiased);

@@ -227,6 +227,26 @@ impl Tileset {
         }
     }
 
+    /// The up axis its frame implies for automatic framing. 3D Tiles are z-up (glTF content
+    /// is rotated into that frame by [`Tileset::content_frame`]): the root's +Z as its
+    /// transform places it, as the nearest of +Y, −Y (a root transform that turns the tileset
+    /// y-up) or else +Z. `None` for streamed SOG, whose content's own rule applies.
+    pub fn up(&self) -> Option<crate::camera::UpAxis> {
+        use crate::camera::UpAxis;
+        match self.format {
+            TilesetFormat::Tiles3d => {
+                let u = self.root.transform.transform_vector3(glam::DVec3::Z);
+                let y = u.y / u.length().max(f64::MIN_POSITIVE);
+                Some(match y {
+                    y if y > 0.9 => UpAxis::Y,
+                    y if y < -0.9 => UpAxis::NegY,
+                    _ => UpAxis::Z,
+                })
+            }
+            TilesetFormat::StreamedSog => None,
+        }
+    }
+
     /// The tiles whose content is drawn when nothing is refined: on every path from the root,
     /// the first tile with content (for framing a view before selecting).
     pub fn coarsest(&self) -> Vec<&Tile> {

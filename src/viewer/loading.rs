@@ -45,6 +45,9 @@ pub struct Loaded {
     pub streamer: Option<crate::tiles::Streamer>,
     /// For a tileset: the tiles of its first selection (`cloud` is them merged, for framing).
     pub tiles: Vec<(String, Arc<SplatCloud>)>,
+    /// The up axis the scene's frame implies (a 3D Tiles tileset's +Z), before the format's
+    /// rule.
+    pub up: Option<crate::camera::UpAxis>,
 }
 
 impl Loaded {
@@ -185,6 +188,7 @@ fn load(
         container,
         streamer: None,
         tiles: Vec::new(),
+        up: None,
     }))
 }
 
@@ -225,14 +229,17 @@ fn load_tileset(
             frame: Box::new(f),
         })
     });
+    let ts_up = ts.up();
     let (streamer, first) =
         crate::tiles::Streamer::start(Arc::new(ts), opts.clone(), keep.tiles, publish)
             .map_err(|e| format!("{}: {e}", p.display()))?;
     warnings.extend(first.warnings.iter().cloned());
+    let up = ts_up;
     let tiles = first.selection.unwrap_or_default();
     let cloud = crate::tiles::merged(&tiles);
     Ok(Box::new(Loaded {
         tiles,
+        up,
         path: Some(p.to_owned()),
         file_len: cloud.len(),
         cloud,

@@ -90,13 +90,14 @@ pub(super) fn place(
         None => {
             let needed: usize = sel.iter().map(|(_, n)| pages_for(*n)).sum::<usize>().max(1);
             let old = paged.as_ref().map_or(0, |p| p.table.pages());
-            // Room for the budget in tiles of this selection's size (pages per splat as now),
-            // and for growth by half.
+            // Room for the budget in tiles of this selection's size (pages per splat as now).
             let splats: usize = sel.iter().map(|(_, n)| n).sum::<usize>().max(1);
             let per_splat = needed as f64 / splats as f64;
             let budget_pages = (budget as f64 * per_splat).ceil().min(1e9) as usize + sel.len();
-            let want = (needed + needed / 2)
-                .max(budget_pages.min(4 * needed + 64))
+            // Half as much again keeps recently used tiles on the GPU for when the view
+            // returns.
+            let want = (budget_pages.min(4 * needed + 64) + budget_pages / 2)
+                .max(needed + needed / 2)
                 .max(2 * old);
             let colour = tiles
                 .iter()

@@ -16,6 +16,7 @@ use crate::load::Format;
 use crate::sort::StaleOrders as Orders;
 use crate::viewer::ViewerError;
 use crate::viewer::loading::{self, Loaded, display_name, spawn};
+use crate::viewer::panel::TileCounts;
 use crate::viewer::rig::Rig;
 
 impl App {
@@ -61,6 +62,7 @@ impl App {
         if self.shown.is_none() {
             let mut v = self.opts.view.clone();
             (v.width, v.height) = (Some(w), Some(h));
+            v.up = v.up.or(l.up);
             let scene = SceneView {
                 cloud: &l.cloud,
                 format: l.format,
@@ -83,6 +85,7 @@ impl App {
     pub(super) fn install(&mut self, el: &ActiveEventLoop, mut l: Loaded) {
         let name = l.name();
         let up = (self.opts.view.up)
+            .or(l.up)
             .unwrap_or_else(|| crate::camera::UpAxis::for_cloud(l.format, &l.cloud));
         let (cam, focus) = match self.first_camera(&l, up) {
             Ok(c) => c,
@@ -106,10 +109,21 @@ impl App {
             if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
                 return self.load_failed(el, format!("{name}: {e}"));
             }
+            self.live.tiles = None;
         } else {
             let budget = self.opts.tiles.select.splat_budget;
             match paging::place(renderer, &win.gl, &mut paged, &l.tiles, budget) {
-                Ok(p) => println!("{}", p.summary()),
+                Ok(p) => {
+                    println!("{}", p.summary());
+                    self.live.tiles = Some(TileCounts {
+                        selected: l.tiles.len(),
+                        splats: l.cloud.len() as u64,
+                        budget,
+                        pages_used: p.used,
+                        pages: p.pages,
+                        ..Default::default()
+                    });
+                }
                 Err(e) => return self.load_failed(el, format!("{name}: {e}")),
             }
         }
@@ -179,6 +193,14 @@ impl App {
         }
         println!("{}", f.summary());
         self.status = (f.pending > 0).then(|| format!("loading {} tiles", f.pending));
+        let mut counts = self.live.tiles.unwrap_or_default();
+        counts.selected = f.tiles;
+        counts.splats = f.splats;
+        counts.budget = f.budget;
+        counts.loading = f.pending;
+        counts.resident = f.resident_tiles;
+        counts.resident_mb = f.resident_bytes.div_ceil(1 << 20);
+        self.live.tiles = Some(counts);
         let (Some(shown), Some(tiles)) = (&mut self.shown, f.selection) else {
             self.update_title(true);
             return;
@@ -202,12 +224,18 @@ impl App {
         };
         let budget = self.opts.tiles.select.splat_budget;
         match paging::place(renderer, &win.gl, &mut shown.paged, &tiles, budget) {
-            Ok(p) => println!("{}", p.summary()),
+            Ok(p) => {
+                println!("{}", p.summary());
+                if let Some(t) = &mut self.live.tiles {
+                    (t.pages_used, t.pages) = (p.used, p.pages);
+                }
+            }
             Err(e) => return self.load_failed(el, e),
         }
         shown.orders = orders;
         shown.uploaded = None;
         shown.len = len;
+        (shown.facts.splats, shown.facts.file_splats, shown.file_len) = (len, len, len);
         shown.sh_degree = tiles.iter().map(|(_, c)| c.sh_degree).max().unwrap_or(0);
         self.update_title(true);
         self.request_redraw();

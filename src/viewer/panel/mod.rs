@@ -21,7 +21,7 @@ mod crop;
 mod model;
 mod ui;
 
-pub use model::{Action, Facts, Live, Settings};
+pub use model::{Action, Facts, Live, Settings, TileCounts};
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};

@@ -52,6 +52,26 @@ pub struct Live {
     /// CPU time of the interface in the last frame, ms: layout (egui's pass and
     /// tessellation; 0 when the previous layout was reused) and painting (GL calls).
     pub ui_ms: (f32, f32),
+    /// A streamed tileset's counts (`None` for other scenes).
+    pub tiles: Option<TileCounts>,
+}
+
+/// A streamed tileset's counts, as the last stream frame and page placement left them.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TileCounts {
+    /// Tiles selected, and their splats.
+    pub selected: usize,
+    pub splats: u64,
+    /// The splat budget (`--splat-budget`).
+    pub budget: u64,
+    /// Tiles the selection wants that are still loading.
+    pub loading: usize,
+    /// Tiles resident in the cache, and their megabytes (`--cache-mb`).
+    pub resident: usize,
+    pub resident_mb: u64,
+    /// GPU pages holding tiles, and allocated.
+    pub pages_used: usize,
+    pub pages: usize,
 }
 
 /// The settings the panel edits in place; the viewer applies what changed.

@@ -105,6 +105,25 @@ fn statistics(ui: &mut Ui, l: &Live, resident: usize) {
                     "interface CPU",
                     format!("{:.2} ms layout, {:.2} ms paint", l.ui_ms.0, l.ui_ms.1),
                 );
+                if let Some(t) = &l.tiles {
+                    row(
+                        "tiles",
+                        format!("{} selected, {} loading", t.selected, t.loading),
+                    );
+                    row(
+                        "tile splats",
+                        format!(
+                            "{} of {}",
+                            thousands(t.splats as usize),
+                            thousands(t.budget as usize)
+                        ),
+                    );
+                    row(
+                        "tile cache",
+                        format!("{} tiles, {} MB", t.resident, t.resident_mb),
+                    );
+                    row("GPU pages", format!("{} of {}", t.pages_used, t.pages));
+                }
             });
         });
 }
