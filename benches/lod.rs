@@ -4,7 +4,9 @@
 //! from a low camera looking across it. Reported per N: the build's time and peak memory,
 //! the render's time to first frame (load, selection, tile loads, draw) and peak memory, and
 //! the per-frame CPU time of selection and of assembling the selected tiles along a flight
-//! over the terrain (tiles already loaded: the frame's own work). The first N is the
+//! over the terrain (tiles already loaded: the frame's own work), and — with `--bench`, under
+//! `xvfb-run` — `splatgl view` of the tileset at the same budget: its frame times along an
+//! orbit while tiles stream, and its peak memory. The first N is the
 //! baseline: the others are given as ratios to it (peak memory should not grow with N).
 //!
 //! `cargo bench --bench lod` (`SPLATGL_BENCH_LOD_SPLATS`, default `10000000,30000000`; run
@@ -114,9 +116,62 @@ struct Row {
     select_ms: f64,
     assemble_ms: f64,
     selected: u64,
+    /// The viewer's (median, p99) frame ms and peak MB (`None`: not run).
+    viewed: Option<(f64, f64, u64)>,
 }
 
-fn measure(dir: &Path, n: u64) -> Row {
+/// `splatgl view` of the tileset under Xvfb (`--bench-frames 40 --orbit` from the render's
+/// camera, 640×360, the budget of the render): the viewer's median and p99 frame time and its
+/// peak memory (MB), as its `bench:` line reports them. `None` without `xvfb-run`.
+fn view_tileset(ts: &Path, look: &str) -> Option<(f64, f64, u64)> {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_splatgl"))
+        .args(["view", ts.to_str().unwrap(), "--splat-budget", "1000000"])
+        .args([
+            "--look-at",
+            look,
+            "--width",
+            "640",
+            "--height",
+            "360",
+            "--no-ui",
+        ])
+        .args(["--no-vsync", "--bench-frames", "40", "--orbit"])
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("bench: ") && l.contains("frames:"));
+    let Some(line) = line else {
+        panic!(
+            "view {}: no bench line: {text}{}",
+            ts.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let after = |key: &str| -> f64 {
+        let rest = line.split(key).nth(1).unwrap_or("");
+        rest.split_whitespace()
+            .next()
+            .and_then(|w| w.trim_end_matches(';').parse().ok())
+            .unwrap_or(f64::NAN)
+    };
+    let last = text
+        .lines()
+        .rev()
+        .find(|l| l.starts_with("tiles: "))
+        .unwrap_or("");
+    eprintln!("lod: view: {line} | {last}");
+    Some((
+        after("median "),
+        after("p99 "),
+        after("peak memory ") as u64,
+    ))
+}
+
+fn measure(dir: &Path, n: u64, view: bool) -> Row {
     let ply = dir.join(format!("terrain-{n}.ply"));
     let t = Instant::now();
     write_terrain(&ply, n);
@@ -196,6 +251,11 @@ fn measure(dir: &Path, n: u64) -> Row {
         assemble_s += t.elapsed().as_secs_f64();
         selected += cloud.len() as u64;
     }
+    let viewed = if view {
+        view_tileset(&ts_path, &look)
+    } else {
+        None
+    };
     if std::env::var("SPLATGL_BENCH_KEEP").as_deref() != Ok("1") {
         let _ = std::fs::remove_dir_all(&out);
     }
@@ -208,6 +268,7 @@ fn measure(dir: &Path, n: u64) -> Row {
         select_ms: select_s * 1e3 / frames as f64,
         assemble_ms: assemble_s * 1e3 / frames as f64,
         selected: selected / frames as u64,
+        viewed,
     }
 }
 
@@ -226,7 +287,9 @@ fn main() {
         .collect();
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("lod-bench");
     std::fs::create_dir_all(&dir).unwrap();
-    let rows: Vec<Row> = sizes.iter().map(|&n| measure(&dir, n)).collect();
+    // The viewer needs an X server (xvfb-run); the smoke run leaves it out.
+    let view = !smoke && Command::new("xvfb-run").arg("--help").output().is_ok();
+    let rows: Vec<Row> = sizes.iter().map(|&n| measure(&dir, n, view)).collect();
     println!(
         "{:>11} | {:>8} {:>9} | {:>11} {:>9} | {:>9} {:>10} {:>9}",
         "splats",
@@ -251,6 +314,14 @@ fn main() {
             r.selected
         );
     }
+    for r in &rows {
+        if let Some((med, p99, mb)) = r.viewed {
+            println!(
+                "{:>11} | view at budget 1000000, 640x360 orbit: frame ms median {med:.1} p99 {p99:.1}, peak memory {mb} MB",
+                r.n
+            );
+        }
+    }
     let base = &rows[0];
     for r in &rows[1..] {
         let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { f64::NAN };
@@ -266,6 +337,15 @@ fn main() {
             ratio(r.first_frame_s, base.first_frame_s),
             ratio(r.select_ms, base.select_ms),
         );
+        if let (Some(a), Some(b)) = (r.viewed, base.viewed) {
+            println!(
+                "{} vs {} splats: view memory {:.2}×, view frame time {:.2}×",
+                r.n,
+                base.n,
+                ratio(a.2 as f64, b.2 as f64),
+                ratio(a.0, b.0)
+            );
+        }
     }
     let _ = std::fs::remove_dir_all(dir.join("scratch"));
 }

@@ -54,12 +54,6 @@ fn image(
     img
 }
 
-fn context() -> Option<HeadlessContext> {
-    let ctx = or_skip(HeadlessContext::new(), "headless context")?;
-    ctx.make_current().unwrap();
-    Some(ctx)
-}
-
 /// A renderer with `cloud` uploaded, drawing without a depth test (the targets have none).
 fn uploaded(gl: &glow::Context, cloud: &SplatCloud) -> SplatRenderer {
     let mut r = SplatRenderer::new(gl).unwrap();
@@ -70,7 +64,7 @@ fn uploaded(gl: &glow::Context, cloud: &SplatCloud) -> SplatRenderer {
 
 #[test]
 fn draw_frame_draws_what_the_full_order_draws() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = current_context() else { return };
     let gl = ctx.gl();
     let (cloud, cam) = scene();
     let mut r = uploaded(gl, &cloud);
@@ -100,7 +94,7 @@ fn draw_frame_draws_what_the_full_order_draws() {
 
 #[test]
 fn draw_frame_in_the_background_draws_exact_or_bounded_orders() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = current_context() else { return };
     let gl = ctx.gl();
     let (cloud, cam) = scene();
     let mut r = uploaded(gl, &cloud);
@@ -135,7 +129,7 @@ fn draw_frame_in_the_background_draws_exact_or_bounded_orders() {
 
 #[test]
 fn draw_frame_refuses_what_it_cannot_draw() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = current_context() else { return };
     let gl = ctx.gl();
     let (cloud, cam) = scene();
     let (view, proj) = (cam.gl_view(), cam.gl_projection());

@@ -84,10 +84,7 @@ fn place(
 
 #[test]
 fn paged_tiles_draw_exactly_what_the_same_tiles_uploaded_whole_draw() {
-    let Some(ctx) = or_skip(HeadlessContext::new(), "headless context") else {
-        return;
-    };
-    ctx.make_current().unwrap();
+    let Some(ctx) = current_context() else { return };
     let gl = ctx.gl();
     let t = tiles();
     let mut whole = SplatRenderer::new(gl).unwrap();
@@ -122,10 +119,7 @@ fn paged_tiles_draw_exactly_what_the_same_tiles_uploaded_whole_draw() {
 
 #[test]
 fn page_writes_outside_the_pages_or_above_their_degree_are_errors() {
-    let Some(ctx) = or_skip(HeadlessContext::new(), "headless context") else {
-        return;
-    };
-    ctx.make_current().unwrap();
+    let Some(ctx) = current_context() else { return };
     let gl = ctx.gl();
     let cloud = synthetic::random_cloud(100, 3, 0.5, 1);
     let mut r = SplatRenderer::new(gl).unwrap();

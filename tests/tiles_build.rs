@@ -39,27 +39,9 @@ fn leaves(ts: &Tileset, cache: &mut TileCache) -> SplatCloud {
     cache.merged(&leaves)
 }
 
-fn render(cloud: &SplatCloud, cam: &Camera) -> splatgl::image::Image {
-    splatgl::reference::render(cloud, cam, &Default::default())
-}
-
-fn psnr(a: &splatgl::image::Image, b: &splatgl::image::Image) -> f64 {
-    splatgl::compare::compare(a, b, 1.0 / 255.0).unwrap().psnr
-}
-
 /// A camera at `distance` × the cloud's bounding radius from its centre, looking at it.
 fn camera_at(cloud: &SplatCloud, dir: Vec3, distance: f32) -> Camera {
-    let b = cloud.bounds().unwrap();
-    let c = Vec3::from(b.center());
-    let r = b.diagonal() / 2.0;
-    Camera::look_at(
-        c + dir.normalize() * r * distance,
-        c,
-        Vec3::Z,
-        50f32.to_radians(),
-        320,
-        240,
-    )
+    common::lod::camera_at(cloud, dir, distance, Vec3::Z)
 }
 
 #[test]
@@ -114,14 +96,7 @@ fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_f
             full.len()
         );
         // The same number of splats, every k-th of the whole scene.
-        let step = full.len() as f64 / lod.len() as f64;
-        let picked: Vec<u32> = (0..lod.len()).map(|i| (i as f64 * step) as u32).collect();
-        let uniform = full.select(&picked);
-        let reference = render(&full, &cam);
-        let (p_lod, p_uniform) = (
-            psnr(&render(&lod, &cam), &reference),
-            psnr(&render(&uniform, &cam), &reference),
-        );
+        let (p_lod, p_uniform) = common::lod::lod_and_uniform_psnr(&full, &lod, &cam);
         report.push(format!(
             "{distance}× radius: {} tiles, {} of {} splats: LOD {p_lod:.1} dB, uniform {p_uniform:.1} dB",
             sel.tiles.len(),

@@ -8,6 +8,7 @@
 
 mod common;
 use common::cli::run;
+use common::lod::render;
 use glam::Vec3;
 use splatgl::SplatCloud;
 use splatgl::camera::Camera;
@@ -86,27 +87,9 @@ fn streamed() -> Option<&'static (PathBuf, PathBuf)> {
         .as_ref()
 }
 
-fn render(cloud: &SplatCloud, cam: &Camera) -> splatgl::image::Image {
-    splatgl::reference::render(cloud, cam, &Default::default())
-}
-
-fn psnr(a: &splatgl::image::Image, b: &splatgl::image::Image) -> f64 {
-    splatgl::compare::compare(a, b, 1.0 / 255.0).unwrap().psnr
-}
-
 /// A camera at `distance` × the cloud's bounding radius from its centre, looking at it.
 fn camera_at(cloud: &SplatCloud, dir: Vec3, distance: f32) -> Camera {
-    let b = cloud.bounds().unwrap();
-    let c = Vec3::from(b.center());
-    let r = b.diagonal() / 2.0;
-    Camera::look_at(
-        c + dir.normalize() * r * distance,
-        c,
-        -Vec3::Y,
-        50f32.to_radians(),
-        320,
-        240,
-    )
+    common::lod::camera_at(cloud, dir, distance, -Vec3::Y)
 }
 
 #[test]
@@ -142,14 +125,7 @@ fn far_views_of_a_streamed_sog_beat_uniform_decimation_and_a_close_view_is_fines
         let sel = splatgl::tiles::select(&ts, &cam, &select, &mut |t| cache.splats(t)).unwrap();
         let lod = cache.merged(&sel.tiles);
         assert!(cache.warnings.is_empty(), "{:?}", cache.warnings);
-        let step = full.len() as f64 / lod.len() as f64;
-        let picked: Vec<u32> = (0..lod.len()).map(|i| (i as f64 * step) as u32).collect();
-        let uniform = full.select(&picked);
-        let reference = render(&full, &cam);
-        let (p_lod, p_uniform) = (
-            psnr(&render(&lod, &cam), &reference),
-            psnr(&render(&uniform, &cam), &reference),
-        );
+        let (p_lod, p_uniform) = common::lod::lod_and_uniform_psnr(&full, &lod, &cam);
         report.push(format!(
             "{distance}× radius: {} tiles, {} of {} splats: streamed SOG {p_lod:.1} dB, uniform {p_uniform:.1} dB",
             sel.tiles.len(),

@@ -71,14 +71,7 @@ impl Progress {
     }
 }
 
-/// The process's peak resident memory so far, in bytes (`VmHWM` of `/proc/self/status`;
-/// `None` where there is no such file).
-pub fn peak_memory() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
+pub use splatgl::files::peak_memory;
 
 /// [`peak_memory`] for a message: `", peak memory 123 MB"`, or nothing.
 pub fn peak_memory_note() -> String {

@@ -152,9 +152,12 @@ impl BenchLog {
                  (median {lmed:.3} p99 {lp99:.3}), paint median {pmed:.3}"
             )
         };
+        let peak = crate::files::peak_memory().map_or(String::new(), |b| {
+            format!("; peak memory {} MB", b.div_ceil(1 << 20))
+        });
         format!(
             "bench: {what}: {n} frames: frame ms min {min:.2} median {med:.2} p99 {p99:.2}; \
-             sort ms median {smed:.2} p99 {sp99:.2}; orders exact {} stale {} waited {}{ui}\n\
+             sort ms median {smed:.2} p99 {sp99:.2}; orders exact {} stale {} waited {}{ui}{peak}\n\
              bench: GL: {gl_info}",
             self.exact, self.stale, self.waited
         )

@@ -205,3 +205,10 @@ pub fn both_targets() -> [HeadlessOptions; 2] {
         },
     ]
 }
+
+/// A headless context made current (`None`: skipped, see [`or_skip`]).
+pub fn current_context() -> Option<HeadlessContext> {
+    let ctx = or_skip(HeadlessContext::new(), "headless context")?;
+    ctx.make_current().unwrap();
+    Some(ctx)
+}

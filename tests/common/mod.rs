@@ -16,6 +16,7 @@ pub mod cli;
 pub mod gl;
 #[cfg(feature = "http")]
 pub mod http;
+pub mod lod;
 pub mod packed;
 #[cfg(feature = "cli")]
 pub mod third_party;
