@@ -637,6 +637,7 @@ fn degenerate_cameras_do_not_panic() {
 }
 
 /// Bit patterns of an image's pixels (f32 equality would let −0 = +0 and NaN ≠ NaN pass).
+#[cfg(feature = "testing")] // used only by the path tests below
 fn pixel_bits(img: &Image) -> Vec<u32> {
     img.pixels.iter().flatten().map(|v| v.to_bits()).collect()
 }

@@ -150,7 +150,10 @@ mod tests {
             &crate::gl::data::TextureLayout::for_limits(2048, 1),
             RESOLVE_FRAG,
         );
-        let program = build_program(gl, "resolve", &v, &f).unwrap();
+        // build_program_in, not build_program: the latter exists only with feature `testing`.
+        let mut objects = Creating::new(gl);
+        let program = build_program_in(&mut objects, "resolve", &v, &f).unwrap();
+        objects.release();
         let all = uniform_locations(gl, program, "resolve", ["u_accum", "u_origin"], true);
         assert!(all.iter().all(Option::is_some));
         let renamed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
