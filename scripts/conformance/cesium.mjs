@@ -50,56 +50,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { renderSuite } from './common.mjs';
-
-// A GLB's JSON (first chunk) and BIN (second chunk, if any); .gltf: the JSON alone.
-const readGlb = (d) => {
-  if (d.length >= 20 && d.readUInt32LE(0) === 0x46546c67) {
-    const len = d.readUInt32LE(12);
-    const json = JSON.parse(d.subarray(20, 20 + len).toString('utf8'));
-    const at = 20 + len;
-    const bin = d.length >= at + 8 ? d.subarray(at + 8, at + 8 + d.readUInt32LE(at)) : null;
-    return { json, bin };
-  }
-  return { json: JSON.parse(d.toString('utf8')), bin: null };
-};
-const writeGlb = (json, bin) => {
-  let js = Buffer.from(JSON.stringify(json), 'utf8');
-  js = Buffer.concat([js, Buffer.alloc((4 - (js.length % 4)) % 4, 0x20)]);
-  const chunks = [Buffer.alloc(8), js];
-  chunks[0].writeUInt32LE(js.length, 0);
-  chunks[0].writeUInt32LE(0x4e4f534a, 4);
-  if (bin) {
-    const b = Buffer.concat([bin, Buffer.alloc((4 - (bin.length % 4)) % 4, 0)]);
-    const h = Buffer.alloc(8);
-    h.writeUInt32LE(b.length, 0);
-    h.writeUInt32LE(0x004e4942, 4);
-    chunks.push(h, b);
-  }
-  const body = Buffer.concat(chunks);
-  const header = Buffer.alloc(12);
-  header.writeUInt32LE(0x46546c67, 0);
-  header.writeUInt32LE(2, 4);
-  header.writeUInt32LE(12 + body.length, 8);
-  return Buffer.concat([header, body]);
-};
-
-// Step 2 above: the placeholders CesiumJS 1.145 expects, the SPZ payload unchanged.
-const PREFIX = 'KHR_gaussian_splatting:';
-function cesiumPlaceholders(json) {
-  const prims = json.meshes.flatMap((m) => m.primitives);
-  if (prims.length !== 1) throw new Error(`${prims.length} primitives after convert (expected 1)`);
-  const attrs = prims[0].attributes;
-  const count = json.accessors[attrs.POSITION].count;
-  delete attrs[`${PREFIX}OPACITY`];
-  delete attrs[`${PREFIX}SH_DEGREE_0_COEF_0`];
-  json.accessors.push({ componentType: 5121, normalized: true, count, type: 'VEC4' });
-  attrs.COLOR_0 = json.accessors.length - 1;
-  for (const n of json.nodes) if (n.mesh !== undefined && !n.matrix && !n.translation && !n.rotation && !n.scale) {
-    n.matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
-  }
-  return json.accessors[attrs.POSITION];
-}
+import { renderSuite, readGlb, writeGlb } from './common.mjs';
+import { cesiumPlaceholders, IDENTITY } from './cesium-gltf.mjs';
 
 // Where the glTF's world frame goes: the east-north-up frame at longitude 0, latitude 0,
 // height 0 (ECEF (R, 0, 0), R = 6378137 m; east (0, 1, 0), north (0, 0, 1), up (1, 0, 0),
@@ -141,7 +93,7 @@ function tilesetOf(a, { suite, splatgl, dir }) {
   const glb = path.join(dir, 'content.glb');
   execFileSync(splatgl, ['convert', path.join(suite, a.file), glb, '--spz-compress', '-f'], { stdio: 'pipe' });
   const { json, bin } = readGlb(fs.readFileSync(glb));
-  const pos = cesiumPlaceholders(json);
+  const pos = cesiumPlaceholders(json, IDENTITY);
   fs.writeFileSync(glb, writeGlb(json, bin));
   // Bounding sphere of the decoded positions (POSITION min/max: glTF axes, as a reader
   // converting RUB decodes them; D turns them to the payload's), in the tile's frame (after

@@ -26,15 +26,40 @@ import { fileURLToPath } from 'node:url';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 
-// The glTF JSON of an asset (.glb: its first chunk; .gltf: the file), for its cameras' znear.
-export const gltfJson = (file) => {
-  const d = fs.readFileSync(file);
+// A GLB's JSON (first chunk) and BIN (second chunk, if any); .gltf: the JSON alone.
+export const readGlb = (d) => {
   if (d.length >= 20 && d.readUInt32LE(0) === 0x46546c67) {
     const len = d.readUInt32LE(12);
-    return JSON.parse(d.subarray(20, 20 + len).toString('utf8'));
+    const json = JSON.parse(d.subarray(20, 20 + len).toString('utf8'));
+    const at = 20 + len;
+    const bin = d.length >= at + 8 ? d.subarray(at + 8, at + 8 + d.readUInt32LE(at)) : null;
+    return { json, bin };
   }
-  return JSON.parse(d.toString('utf8'));
+  return { json: JSON.parse(d.toString('utf8')), bin: null };
 };
+export const writeGlb = (json, bin) => {
+  let js = Buffer.from(JSON.stringify(json), 'utf8');
+  js = Buffer.concat([js, Buffer.alloc((4 - (js.length % 4)) % 4, 0x20)]);
+  const chunks = [Buffer.alloc(8), js];
+  chunks[0].writeUInt32LE(js.length, 0);
+  chunks[0].writeUInt32LE(0x4e4f534a, 4);
+  if (bin) {
+    const b = Buffer.concat([bin, Buffer.alloc((4 - (bin.length % 4)) % 4, 0)]);
+    const h = Buffer.alloc(8);
+    h.writeUInt32LE(b.length, 0);
+    h.writeUInt32LE(0x004e4942, 4);
+    chunks.push(h, b);
+  }
+  const body = Buffer.concat(chunks);
+  const header = Buffer.alloc(12);
+  header.writeUInt32LE(0x46546c67, 0);
+  header.writeUInt32LE(2, 4);
+  header.writeUInt32LE(12 + body.length, 8);
+  return Buffer.concat([header, body]);
+};
+
+// The glTF JSON of an asset (.glb: its first chunk; .gltf: the file), for its cameras' znear.
+export const gltfJson = (file) => readGlb(fs.readFileSync(file)).json;
 
 // The default `prepare`: the asset as INRIA PLY, in the axes its numbers are written in.
 const plyOf = (a, { suite, splatgl, dir }) => {
@@ -109,6 +134,16 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
     }
   }
 
+  renderViews({ name, page, prefix, views, tmp, out, mounts, chromiumArgs, limitS, npm });
+}
+
+// Serves `page` (next to this module), views.json, the prepared files in `tmp` (/files/), the
+// npm tools (/npm/) and `mounts` from 127.0.0.1 to headless Chromium, writes each image the
+// page POSTs back as OUT/IMAGE.png (only the views' own image names), and exits with 0 when
+// every view came back, else 1; `tmp` is removed once chromium has exited.
+export function renderViews({ name, page, prefix, views, tmp, out, mounts = {}, chromiumArgs = [],
+                              limitS = 600, npm = path.join(process.env.SPLATGL_ROOT || path.resolve(here, '../..'), '.npm-tools/node_modules') }) {
+  const me = `${name}.mjs`;
   const send = (res, code, type, body) => { res.writeHead(code, { 'content-type': type }); res.end(body); };
   const inside = (base, rel) => {
     const p = path.resolve(base, '.' + path.posix.normalize('/' + rel));
