@@ -1,6 +1,7 @@
 //! The converter's library half (`splatgl convert`): a loaded cloud → an RC-conformant glTF
 //! (`.glb`, `.gltf`; a `.glb` with `KHR_gaussian_splatting_compression_spz_2` under
-//! `--spz-compress`), an INRIA PLY, Niantic SPZ (v2–v4) or antimatter15 `.splat`, with
+//! `--spz-compress`), an INRIA PLY, Niantic SPZ (v2–v4), antimatter15 `.splat` or PlayCanvas
+//! SOG (`.sog`), with
 //! optional quantization, SH truncation, a rotation (e.g. a y-down capture to glTF's +Y up)
 //! and colour-space relabelling.
 //!
@@ -32,6 +33,8 @@ pub enum OutputFormat {
     Spz,
     /// antimatter15 `.splat` (32 bytes per splat, SH degree 0).
     Splat,
+    /// PlayCanvas SOG v2 (`.sog`: lossless WebP textures in a zip; see [`write::to_sog_files`]).
+    Sog,
 }
 
 /// Output formats by file extension (lower case).
@@ -41,6 +44,7 @@ pub const OUTPUTS: &[(&str, OutputFormat)] = &[
     ("ply", OutputFormat::Ply),
     ("spz", OutputFormat::Spz),
     ("splat", OutputFormat::Splat),
+    ("sog", OutputFormat::Sog),
 ];
 
 impl OutputFormat {
@@ -324,6 +328,7 @@ pub fn encode_with_cameras(
     let spz_err = |e: write::SpzWriteError| format!("cannot write SPZ: {e}");
     match format {
         OutputFormat::Ply => return Ok((write::to_inria_ply(cloud), notes)),
+        OutputFormat::Sog => return Ok((write::to_sog_bundle(cloud)?, notes)),
         OutputFormat::Spz => {
             return Ok((write::to_spz(cloud, o.spz_version).map_err(spz_err)?, notes));
         }

@@ -447,3 +447,76 @@ fn glb_spz_axes_follow_position_bounds() {
         "{w:?}"
     );
 }
+
+/// The SOG writer (`splatgl::write::to_sog_files`, k-means codebooks): positions, rotations and
+/// opacities within SOG's fixed steps (as the test encoder's), ln scales, DC and SH on the
+/// nearest entry of the codebooks its meta.json carries; bundled and unbundled decode alike.
+/// Past 65,536 splats the SH palette is a median cut: exactly 65,536 entries, rms error a few
+/// percent of the SH's.
+#[test]
+fn sog_writer_round_trips_onto_its_codebooks_and_palettes_large_clouds() {
+    let cloud = random_cloud(700, 3, 5.0, 17);
+    let files = splatgl::write::to_sog_files(&cloud).unwrap();
+    assert_eq!(files[0].0, "meta.json");
+    let meta: serde_json::Value = serde_json::from_slice(&files[0].1).unwrap();
+    let book = |k: &str| -> Vec<f32> {
+        let v = if k == "shN" { &meta["shN"] } else { &meta[k] };
+        v["codebook"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap() as f32)
+            .collect()
+    };
+    let nearest = |b: &[f32], v: f32| b.iter().map(|c| (c - v).abs()).fold(f32::MAX, f32::min);
+    let l = load(&splatgl::write::to_sog_bundle(&cloud).unwrap(), "x.sog");
+    let mut bounds = sog_bounds(&cloud);
+    // ln scale, DC and SH are checked against the codebooks below instead.
+    (bounds.log_scale, bounds.dc, bounds.sh) = (f32::MAX, f32::MAX, [f32::MAX; 3]);
+    check("SOG writer", &cloud, &l.cloud, &bounds);
+    let (scales, dc, sh) = (book("scales"), book("sh0"), book("shN"));
+    for i in 0..cloud.len() {
+        for a in 0..3 {
+            let v = cloud.scales[i][a].ln();
+            assert!((l.cloud.scales[i][a].ln() - v).abs() <= nearest(&scales, v) + 1e-4);
+            let v = cloud.sh_of(i)[0][a];
+            assert!((l.cloud.sh_of(i)[0][a] - v).abs() <= nearest(&dc, v) + 1e-5);
+        }
+        let pairs = cloud.sh_of(i).iter().zip(l.cloud.sh_of(i)).enumerate();
+        for (j, (c, got)) in pairs.skip(1) {
+            for (v, g) in c.iter().zip(got) {
+                let d = (g - v).abs();
+                assert!(d <= nearest(&sh, *v) + 1e-5, "splat {i} coefficient {j}");
+            }
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("splatgl-sog-writer-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes) in &files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let u = load_path(dir.join("meta.json"), &LoadOptions::default()).unwrap();
+    assert_eq!(u.cloud, l.cloud, "both forms decode identically");
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let big = random_cloud(70_000, 1, 5.0, 18);
+    let files = splatgl::write::to_sog_files(&big).unwrap();
+    let meta: serde_json::Value = serde_json::from_slice(&files[0].1).unwrap();
+    assert_eq!(meta["shN"]["count"], 65_536);
+    let back = load(&splatgl::write::to_sog_bundle(&big).unwrap(), "big.sog").cloud;
+    let (mut err, mut energy) = (0f64, 0f64);
+    for i in 0..big.len() {
+        for (a, b) in big.sh_of(i)[1..].iter().zip(&back.sh_of(i)[1..]) {
+            for ch in 0..3 {
+                err += ((a[ch] - b[ch]) as f64).powi(2);
+                energy += (a[ch] as f64).powi(2);
+            }
+        }
+    }
+    let rms = (err / energy).sqrt();
+    eprintln!(
+        "SOG writer, 70,000 splats: SH rms error {:.1} % of the SH",
+        100.0 * rms
+    );
+    assert!(rms < 0.15, "SH rms error {rms}");
+}

@@ -6,8 +6,9 @@
 //! compressed PLY by splat-transform, and to `.ksplat` levels 0-2 by GaussianSplats3D; splatgl
 //! loads each and compares with its own load of the PLY, splat by splat (matched by position:
 //! SOG, compressed PLY and `.ksplat` reorder), within each format's quantization error as
-//! docs/formats.md derives it. Reverse: splat-transform reads the `.splat` and `.spz` (v2, v3,
-//! v4) splatgl writes, and its PLY output matches splatgl's input within the same bounds.
+//! docs/formats.md derives it. Reverse: splat-transform reads the `.splat`, `.spz` (v2, v3,
+//! v4) and `.sog` splatgl writes, and its PLY output matches splatgl's input within the same
+//! bounds.
 //!
 //! splat-transform 3.x stores SPZ numbers in PLY axes, without Niantic's RUB conversion; the
 //! test reads its SPZ raw and checks that our Niantic-axes files come back turned by 180°
@@ -23,7 +24,9 @@ use common::random_cloud;
 use splatgl::SplatCloud;
 use splatgl::load::spz::SpzAxes;
 use splatgl::load::{LoadOptions, load_bytes};
-use splatgl::write::{SpzVersion, SpzWriteOptions, to_inria_ply, to_splat, to_spz_with};
+use splatgl::write::{
+    SpzVersion, SpzWriteOptions, to_inria_ply, to_sog_bundle, to_splat, to_spz_with,
+};
 use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -282,6 +285,16 @@ fn splat_transform_and_splatgl_agree_on_every_format() {
             sh: Some([0.0; 3]),
         },
     );
+    // Our SOG writer (k-means codebooks, one palette entry per splat): splat-transform's
+    // decode is within the same bounds of the PLY as its own files are.
+    std::fs::write(f("ours.sog"), to_sog_bundle(&cloud).unwrap()).unwrap();
+    convert(&st, &f("ours.sog"), &f("back_sog.ply"), &[]);
+    sog_check(
+        "splatgl .sog → splat-transform",
+        &f("ours.sog"),
+        &ply,
+        &load(&f("back_sog.ply")),
+    );
     for version in 2..=4u32 {
         for axes in [SpzAxes::Raw, SpzAxes::Rub] {
             let o = SpzWriteOptions {
@@ -412,7 +425,18 @@ fn compressed_ply(st: &Path, f: &dyn Fn(&str) -> PathBuf, ply: &SplatCloud) {
 /// a decode with channels or coefficients mixed up about 140 %; SPZ's 4-bit SH is ~30 %).
 fn sog(st: &Path, f: &dyn Fn(&str) -> PathBuf, ply: &SplatCloud) {
     convert(st, &f("in.ply"), &f("st.sog"), &[]);
-    let bytes = std::fs::read(f("st.sog")).unwrap();
+    sog_check(
+        "splat-transform .sog",
+        &f("st.sog"),
+        ply,
+        &load(&f("st.sog")),
+    );
+}
+
+/// `got` (a decode of the SOG bundle `sog`, by splatgl or splat-transform) against `ply`
+/// within the bounds of [`sog`], the codebooks taken from `sog`'s meta.json.
+fn sog_check(name: &str, sog: &Path, ply: &SplatCloud, got: &SplatCloud) {
+    let bytes = std::fs::read(sog).unwrap();
     let zip = splatgl::load::sog::zip::Archive::new(&bytes).unwrap();
     let meta: serde_json::Value =
         serde_json::from_slice(&zip.read("meta.json", &mut u64::MAX.clone()).unwrap()).unwrap();
@@ -440,7 +464,7 @@ fn sog(st: &Path, f: &dyn Fn(&str) -> PathBuf, ply: &SplatCloud) {
         opacity: 1.0 / 255.0 + 1e-6,
         sh: None,
     };
-    compare("splat-transform .sog", ply, &load(&f("st.sog")), &tol);
+    compare(name, ply, got, &tol);
 }
 
 /// `.ksplat` from GaussianSplats3D (SH degree 2, its maximum): level 0 f32 (colour and opacity

@@ -23,10 +23,12 @@ pub use atomic::{refuse_overwriting_inputs, write_atomic, write_bytes_atomic};
 pub use comp::Comp;
 pub use ply::{to_inria_ply, to_inria_ply_with_normals};
 mod glb_spz;
+mod sog;
 mod splat;
 mod spz;
 pub(crate) use glb_spz::build_glb_spz;
 pub use glb_spz::{to_glb_spz, to_glb_spz_with};
+pub use sog::{SogFiles, to_sog_bundle, to_sog_files};
 pub use splat::to_splat;
 pub use spz::{SpzVersion, SpzWriteError, SpzWriteOptions, to_spz, to_spz_with};
 
