@@ -19,12 +19,28 @@ fn dir(name: &str) -> PathBuf {
 
 /// `convert input d/tileset.json` with `extra`; the tileset read back.
 fn build(input: &Path, d: &Path, extra: &[&str]) -> Tileset {
-    let out = d.join("tileset.json");
+    build_as(input, d, "tileset.json", extra)
+}
+
+/// `convert input d/NAME` (`tileset.json`: 3D Tiles; `lod-meta.json`: streamed SOG) with
+/// `extra`; the tree read back.
+fn build_as(input: &Path, d: &Path, name: &str, extra: &[&str]) -> Tileset {
+    let out = d.join(name);
     let mut args = vec!["convert", input.to_str().unwrap(), out.to_str().unwrap()];
     args.extend_from_slice(extra);
     let r = run(&args);
     assert_eq!(r.code, 0, "{}", r.all());
-    assert!(r.stderr.contains("tiles in"), "{}", r.all());
+    assert!(
+        r.stderr.contains("tiles in") || r.stderr.contains("streamed SOG: "),
+        "{}",
+        r.all()
+    );
+    let v = run(&["validate", out.to_str().unwrap()]);
+    assert!(
+        v.out().contains("valid (0 errors, 0 warnings)"),
+        "{}",
+        v.all()
+    );
     splatgl::tiles::read(&out, &Default::default()).unwrap()
 }
 
@@ -39,11 +55,6 @@ fn leaves(ts: &Tileset, cache: &mut TileCache) -> SplatCloud {
     cache.merged(&leaves)
 }
 
-/// A camera at `distance` × the cloud's bounding radius from its centre, looking at it.
-fn camera_at(cloud: &SplatCloud, dir: Vec3, distance: f32) -> Camera {
-    common::lod::camera_at(cloud, dir, distance, Vec3::Z)
-}
-
 #[test]
 fn a_built_tileset_validates_and_its_leaves_are_the_input() {
     let d = dir("leaves");
@@ -51,12 +62,6 @@ fn a_built_tileset_validates_and_its_leaves_are_the_input() {
     let cloud = common::random_cloud(3000, 2, 1.0, 11);
     std::fs::write(&input, splatgl::write::to_glb(&cloud, &Default::default())).unwrap();
     let ts = build(&input, &d, &["--chunk-splats", "256"]);
-    let v = run(&["validate", d.join("tileset.json").to_str().unwrap()]);
-    assert!(
-        v.out().contains("valid (0 errors, 0 warnings)"),
-        "{}",
-        v.all()
-    );
     let mut cache = TileCache::new(&ts, &Default::default());
     let all = leaves(&ts, &mut cache);
     assert_eq!(all.len(), cloud.len());
@@ -74,20 +79,17 @@ fn a_built_tileset_validates_and_its_leaves_are_the_input() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-#[test]
-fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_finest() {
-    let Some(biker) = common::real("playcanvas_biker.compressed.ply") else {
-        return;
-    };
-    let d = dir("biker");
-    let ts = build(&biker, &d, &["--chunk-splats", "8192"]);
-    let mut cache = TileCache::new(&ts, &Default::default());
-    let full = leaves(&ts, &mut cache);
+/// Far views of the biker's LOD tree `ts` (leaves in the tileset's frame, `dir` and `up` the
+/// same view in it): the coarse selection stays ≥ 30 dB from the whole scene and above uniform
+/// decimation to the same count. Its per-distance report.
+fn far_views_beat_uniform_decimation(ts: &Tileset, dir: Vec3, up: Vec3) -> Vec<String> {
+    let mut cache = TileCache::new(ts, &Default::default());
+    let full = leaves(ts, &mut cache);
     let select = SelectOptions::default();
     let mut report = Vec::new();
     for distance in [6.0, 3.0, 2.0, 1.5, 1.2] {
-        let cam = camera_at(&full, Vec3::new(0.3, -1.0, 0.4), distance);
-        let sel = splatgl::tiles::select(&ts, &cam, &select, &mut |t| cache.splats(t)).unwrap();
+        let cam = common::lod::camera_at(&full, dir, distance, up);
+        let sel = splatgl::tiles::select(ts, &cam, &select, &mut |t| cache.splats(t)).unwrap();
         let lod = cache.merged(&sel.tiles);
         assert!(
             lod.len() < full.len() / 2,
@@ -95,7 +97,6 @@ fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_f
             lod.len(),
             full.len()
         );
-        // The same number of splats, every k-th of the whole scene.
         let (p_lod, p_uniform) = common::lod::lod_and_uniform_psnr(&full, &lod, &cam);
         report.push(format!(
             "{distance}× radius: {} tiles, {} of {} splats: LOD {p_lod:.1} dB, uniform {p_uniform:.1} dB",
@@ -107,6 +108,47 @@ fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_f
         assert!(p_lod >= 30.0, "{report:?}");
         assert!(p_lod > p_uniform + 1.0, "{report:?}");
     }
+    report
+}
+
+/// The biker as a streamed SOG (`convert … lod-meta.json`, SOG units in the PLY's own frame):
+/// it validates, its finest level is the whole scene within SOG's quantization, and far
+/// views of it beat uniform decimation as the 3D Tiles tileset's do (the same views: the
+/// tileset's (0.3, −1, 0.4) with +Z up is (−0.3, −0.4, 1) with −Y up in the PLY's frame).
+#[test]
+fn a_built_streamed_sog_validates_and_its_far_views_beat_uniform_decimation() {
+    let Some(biker) = common::real("playcanvas_biker.compressed.ply") else {
+        return;
+    };
+    let d = dir("biker-sog");
+    let ts = build_as(&biker, &d, "lod-meta.json", &["--chunk-splats", "8192"]);
+    let mut cache = TileCache::new(&ts, &Default::default());
+    let finest = leaves(&ts, &mut cache);
+    let whole = splatgl::load::load_path(&biker, &Default::default())
+        .unwrap()
+        .cloud;
+    assert_eq!(finest.len(), whole.len());
+    let cam = common::lod::camera_at(&whole, Vec3::new(-0.3, -0.4, 1.0), 2.0, -Vec3::Y);
+    let p = common::lod::psnr(
+        &common::lod::render(&finest, &cam),
+        &common::lod::render(&whole, &cam),
+    );
+    assert!(p >= 50.0, "finest level vs the PLY: {p:.1} dB");
+    far_views_beat_uniform_decimation(&ts, Vec3::new(-0.3, -0.4, 1.0), -Vec3::Y);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_far_view_of_the_coarse_tiles_beats_uniform_decimation_and_a_close_view_is_finest() {
+    let Some(biker) = common::real("playcanvas_biker.compressed.ply") else {
+        return;
+    };
+    let d = dir("biker");
+    let ts = build(&biker, &d, &["--chunk-splats", "8192"]);
+    far_views_beat_uniform_decimation(&ts, Vec3::new(0.3, -1.0, 0.4), Vec3::Z);
+    let mut cache = TileCache::new(&ts, &Default::default());
+    let full = leaves(&ts, &mut cache);
+    let select = SelectOptions::default();
     // Inside the scene every tile in view refines: the selection is leaves only.
     let b = full.bounds().unwrap();
     let inside = Camera::look_at(
@@ -304,5 +346,40 @@ fn a_small_cache_evicts_yet_every_frame_draws_the_same_splats_whatever_the_load_
         small.loads,
         unlimited.loads
     );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A streamed SOG output is built in memory and holds SOG units: the options it cannot honour
+/// are errors that say so, before anything is written.
+#[test]
+fn a_streamed_sog_output_refuses_what_it_cannot_write() {
+    let d = dir("sog-refusals");
+    let input = d.join("in.ply");
+    std::fs::write(
+        &input,
+        splatgl::write::to_inria_ply(&common::random_cloud(100, 0, 1.0, 3)),
+    )
+    .unwrap();
+    let out = d.join("lod-meta.json");
+    let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
+    let scratch = d.join("scratch");
+    for (extra, says) in [
+        (
+            vec!["--scratch-dir", scratch.to_str().unwrap()],
+            "built in memory",
+        ),
+        (
+            vec!["--spz-compress"],
+            "--spz-compress applies to .glb outputs only",
+        ),
+        (vec!["--quantize", "scale=u8n"], "--quantize applies to"),
+    ] {
+        let mut args = vec!["convert", i, o];
+        args.extend(extra);
+        let r = run(&args);
+        assert_eq!(r.code, 2, "{}", r.all());
+        assert!(r.stderr.contains(says), "{}", r.all());
+        assert!(!out.exists());
+    }
     let _ = std::fs::remove_dir_all(&d);
 }

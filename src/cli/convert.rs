@@ -1,6 +1,7 @@
 //! `splatgl convert IN OUT`: any readable splat file → `.glb` / `.gltf` (RC-conformant) or
 //! `.ply` (INRIA), through [`splatgl::convert`].
 
+use super::convert_lod::TreeOutput;
 use splatgl::SplatCloud;
 use splatgl::cloud::ColorSpace;
 use splatgl::convert::{self, ConvertOptions, OutputFormat, Quantize, Up};
@@ -14,9 +15,11 @@ use std::time::Instant;
 pub struct Args {
     /// Input file (any format splatgl reads).
     pub input: PathBuf,
-    /// Output file: .glb, .gltf (KHR_gaussian_splatting RC), .ply (INRIA 3DGS), .spz (Niantic)
-    /// or .splat (antimatter15); or a 3D Tiles 1.1 LOD tileset, OUT ending in .json
-    /// (e.g. out/tileset.json, its tiles' .glb content in out/tiles/; docs/lod.md).
+    /// Output file: .glb, .gltf (KHR_gaussian_splatting RC), .ply (INRIA 3DGS), .spz (Niantic),
+    /// .splat (antimatter15) or .sog (PlayCanvas SOG v2); or a LOD tree: OUT named
+    /// lod-meta.json a PlayCanvas streamed SOG (its SOG units in folders beside it), any other
+    /// OUT ending in .json a 3D Tiles 1.1 tileset (e.g. out/tileset.json, its tiles' .glb
+    /// content in out/tiles/); docs/lod.md.
     pub output: PathBuf,
     /// Store an attribute as an integer type (glTF outputs), ATTR=TYPE, comma-separated or
     /// repeated: position=i8|i8n|u8|u8n|i16|i16n|u16|u16n (KHR_mesh_quantization with a
@@ -239,10 +242,21 @@ pub(super) fn write_output(
 
 fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
-    let tileset = super::convert_lod::is_tileset_output(&a.output)?;
-    let format = if tileset {
+    let tree = super::convert_lod::tree_output(&a.output);
+    let tileset = tree.is_some();
+    let format = if let Some(kind) = tree {
         super::convert_lod::check_args(a)?;
-        OutputFormat::Glb
+        match kind {
+            TreeOutput::Tiles3d => OutputFormat::Glb,
+            TreeOutput::LodMeta if a.scratch_dir.is_some() => {
+                return Err(format!(
+                    "{}: a streamed SOG is built in memory; --scratch-dir builds 3D Tiles \
+                     tilesets (e.g. out/tileset.json) only",
+                    a.output.display()
+                ));
+            }
+            TreeOutput::LodMeta => OutputFormat::Sog,
+        }
     } else {
         OutputFormat::from_path(&a.output).ok_or_else(|| {
             let exts: Vec<&str> = convert::OUTPUTS.iter().map(|(e, _)| *e).collect();
@@ -311,8 +325,8 @@ fn go(a: &Args) -> Result<(), String> {
         cameras.push(node);
     }
     let cloud = rotate(cloud, r, &p)?;
-    if tileset {
-        return super::convert_lod::write_tileset(a, &cloud, &o, &p, t0);
+    if let Some(kind) = tree {
+        return super::convert_lod::write_tree(a, kind, &cloud, &o, &p, t0);
     }
     p.stage("encoding");
     let (bytes, notes) = convert::encode_with_cameras(&cloud, format, &o, &cameras)?;

@@ -17,20 +17,26 @@ use std::time::Instant;
 /// The folder, next to the tileset, that holds the tiles' content.
 const TILES_DIR: &str = "tiles";
 
-/// Whether OUT asks for a tileset (a `.json` file); a streamed SOG `lod-meta.json` is an
-/// error for now.
-pub(super) fn is_tileset_output(out: &Path) -> Result<bool, String> {
+/// The kind of LOD tree an output asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum TreeOutput {
+    /// A 3D Tiles 1.1 tileset (OUT ending in `.json`, e.g. `out/tileset.json`).
+    Tiles3d,
+    /// A streamed SOG (OUT named `lod-meta.json`).
+    LodMeta,
+}
+
+/// The LOD tree OUT asks for, if any: `lod-meta.json` a streamed SOG, any other `.json` a 3D
+/// Tiles tileset.
+pub(super) fn tree_output(out: &Path) -> Option<TreeOutput> {
     let json = out
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    if json && out.file_name().is_some_and(|n| n == "lod-meta.json") {
-        return Err(format!(
-            "{}: writing streamed SOG (lod-meta.json) is not supported yet; write a 3D Tiles \
-             tileset (e.g. out/tileset.json)",
-            out.display()
-        ));
+    match (json, out.file_name().is_some_and(|n| n == "lod-meta.json")) {
+        (true, true) => Some(TreeOutput::LodMeta),
+        (true, false) => Some(TreeOutput::Tiles3d),
+        _ => None,
     }
-    Ok(json)
 }
 
 /// The options that mean nothing for a tileset.
@@ -165,14 +171,19 @@ fn chunk(a: &Args) -> usize {
     a.chunk_splats.unwrap_or(BuildOptions::DEFAULT_CHUNK_SPLATS)
 }
 
-/// Builds the tree over `cloud` (already in glTF's +Y-up frame) in memory.
-pub(super) fn write_tileset(
+/// Builds the tree over `cloud` (already in the output's frame: glTF's +Y up for a tileset,
+/// the PLY side's for a streamed SOG) in memory.
+pub(super) fn write_tree(
     a: &Args,
+    kind: TreeOutput,
     cloud: &SplatCloud,
     o: &ConvertOptions,
     p: &Progress,
     t0: Instant,
 ) -> Result<(), String> {
+    if kind == TreeOutput::LodMeta {
+        return super::convert_sog::write_lod_meta(a, cloud, p, t0, chunk(a));
+    }
     let w = TileWriter::new(a, o, p, cloud.len() as u64)?;
     let opts = BuildOptions {
         chunk_splats: chunk(a),

@@ -9,6 +9,7 @@ mod compare;
 mod conformance;
 mod convert;
 mod convert_lod;
+mod convert_sog;
 mod info;
 mod kernel;
 mod progress;

@@ -182,7 +182,8 @@ impl Reader<'_> {
             ));
         }
         let refs = self.lods(obj.get("lods"), &path);
-        Some(self.chain(&path, depth, bounds, refs))
+        let errors = self.errors(obj.get("geometricErrors"), &path);
+        Some(self.chain(&path, depth, bounds, refs, errors))
     }
 
     /// A leaf's levels as a chain of tiles, the coarsest on top.
@@ -192,6 +193,7 @@ impl Reader<'_> {
         depth: usize,
         bounds: Option<Bounds>,
         refs: Vec<LodRef>,
+        errors: Option<Vec<f64>>,
     ) -> Tile {
         let diagonal = bounds.map_or(0.0, |b| 2.0 * b.sphere().1);
         let mut below: Option<Tile> = None;
@@ -201,7 +203,10 @@ impl Reader<'_> {
             let finer = below.take();
             let error = match &finer {
                 None => 0.0,
-                Some(f) => level_error(diagonal, r.count).max(f.geometric_error),
+                Some(f) => errors
+                    .as_ref()
+                    .map_or_else(|| level_error(diagonal, r.count), |e| e[r.level])
+                    .max(f.geometric_error),
             };
             let uri = content_uri(&self.filenames[r.file], r.offset, r.count);
             let t = tile(
@@ -258,6 +263,28 @@ impl Reader<'_> {
         }
         out.sort_by_key(|r| r.level);
         out
+    }
+
+    /// A leaf's `geometricErrors` (splatgl's own key, which other readers ignore): one finite,
+    /// non-negative error per level, in scene units as 3D Tiles' `geometricError`. `None` when
+    /// absent; a problem, and `None`, when malformed.
+    fn errors(&mut self, v: Option<&Value>, path: &str) -> Option<Vec<f64>> {
+        let v = v?;
+        let e: Option<Vec<f64>> = v
+            .as_array()
+            .filter(|a| a.len() == self.levels)
+            .and_then(|a| a.iter().map(Value::as_f64).collect())
+            .filter(|e: &Vec<f64>| e.iter().all(|x| x.is_finite() && *x >= 0.0));
+        if e.is_none() {
+            self.problem(
+                &format!("{path}.geometricErrors"),
+                format!(
+                    "{v}: expected {} finite non-negative numbers, one per level (errors derived from the counts instead)",
+                    self.levels
+                ),
+            );
+        }
+        e
     }
 
     /// A node's `bound` (`min`, `max`: three finite numbers each, min ≤ max) as a box.

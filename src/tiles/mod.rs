@@ -23,6 +23,7 @@
 mod build;
 mod check;
 mod lod_meta;
+mod lod_meta_write;
 pub mod pages;
 mod scratch;
 mod select;
@@ -36,6 +37,7 @@ pub use build::{
 
 pub use check::{LevelSummary, TilesetReport, check};
 pub use lod_meta::{MAX_LOD_LEVELS, level_error};
+pub use lod_meta_write::{LodMetaLayout, layout as lod_meta_layout};
 pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
 pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
 pub use stream::{
