@@ -383,3 +383,75 @@ fn a_streamed_sog_output_refuses_what_it_cannot_write() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `render`'s views of a tileset upload a selection once while it stays the same: an orbit at
+/// a far distance keeps the root tile, the later views say they draw what is on the GPU
+/// already, and each of their images is the one a render of that view alone makes (GL; within
+/// 1/255, the rounding of the camera through cameras.json).
+#[test]
+fn a_batch_whose_views_keep_their_selection_draws_it_without_uploading_again() {
+    let Some(biker) = common::real("playcanvas_biker.compressed.ply") else {
+        return;
+    };
+    if let Err(e) = splatgl::headless::HeadlessContext::new() {
+        common::skip(&format!("the GL part: {e}"));
+        return;
+    }
+    let d = dir("orbit-upload");
+    build(&biker, &d, &["--chunk-splats", "8192"]);
+    let ts = d.join("tileset.json");
+    let ts = ts.to_str().unwrap();
+    let pattern = d.join("o_{index}.png");
+    let common_args = ["--backend", "gl", "--width", "96", "--height", "72"];
+    let mut args = vec![
+        "render",
+        ts,
+        "--orbit",
+        "3",
+        "-v",
+        "--print-camera-json",
+        "-o",
+    ];
+    args.push(pattern.to_str().unwrap());
+    args.extend(common_args);
+    let r = run(&args);
+    assert_eq!(r.code, 0, "{}", r.all());
+    assert_eq!(
+        r.stderr.matches("(not uploaded again)").count(),
+        2,
+        "{}",
+        r.stderr
+    );
+    let cams = d.join("cameras.json");
+    std::fs::write(&cams, r.out()).unwrap();
+    let read = |p: &Path| splatgl::image::Image::read(p).unwrap();
+    for i in 0..3 {
+        let one = d.join(format!("one_{i}.png"));
+        let view = i.to_string();
+        let mut args = vec![
+            "render",
+            ts,
+            "--camera",
+            cams.to_str().unwrap(),
+            "--view",
+            &view,
+        ];
+        args.extend(["-o", one.to_str().unwrap()]);
+        args.extend(common_args);
+        let r = run(&args);
+        assert_eq!(r.code, 0, "{}", r.all());
+        // cameras.json's rounding of the orbit's camera moves a pixel by 1/255 at most.
+        let c = splatgl::compare::compare(
+            &read(&one),
+            &read(&d.join(format!("o_{i}.png"))),
+            1.0 / 255.0,
+        )
+        .unwrap();
+        assert!(
+            c.max_abs <= 1.5 / 255.0,
+            "view {i}: max error {}",
+            c.max_abs
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

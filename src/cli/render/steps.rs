@@ -200,6 +200,9 @@ pub(super) fn render_tileset_views(
     );
     let (mut visible, mut drawn) = (None, 0);
     let mut entries = Vec::new();
+    // The selection uploaded last (tile paths) and its cloud: a view that selects the same
+    // tiles (an orbit at one distance, say) draws what is on the GPU already.
+    let (mut uploaded, mut cloud): (Vec<String>, SplatCloud) = (Vec::new(), SplatCloud::default());
     for (i, (cam, distance)) in views.iter().enumerate() {
         progress.step("selecting tiles", i, views.len());
         cache.next_frame();
@@ -207,17 +210,26 @@ pub(super) fn render_tileset_views(
             None => splatgl::tiles::select(ts, cam, &select, &mut |t| cache.splats(t))?,
             Some(s) => select_within(a, ts, cam, &select, &mut cache, Duration::from_secs_f64(s))?,
         };
-        let cloud = cache.merged(&sel.tiles);
+        let paths: Vec<String> = sel.tiles.iter().map(|t| t.path.clone()).collect();
+        let same = i > 0 && paths == uploaded;
+        if !same {
+            cloud = cache.merged(&sel.tiles);
+        }
         progress.clear();
         warn_skipped(a, &mut cache);
         if a.verbose {
             eprintln!(
-                "tiles: {} selected, {} splats (budget {}), {} held back by the budget; cache: {} \
+                "tiles: {} selected, {} splats (budget {}), {} held back by the budget{}; cache: {} \
                  tiles, {} MB resident, {} loads, {} evicted, {} more skipped as warned",
                 sel.tiles.len(),
                 cloud.len(),
                 select.splat_budget,
                 sel.held_back,
+                if same {
+                    ", the previous view's selection (not uploaded again)"
+                } else {
+                    ""
+                },
                 cache.resident_tiles(),
                 cache.resident_bytes().div_ceil(1 << 20),
                 cache.loads,
@@ -225,7 +237,10 @@ pub(super) fn render_tileset_views(
                 cache.skipped_alike
             );
         }
-        engine.upload(&cloud)?;
+        if !same {
+            engine.upload(&cloud)?;
+            uploaded = paths;
+        }
         progress.stage("rendering");
         let (img, v) = engine.render(&cloud, cam, opts)?;
         (visible, drawn) = (v, cloud.len());
