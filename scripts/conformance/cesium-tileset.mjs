@@ -5,7 +5,7 @@
 // prints them), so its images can be compared with splatgl's of the same cameras.
 //
 //   node scripts/conformance/cesium-tileset.mjs TILESET.json CAMERAS.json OUT
-//        [--max-sse PX[,PX...]] [--splatgl PATH] [--timeout S]
+//        [--max-sse PX[,PX...]] [--timeout S]
 //
 // OUT/view_I_sse_PX.png for camera I of CAMERAS.json and each maximumScreenSpaceError PX
 // (default 16, Cesium's default); stderr has one line per image saying what Cesium drew
@@ -37,6 +37,10 @@ const me = 'cesium-tileset.mjs';
 const args = process.argv.slice(2);
 const opt = (flag, dflt) => {
   const i = args.indexOf(flag);
+  if (i >= 0 && i + 1 >= args.length) {
+    console.error(`${me}: ${flag} needs a value`);
+    process.exit(2);
+  }
   return i >= 0 ? args.splice(i, 2)[1] : dflt;
 };
 const sses = opt('--max-sse', '16').split(',').map(Number);

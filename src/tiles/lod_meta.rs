@@ -15,7 +15,8 @@
 //! Content and bounds are in splat-transform's PLY frame (the frame of the SOG units), so the
 //! tileset's frame is that frame: no axis turn.
 //!
-//! What is checked, as splat-transform's reader does: `version` 1 or absent, `lodLevels` a
+//! What is checked, as splat-transform's reader does (and, for splatgl's `geometricErrors`,
+//! one finite non-negative number per level, else a problem and the derived errors): `version` 1 or absent, `lodLevels` a
 //! positive integer, `counts` one per level and equal to the tree's sums, `filenames` strings,
 //! every LOD reference's level, file index, offset and count in range. A broken node or
 //! reference is a [`Problem`] at its JSON path and is left out; the rest is read.

@@ -9,7 +9,10 @@
 //! subtree's means) is nearest to its mean, until it reaches a leaf. Per level, the leaves'
 //! parts are packed in tree order into units of about `unit_splats` (`{level}_{k}/meta.json`,
 //! as splat-transform names them); a node's `bound` is the extent of the means of every level
-//! it holds. A leaf whose share of a coarse tile is empty has no entry for that level. Each
+//! it holds. A leaf whose share of a coarse tile is empty has no entry for that level. Where
+//! the tree's leaves lie at different depths (a split leaving one half just over the chunk
+//! size), level `j` of two leaves may come from tiles at different depths; `geometricErrors`
+//! carries each leaf's own. Each
 //! leaf also carries its levels' geometric errors (`geometricErrors`: 0, then the errors of
 //! the tiles its levels come from, in scene units as in a tileset), a key of splatgl's own
 //! that other readers ignore, so splatgl selects from it as from the tileset.
@@ -247,7 +250,8 @@ mod tests {
         let contents = contents.into_inner().unwrap();
         let out = layout(&root, &contents, 300).unwrap();
         let m = &out.manifest;
-        // Level j holds the content of the tiles j levels above the leaves, once each.
+        // Level j holds the content of the tiles j levels above the leaves, once each (this
+        // tree is balanced: 2000 splats halve evenly to 16 leaves of 125).
         let levels = m["lodLevels"].as_u64().unwrap() as usize;
         for (j, count) in m["counts"].as_array().unwrap().iter().enumerate() {
             let want: usize = root

@@ -56,8 +56,9 @@ pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, String> {
         .collect();
     let (mut mins, mut maxs) = ([0f64; 3], [0f64; 3]);
     for a in 0..3 {
-        let axis = logs.iter().map(|l| l[a]);
-        if n > 0 {
+        // Finite values only: the meta's range must be JSON numbers.
+        let axis = logs.iter().map(|l| l[a]).filter(|x| x.is_finite());
+        if axis.clone().next().is_some() {
             mins[a] = axis.clone().fold(f64::INFINITY, f64::min);
             maxs[a] = axis.fold(f64::NEG_INFINITY, f64::max);
         }
@@ -131,7 +132,7 @@ pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, String> {
 
 /// [`to_sog_files`] stored (uncompressed: WebP is compressed already) in one zip, `.sog`.
 pub fn to_sog_bundle(cloud: &SplatCloud) -> Result<Vec<u8>, String> {
-    Ok(zip_stored(&to_sog_files(cloud)?))
+    zip_stored(&to_sog_files(cloud)?)
 }
 
 /// One texel of `quats` for `[x, y, z, w]`: see the module docs (a zero quaternion is the
@@ -164,7 +165,8 @@ struct Codebook {
 }
 
 impl Codebook {
-    /// 1D k-means of `v`: centroids start at the quantiles of the sorted values, then each
+    /// 1D k-means of `v`: centroids start half at quantiles of the sorted values and half
+    /// evenly spaced over their range (finite values only), then each
     /// iteration moves every centroid to the mean of the values nearer to it than to its
     /// neighbours (ranges of the sorted values, summed by prefix sums).
     fn fit(v: &[f32]) -> Codebook {
@@ -297,14 +299,13 @@ fn median_cut(points: &[Vec<f32>]) -> (Vec<Vec<f32>>, Vec<usize>) {
             break;
         }
         let mut members = std::mem::take(&mut boxes[b]);
+        let span = |d: usize| {
+            let it = members.iter().map(|&i| points[i as usize][d]);
+            it.clone().fold(f32::NEG_INFINITY, f32::max) - it.fold(f32::INFINITY, f32::min)
+        };
+        let spans: Vec<f32> = (0..dim).map(span).collect();
         let widest = (0..dim)
-            .max_by(|&x, &y| {
-                let span = |d: usize| {
-                    let it = members.iter().map(|&i| points[i as usize][d]);
-                    it.clone().fold(f32::NEG_INFINITY, f32::max) - it.fold(f32::INFINITY, f32::min)
-                };
-                span(x).total_cmp(&span(y))
-            })
+            .max_by(|&x, &y| spans[x].total_cmp(&spans[y]))
             .unwrap_or(0);
         let mid = members.len() / 2;
         members.select_nth_unstable_by(mid, |&a, &b| {
@@ -345,13 +346,20 @@ fn webp(rgba: &[u8], w: usize, h: usize) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
-/// A zip of `files`, each stored (method 0) with its CRC-32.
-fn zip_stored(files: &[(String, Vec<u8>)]) -> Vec<u8> {
+/// A zip of `files`, each stored (method 0) with its CRC-32, dated 1980-01-01. `Err` past
+/// the 4 GiB a zip without zip64 can address.
+fn zip_stored(files: &[(String, Vec<u8>)]) -> Result<Vec<u8>, String> {
+    let total: usize = files.iter().map(|(n, d)| 2 * n.len() + d.len() + 128).sum();
+    if total > u32::MAX as usize || files.len() > u16::MAX as usize {
+        return Err(format!(
+            "a SOG bundle of {total} bytes is past the zip limit of 4 GiB"
+        ));
+    }
     let (mut out, mut dir) = (Vec::new(), Vec::new());
     for (name, data) in files {
         let (crc, len, at) = (crc32fast::hash(data), data.len() as u32, out.len() as u32);
         let common = |v: &mut Vec<u8>| {
-            for x in [20u16, 0, 0, 0, 0] {
+            for x in [20u16, 0, 0, 0, 0x0021] {
                 v.extend_from_slice(&x.to_le_bytes()); // version, flags, method, time, date
             }
             for x in [crc, len, len] {
@@ -384,7 +392,7 @@ fn zip_stored(files: &[(String, Vec<u8>)]) -> Vec<u8> {
     out.extend_from_slice(&dir_len.to_le_bytes());
     out.extend_from_slice(&dir_at.to_le_bytes());
     out.extend_from_slice(&0u16.to_le_bytes());
-    out
+    Ok(out)
 }
 
 #[cfg(test)]
