@@ -11,7 +11,7 @@ pub(super) fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64;
     if l2 <= 0.0 {
         return None;
     }
-    let e1 = major_axis(a, b, c, l1);
+    let e1 = f32_major_axis(a, b, c, l1, mid);
     let e2 = [-e1[1], e1[0]];
     Some([
         l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
@@ -20,6 +20,34 @@ pub(super) fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64;
         l1 * l2,
     ])
 }
+
+/// The major axis GaussianSplats3D's vertex shader takes, `normalize(vec2(b, λ₁ − a))` in
+/// f32 (build/gaussian-splats-3d.module.js 0.4.7, lines 8210–8222). Its `λ₁ − a` carries the
+/// rounding of `mid² − det`, about 2⁻²¹·mid² before the square root, so where `|b|` is below
+/// that noise the vector is vertical: a near-round footprint a little wider than tall is drawn
+/// with its axes swapped, and one the floor lifts (`λ₁ − a` > 0) is vertical as well. An
+/// exactly axis-aligned footprint (`b` = 0) is GS3D's degenerate case, which
+/// scripts/conformance/gs3d.mjs avoids by rolling each camera [`ADAPTER_ROLL`] rad: the model
+/// takes `b` to be at least what that roll gives, `ADAPTER_ROLL·|a − c|`, so only footprints
+/// within a few per cent of round (|a − c| ≲ 0.07·mid) swap, as GS3D's do.
+fn f32_major_axis(a: f64, b: f64, c: f64, l1: f64, mid: f64) -> [f64; 2] {
+    let noise = 2f64.powi(-21) * mid * mid / (2.0 * (l1 - mid));
+    let b_seen = b.abs().max(ADAPTER_ROLL * (a - c).abs());
+    if b_seen <= noise {
+        [0.0, 1.0]
+    } else if b.abs() > 1e-12 * (a.abs() + c.abs()) {
+        let (x, y) = (b, l1 - a);
+        let n = (x * x + y * y).sqrt();
+        [x / n, y / n]
+    } else if l1 - a > 1e-12 * l1 {
+        [0.0, 1.0]
+    } else {
+        [1.0, 0.0]
+    }
+}
+
+/// The roll (radians) scripts/conformance/gs3d.mjs gives each camera by default (`GS3D_ROLL`).
+const ADAPTER_ROLL: f64 = 1e-4;
 
 /// The unit eigenvector of [[a, b], [b, c]] for its larger eigenvalue `l1`: `(b, l1 − a)`
 /// normalised, or the axis of the larger diagonal entry when `b` is 0 (to rounding).
