@@ -72,11 +72,30 @@ fn gaussian_splats_3d_is_graded_by_the_rules_its_source_breaks() {
     // near-round footprints (the floor, or b below the rounding of mid² − det), which swaps
     // the axes of `opacity_one_cap`'s red splat and turns `sh_degree_1`'s; the
     // `eigenvalue_floor` term follows it (src/conformance/model/footprint.rs).
+    // Where b is comparable with that rounding the axis may come out anywhere in the range
+    // the rounding allows (`color0_fallback`'s faint tilted fringe); the term samples it.
     assert!(passes(&json, "sh_degree_1") && passes(&json, "opacity_one_cap"));
-    let passed = json["passed"].as_u64().unwrap();
-    // Measured 25 of 29 (docs/conformance.md): its other choices (8-bit colour, half-float
-    // covariances, the 2.83σ cut and the floor together) are admitted where not tested.
-    assert!(passed >= 23, "{passed} RC assets pass");
+    assert!(passes(&json, "color0_fallback"));
+    // Measured 26 of 29 (docs/conformance.md): its other choices (8-bit colour, half-float
+    // covariances, the 2.83σ cut and the floor together) are admitted where not tested, so
+    // the RC assets it fails are exactly those of its two RC deviations and the adapter's
+    // colour space, each explained.
+    let failed: Vec<&str> = rc_assets(&json)
+        .filter(|a| !a["pass"].as_bool().unwrap_or(false))
+        .map(|a| a["name"].as_str().unwrap_or(""))
+        .collect();
+    assert_eq!(
+        failed,
+        [
+            "sort_distance_not_depth",
+            "color_space_linear",
+            "cutoff_three_sigma"
+        ]
+    );
+    for a in rc_assets(&json).filter(|a| !a["pass"].as_bool().unwrap_or(false)) {
+        let cause = a["cause"].as_str().unwrap_or("");
+        assert!(cause.starts_with("explained by"), "{a:#}");
+    }
     clean(&[&suite, &images, &report]);
 }
 

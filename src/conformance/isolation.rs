@@ -111,8 +111,10 @@ pub(crate) fn admitted_sets(
     out
 }
 
-/// The model image with the deviations `ds` at once.
-fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> Image {
+/// The model images with the deviations `ds` at once: one, or where `ds` holds the eigenvalue
+/// floor, one per major axis f32 rounding allows it ([`model::axis_samples`]) besides the
+/// representative one — the term admits whichever GaussianSplats3D's rounding picks.
+fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> Vec<Image> {
     let errata: Vec<Erratum> = ds
         .iter()
         .filter_map(|d| match d {
@@ -127,14 +129,21 @@ fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> 
             Admitted::Erratum(_) => None,
         })
         .collect();
-    model::render_with(cloud, cam, &errata, &variants).image
+    let mut axes = vec![None];
+    if variants.contains(&Variant::EigenvalueFloor) {
+        axes.extend(model::axis_samples.map(Some));
+    }
+    axes.into_iter()
+        .map(|axis| model::render_with_axis(cloud, cam, &errata, &variants, axis).image)
+        .collect()
 }
 
-/// The largest channel difference of two images at pixel `i`.
-fn diff_at(a: &Image, b: &Image, i: usize) -> f64 {
-    let (p, q) = (a.pixels[i], b.pixels[i]);
-    (0..3)
-        .map(|k| (p[k] as f64 - q[k] as f64).abs())
+/// The largest channel difference at pixel `i` between `a` and any of `others`.
+fn diff_at(a: &Image, others: &[Image], i: usize) -> f64 {
+    let p = a.pixels[i];
+    others
+        .iter()
+        .flat_map(|o| (0..3).map(move |k| (p[k] as f64 - o.pixels[i][k] as f64).abs()))
         .fold(0.0, f64::max)
 }
 
@@ -156,13 +165,11 @@ pub(crate) fn admit(
         .filter(|(d, _)| !detects(spec, *d))
         .collect();
     for (d, field) in &admitted {
-        let other = render_admitted(cloud, cam, &[*d]);
+        let others = render_admitted(cloud, cam, &[*d]);
         // Terms of one field (the two cut-off shapes) take the larger difference.
         let mut per_field = model::Terms::default();
-        for (i, (p, q)) in exact.image.pixels.iter().zip(&other.pixels).enumerate() {
-            let diff = (0..3)
-                .map(|k| (p[k] as f64 - q[k] as f64).abs())
-                .fold(0.0, f64::max);
+        for i in 0..exact.bound.len() {
+            let diff = diff_at(&exact.image, &others, i);
             let extra = (diff - *field(&mut exact.extra[i])).max(0.0);
             *field(&mut exact.extra[i]) += extra;
             exact.bound[i] += extra;
@@ -203,13 +210,13 @@ fn admit_combined(
     let mut worst = 0.0f64;
     for s in sets {
         let ds: Vec<Admitted> = s.iter().map(|&i| admitted[i].0).collect();
-        let other = render_admitted(cloud, cam, &ds);
+        let others = render_admitted(cloud, cam, &ds);
         for i in 0..exact.bound.len() {
             let mut own: f64 = 0.0;
             for &k in &s {
                 own += *(admitted[k].1)(&mut exact.extra[i]);
             }
-            let beyond = diff_at(&exact.image, &other, i) - own - exact.extra[i].combined;
+            let beyond = diff_at(&exact.image, &others, i) - own - exact.extra[i].combined;
             if beyond > 0.0 {
                 exact.extra[i].combined += beyond;
                 exact.bound[i] += beyond;

@@ -95,6 +95,15 @@ pub fn asset<'a>(json: &'a serde_json::Value, name: &str) -> &'a serde_json::Val
         .unwrap_or_else(|| panic!("{name}"))
 }
 
+/// The report's entries of the RC assets (`"checks": "rc"`), in the manifest's order.
+pub fn rc_assets(json: &serde_json::Value) -> impl Iterator<Item = &serde_json::Value> {
+    json["assets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|a| a["checks"] == "rc")
+}
+
 /// Whether asset `name` passed.
 pub fn passes(json: &serde_json::Value, name: &str) -> bool {
     asset(json, name)["pass"].as_bool().unwrap()

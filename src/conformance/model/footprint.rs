@@ -2,16 +2,26 @@
 //! bounding box (Σ' = [[a, b], [b, c]] in pixels²).
 
 /// [`Variant::EigenvalueFloor`]: Σ' = [[a, b], [b, c]] rebuilt from the floored eigenvalues
-/// and the eigenvector `normalize(b, λ₁ − a)` (axis-aligned when that is degenerate); `None`
-/// when the smaller eigenvalue is ≤ 0. Returns `[a, b, c, det]`.
-pub(super) fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64; 4]> {
+/// and the eigenvector `normalize(b, λ₁ − a)` (axis-aligned when that is degenerate), taken
+/// at `axis` ∈ [0, 1] of the angles f32 rounding allows it (`None`: the representative one,
+/// [`f32_major_axis`]); `None` when the smaller eigenvalue is ≤ 0. Returns `[a, b, c, det]`.
+pub(super) fn eigenvalue_floor(
+    a: f64,
+    b: f64,
+    c: f64,
+    det: f64,
+    axis: Option<f64>,
+) -> Option<[f64; 4]> {
     let mid = 0.5 * (a + c);
     let r = (mid * mid - det).max(0.1).sqrt();
     let (l1, l2) = (mid + r, mid - r);
     if l2 <= 0.0 {
         return None;
     }
-    let e1 = f32_major_axis(a, b, c, l1, mid);
+    let e1 = match axis {
+        None => f32_major_axis(a, b, c, l1, mid),
+        Some(at) => f32_axis_within_rounding(a, b, c, l1, mid, at),
+    };
     let e2 = [-e1[1], e1[0]];
     Some([
         l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
@@ -21,17 +31,22 @@ pub(super) fn eigenvalue_floor(a: f64, b: f64, c: f64, det: f64) -> Option<[f64;
     ])
 }
 
+/// Where in [`f32_axis_within_rounding`]'s range the `eigenvalue_floor` term samples the
+/// major axis: its ends, its middle and between (the image changes with the angle as a
+/// sinusoid of twice it, so a range of up to ~120° needs more than its ends).
+pub(crate) const AXIS_SAMPLES: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+
 /// The major axis GaussianSplats3D's vertex shader takes, `normalize(vec2(b, λ₁ − a))` in
 /// f32 (build/gaussian-splats-3d.module.js 0.4.7, lines 8210–8222). Its `λ₁ − a` carries the
-/// rounding of `mid² − det`, about 2⁻²¹·mid² before the square root, so where `|b|` is below
-/// that noise the vector is vertical: a near-round footprint a little wider than tall is drawn
-/// with its axes swapped, and one the floor lifts (`λ₁ − a` > 0) is vertical as well. An
-/// exactly axis-aligned footprint (`b` = 0) is GS3D's degenerate case, which
-/// scripts/conformance/gs3d.mjs avoids by rolling each camera [`ADAPTER_ROLL`] rad: the model
-/// takes `b` to be at least what that roll gives, `ADAPTER_ROLL·|a − c|`, so only footprints
-/// within a few per cent of round (|a − c| ≲ 0.07·mid) swap, as GS3D's do.
+/// rounding of `mid² − det` ([`axis_noise`]), so where `|b|` is below that noise the vector is
+/// vertical: a near-round footprint a little wider than tall is drawn with its axes swapped,
+/// and one the floor lifts (`λ₁ − a` > 0) is vertical as well. An exactly axis-aligned
+/// footprint (`b` = 0) is GS3D's degenerate case, which scripts/conformance/gs3d.mjs avoids
+/// by rolling each camera [`ADAPTER_ROLL`] rad: the model takes `b` to be at least what that
+/// roll gives, `ADAPTER_ROLL·|a − c|`, so only footprints within a few per cent of round
+/// (|a − c| ≲ 0.07·mid) swap, as GS3D's do.
 fn f32_major_axis(a: f64, b: f64, c: f64, l1: f64, mid: f64) -> [f64; 2] {
-    let noise = 2f64.powi(-21) * mid * mid / (2.0 * (l1 - mid));
+    let noise = axis_noise(l1, mid);
     let b_seen = b.abs().max(ADAPTER_ROLL * (a - c).abs());
     if b_seen <= noise {
         [0.0, 1.0]
@@ -44,6 +59,32 @@ fn f32_major_axis(a: f64, b: f64, c: f64, l1: f64, mid: f64) -> [f64; 2] {
     } else {
         [1.0, 0.0]
     }
+}
+
+/// How far f32 rounding may move GaussianSplats3D's `λ₁ − a`: `mid² − det` carries about
+/// 2⁻²¹·mid² (the rounding of `mid²`, `a·d` and their difference, with margin), which the
+/// square root turns into that over 2(λ₁ − mid); and λ₁ and `a` an ulp or two each.
+fn axis_noise(l1: f64, mid: f64) -> f64 {
+    2f64.powi(-21) * mid * mid / (2.0 * (l1 - mid)) + 2f64.powi(-22) * l1
+}
+
+/// The major axis at `at` ∈ [0, 1] of the angles `normalize(vec2(b, λ₁ − a ± noise))`
+/// takes as the rounding of [`axis_noise`] runs over its range, `b` at least what the
+/// adapter's roll gives (see [`f32_major_axis`]). Where `|b|` is well above the noise the
+/// range is a sliver around the exact axis; where it is comparable, a tilted near-round
+/// footprint's axis may come out at any angle in it (GaussianSplats3D's `color0_fallback`
+/// fringe: b ≈ 4·10⁻⁴, noise ≈ 7·10⁻⁴, axis anywhere within ±60° of the exact one).
+fn f32_axis_within_rounding(a: f64, b: f64, c: f64, l1: f64, mid: f64, at: f64) -> [f64; 2] {
+    let noise = axis_noise(l1, mid);
+    // (b, y) and (−b, −y) are the same axis: take x ≥ 0 so the range never wraps at ±π.
+    let x = b.abs().max(ADAPTER_ROLL * (a - c).abs());
+    let y = if b < 0.0 { a - l1 } else { l1 - a };
+    if x == 0.0 {
+        return f32_major_axis(a, b, c, l1, mid); // exactly round and unrolled: no angle
+    }
+    let (lo, hi) = ((y - noise).atan2(x), (y + noise).atan2(x));
+    let t = lo + at.clamp(0.0, 1.0) * (hi - lo);
+    [t.cos(), t.sin()]
 }
 
 /// The roll (radians) scripts/conformance/gs3d.mjs gives each camera by default (`GS3D_ROLL`).

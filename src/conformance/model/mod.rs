@@ -22,6 +22,7 @@ mod project;
 mod quantized;
 mod terms;
 mod variant;
+pub(crate) use footprint::AXIS_SAMPLES as axis_samples;
 use project::project;
 pub(crate) use quantized::spz as spz_copy;
 pub use terms::Terms;
@@ -70,6 +71,18 @@ pub fn render(cloud: &SplatCloud, cam: &Camera, x: &[Erratum]) -> ModelImage {
 
 /// [`render`] with implementation [`Variant`]s `v` switched on too.
 pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant]) -> ModelImage {
+    render_with_axis(cloud, cam, x, v, None)
+}
+
+/// [`render_with`], with [`Variant::EigenvalueFloor`]'s major axis taken at `axis` ∈ [0, 1]
+/// of the angles f32 rounding allows it ([`axis_samples`]; `None`: the representative axis).
+pub(crate) fn render_with_axis(
+    cloud: &SplatCloud,
+    cam: &Camera,
+    x: &[Erratum],
+    v: &[Variant],
+    axis: Option<f64>,
+) -> ModelImage {
     let quantized = if v.contains(&Variant::SpzPrecision) {
         quantized::spz(cloud)
     } else if v.contains(&Variant::PackedSplat) {
@@ -78,7 +91,7 @@ pub fn render_with(cloud: &SplatCloud, cam: &Camera, x: &[Erratum], v: &[Variant
         None
     };
     let cloud = quantized.as_ref().unwrap_or(cloud);
-    let layers = project(cloud, cam, x, v);
+    let layers = project(cloud, cam, x, v, axis);
     let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display
         && !v.contains(&Variant::ColorSpaceIgnored);
     let blend = Blending {

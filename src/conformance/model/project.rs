@@ -72,6 +72,8 @@ struct View<'a> {
     eye: DVec3,
     /// The J clamp limits on x/z, y/z.
     lim: [f64; 2],
+    /// Where in the f32 rounding's range of angles `EigenvalueFloor` takes its major axis.
+    axis: Option<f64>,
 }
 
 impl View<'_> {
@@ -88,6 +90,7 @@ pub(super) fn project(
     cam: &Camera,
     x: &[Erratum],
     vars: &[Variant],
+    axis: Option<f64>,
 ) -> Vec<Layer> {
     let w2c = cam.world_to_camera.as_dmat4();
     let w_cv = DMat3::from_mat4(w2c);
@@ -110,6 +113,7 @@ pub(super) fn project(
         } else {
             [JACOBIAN_CLAMP * tan.x, JACOBIAN_CLAMP * tan.y]
         },
+        axis,
     };
     let mode = if view.var(Variant::ViewDepthOrder) {
         SortMode::ViewDepth
@@ -214,7 +218,7 @@ fn screen_covariance(
         return None;
     }
     if view.var(Variant::EigenvalueFloor) {
-        [a, b, cc, det] = eigenvalue_floor(a, b, cc, det)?;
+        [a, b, cc, det] = eigenvalue_floor(a, b, cc, det, view.axis)?;
     }
     Some(([a, b, cc, det], p0.cross(p1).length_squared()))
 }
@@ -246,7 +250,7 @@ fn half_covariance(view: &View, m: DMat3, [j0, j1]: [DVec3; 2]) -> Option<([f64;
         return None;
     }
     if view.var(Variant::EigenvalueFloor) {
-        [a, b, cc, det] = eigenvalue_floor(a, b, cc, det)?;
+        [a, b, cc, det] = eigenvalue_floor(a, b, cc, det, view.axis)?;
     }
     Some(([a, b, cc, det], (a0 * c0 - b * b).max(0.0)))
 }
