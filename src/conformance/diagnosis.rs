@@ -213,6 +213,12 @@ impl<'a> Search<'a> {
         }
     }
 
+    /// Pixels over their bound against the model without deviations (the reference, or with
+    /// SPZ input the SPZ copy).
+    pub fn baseline_over(&self) -> usize {
+        self.baseline_over
+    }
+
     /// `devs` tried: the explanation when the image passes the camera's tolerance against
     /// the model with them, else `None`; its PSNR against that model either way.
     fn score(&mut self, devs: &[Deviation]) -> (Option<Explanation>, f64) {

@@ -141,7 +141,7 @@ pub(crate) fn clamped(img: &Image) -> Image {
 
 /// The tolerance from the model's per-pixel bound: `max_abs` is the largest bound, and if
 /// every pixel's error is within its bound the MSE is at most the mean squared bound.
-fn tolerance(m: &model::ModelImage) -> Tolerance {
+pub(crate) fn tolerance(m: &model::ModelImage) -> Tolerance {
     let max_abs = m.bound.iter().copied().fold(0.0, f64::max);
     let mse = m.bound.iter().map(|b| b * b).sum::<f64>() / m.bound.len().max(1) as f64;
     Tolerance {

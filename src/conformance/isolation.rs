@@ -115,20 +115,7 @@ pub(crate) fn admitted_sets(
 /// floor, one per major axis f32 rounding allows it ([`model::axis_samples`]) besides the
 /// representative one — the term admits whichever GaussianSplats3D's rounding picks.
 fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> Vec<Image> {
-    let errata: Vec<Erratum> = ds
-        .iter()
-        .filter_map(|d| match d {
-            Admitted::Erratum(e) => Some(*e),
-            Admitted::Variant(_) => None,
-        })
-        .collect();
-    let variants: Vec<Variant> = ds
-        .iter()
-        .filter_map(|d| match d {
-            Admitted::Variant(v) => Some(*v),
-            Admitted::Erratum(_) => None,
-        })
-        .collect();
+    let (errata, variants) = split(ds);
     let mut axes = vec![None];
     if variants.contains(&Variant::EigenvalueFloor) {
         axes.extend(model::axis_samples.map(Some));
@@ -136,6 +123,18 @@ fn render_admitted(cloud: &crate::SplatCloud, cam: &Camera, ds: &[Admitted]) -> 
     axes.into_iter()
         .map(|axis| model::render_with_axis(cloud, cam, &errata, &variants, axis).image)
         .collect()
+}
+
+/// The errata and the variants of `ds`.
+fn split(ds: &[Admitted]) -> (Vec<Erratum>, Vec<Variant>) {
+    let mut out = (Vec::new(), Vec::new());
+    for d in ds {
+        match *d {
+            Admitted::Erratum(e) => out.0.push(e),
+            Admitted::Variant(v) => out.1.push(v),
+        }
+    }
+    out
 }
 
 /// The largest channel difference at pixel `i` between `a` and any of `others`.
@@ -158,13 +157,23 @@ pub(crate) fn admit(
     cloud: &crate::SplatCloud,
     cam: &Camera,
 ) {
-    let mut worst = model::Terms::default();
     let admitted: Vec<(Admitted, TermField)> = ISOLATED
         .iter()
         .copied()
         .filter(|(d, _)| !detects(spec, *d))
         .collect();
-    for (d, field) in &admitted {
+    admit_all(exact, &admitted, cloud, cam);
+}
+
+/// [`admit`] with the admitted deviations given.
+fn admit_all(
+    exact: &mut model::ModelImage,
+    admitted: &[(Admitted, TermField)],
+    cloud: &crate::SplatCloud,
+    cam: &Camera,
+) {
+    let mut worst = model::Terms::default();
+    for (d, field) in admitted {
         let others = render_admitted(cloud, cam, &[*d]);
         // Terms of one field (the two cut-off shapes) take the larger difference.
         let mut per_field = model::Terms::default();
@@ -178,7 +187,7 @@ pub(crate) fn admit(
         }
         worst = worst.max(per_field);
     }
-    worst.combined = admit_combined(exact, &admitted, cloud, cam);
+    worst.combined = admit_combined(exact, admitted, cloud, cam);
     exact.worst = exact.worst.max(worst);
 }
 
@@ -225,4 +234,27 @@ fn admit_combined(
         }
     }
     worst
+}
+
+/// The model of `cloud` seen by `cam` and the bound the suite's generator derives around it
+/// for an asset that catches `catches` and detects `detects`: the model's own terms and every
+/// deviation the asset admits, alone, in pairs and in triples ([`admit`]). The runner judges
+/// an image rendered from an asset's SPZ copy by it (`cloud` the copy): the admitted choices
+/// then act on the copy's footprints, which differ a little from the asset's.
+pub(crate) fn derived_bound(
+    cloud: &crate::SplatCloud,
+    cam: &Camera,
+    (catches, detects): (&[Erratum], &[String]),
+) -> model::ModelImage {
+    let admitted: Vec<(Admitted, TermField)> = ISOLATED
+        .iter()
+        .copied()
+        .filter(|&(d, _)| match d {
+            Admitted::Erratum(e) => !catches.contains(&e),
+            Admitted::Variant(v) => !detects.iter().any(|n| n == v.name()),
+        })
+        .collect();
+    let mut exact = model::render(cloud, cam, &[]);
+    admit_all(&mut exact, &admitted, cloud, cam);
+    exact
 }

@@ -52,7 +52,9 @@ fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool, v: &[Variant]) -
             .map(|v| (*v as f64 * y[k]).abs())
             .fold(0.0, f64::max);
     }
-    let f16_err = f16 * 2f64.powi(-11);
+    // f16 keeps 11 significant bits: rounded, a coefficient is off by 2⁻¹¹ of itself at most;
+    // truncated (CesiumJS's `>>> 13` of the f32 mantissa), 2⁻¹⁰. Both are storage choices.
+    let f16_err = f16 * 2f64.powi(-10);
     let c = if e || v.contains(&Variant::SigmoidColour) {
         sum.map(|v| 1.0 / (1.0 + (-v).exp()))
     } else {
