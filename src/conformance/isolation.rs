@@ -74,6 +74,19 @@ pub(crate) fn admitted_errata(spec: &AssetSpec) -> Vec<Erratum> {
         .collect()
 }
 
+/// The deviations of [`ISOLATED`] that an asset which catches `catches` and detects
+/// `detects` (its manifest entry) admits.
+fn admitted_by(catches: &[Erratum], detects: &[String]) -> Vec<(Admitted, TermField)> {
+    ISOLATED
+        .iter()
+        .copied()
+        .filter(|&(d, _)| match d {
+            Admitted::Erratum(e) => !catches.contains(&e),
+            Admitted::Variant(v) => !detects.iter().any(|n| n == v.name()),
+        })
+        .collect()
+}
+
 /// Whether two term fields are the same one (alternatives such as the cut-off shapes).
 fn same_term(a: TermField, b: TermField) -> bool {
     let mut t = model::Terms::default();
@@ -83,21 +96,17 @@ fn same_term(a: TermField, b: TermField) -> bool {
 
 /// The deviations an asset that catches `catches` and detects `detects` admits (its bound is
 /// widened for them), singly and in pairs of different terms, as the diagnosis names them:
-/// what an image rendered from an SPZ copy may still show and pass (`--input-precision spz`),
-/// since the bound was widened on the float asset and the copy's footprints differ a little.
+/// what an image may still show and pass as (the runner's admitted choices).
 pub(crate) fn admitted_sets(
     catches: &[Erratum],
     detects: &[String],
 ) -> Vec<Vec<super::diagnosis::Deviation>> {
     use super::diagnosis::Deviation;
-    let admitted: Vec<(Deviation, TermField)> = ISOLATED
-        .iter()
-        .filter_map(|&(d, f)| match d {
-            Admitted::Erratum(e) if !catches.contains(&e) => Some((Deviation::Erratum(e), f)),
-            Admitted::Variant(v) if !detects.iter().any(|n| n == v.name()) => {
-                Some((Deviation::Variant(v), f))
-            }
-            _ => None,
+    let admitted: Vec<(Deviation, TermField)> = admitted_by(catches, detects)
+        .into_iter()
+        .map(|(d, f)| match d {
+            Admitted::Erratum(e) => (Deviation::Erratum(e), f),
+            Admitted::Variant(v) => (Deviation::Variant(v), f),
         })
         .collect();
     let mut out: Vec<Vec<Deviation>> = admitted.iter().map(|(d, _)| vec![*d]).collect();
@@ -246,15 +255,7 @@ pub(crate) fn derived_bound(
     cam: &Camera,
     (catches, detects): (&[Erratum], &[String]),
 ) -> model::ModelImage {
-    let admitted: Vec<(Admitted, TermField)> = ISOLATED
-        .iter()
-        .copied()
-        .filter(|&(d, _)| match d {
-            Admitted::Erratum(e) => !catches.contains(&e),
-            Admitted::Variant(v) => !detects.iter().any(|n| n == v.name()),
-        })
-        .collect();
     let mut exact = model::render(cloud, cam, &[]);
-    admit_all(&mut exact, &admitted, cloud, cam);
+    admit_all(&mut exact, &admitted_by(catches, detects), cloud, cam);
     exact
 }

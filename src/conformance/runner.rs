@@ -173,14 +173,15 @@ fn allowed_choice(
 ) -> Option<Allowed> {
     let c = &a.cameras[ci];
     let model = |devs: &[Deviation]| diagnosis::model_image(&l.0.cloud, &l.1[ci], devs);
-    let passes = |m: &Image| !fails(img, m, bound, &c.tolerance) || !judge.fails(img, m);
+    // The suite's bound, and with SPZ input also the copy's.
+    let passes = |m: &Image| {
+        !fails(img, m, bound, &c.tolerance) || (judge.copy.is_some() && !judge.fails(img, m))
+    };
     if judge.copy.as_ref().is_some_and(&passes) {
         return Some(Allowed::Admitted(Vec::new()));
     }
-    let mut sets = Vec::new();
     // Of the sets it passes with, the one it matches closest is named.
-    sets.extend(super::isolation::admitted_sets(&a.catches, &a.detects));
-    let closest = sets
+    let closest = super::isolation::admitted_sets(&a.catches, &a.detects)
         .into_iter()
         .filter_map(|ds| {
             let m = model(&ds);
@@ -262,21 +263,6 @@ fn second_look(
     if named.len() < 2 {
         return Ok(());
     }
-    for_open_cameras(dir, m, budget, results, |search| {
-        search.explain_with(&named)
-    })
-}
-
-/// Runs `look` on every failing camera with an image that nothing explains yet, within the
-/// run's budget and the model's work limit; what it returns becomes the camera's
-/// explanations, and its search's nearest model the camera's `nearest`.
-fn for_open_cameras(
-    dir: &Path,
-    m: &Manifest,
-    budget: &mut Budget,
-    results: &mut [AssetResult],
-    mut look: impl FnMut(&mut Search) -> Vec<Explanation>,
-) -> Result<(), String> {
     for (ai, r) in results.iter_mut().enumerate().filter(|(_, r)| !r.skipped) {
         let mut loaded: Loaded = None;
         for (ci, c) in r.cameras.iter_mut().enumerate() {
@@ -302,7 +288,7 @@ fn for_open_cameras(
             let judge = Judge::new(l, (&r.asset, ci), &bound, budget.input);
             let mut search = Search::new(&l.0.cloud, &l.1[ci], &judge.camera, img, &judge.bound);
             search.closest = c.closest.take();
-            c.explained_by = look(&mut search);
+            c.explained_by = search.explain_with(&named);
             c.closest = search.closest;
         }
     }
