@@ -30,8 +30,7 @@
 //!
 //! `cargo bench --features testing --bench gl`; `scripts/bench-gpu.sh` runs it at 1920×1080 with 1M and 4M.
 
-#[path = "../tests/common/mod.rs"]
-mod common;
+use splatgl_testkit as common;
 
 use std::time::{Duration, Instant};
 

@@ -12,8 +12,7 @@
 //!
 //! `cargo bench --features testing --bench gl_state` (`SPLATGL_BENCH_DRAWS`, default 4000).
 
-#[path = "../tests/common/mod.rs"]
-mod common;
+use splatgl_testkit as common;
 
 use std::time::Instant;
 

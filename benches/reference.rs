@@ -2,8 +2,7 @@
 //! footprints: a worst case), and the real 50,000-splat `mujoco_warp_fox_sh0.ply` when
 //! `../shared/data/real/` is present.
 
-#[path = "../tests/common/mod.rs"]
-mod common;
+use splatgl_testkit as common;
 
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use glam::Vec3;

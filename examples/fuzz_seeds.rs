@@ -14,9 +14,7 @@ use splatgl::write::{SpzVersion, SpzWriteOptions, to_glb_spz, to_splat, to_spz_w
 use std::path::Path;
 
 /// The tests' independent `.ksplat` and SOG encoders (splatgl writes neither).
-#[path = "../tests/common/packed.rs"]
-#[allow(dead_code)]
-mod packed;
+use splatgl_testkit::packed;
 
 fn put(dir: &Path, target: &str, name: &str, bytes: &[u8]) {
     let d = dir.join(target);

@@ -8,12 +8,14 @@
 //! the CPU [`reference`](mod@reference) rasterizer beside it, [`compare`] for image comparison, [`image`] for
 //! PNG / PFM files and [`write`](mod@write) for glTF / PLY output. [`camera`] holds the camera model,
 //! [`profile`] every number of the rendering profile and [`sh`] the spherical harmonics.
-//! The module map with the documentation pages is in the README.
+//! The crates and modules are mapped in `ARCHITECTURE.md`; the applications (command line,
+//! viewer, conformance kit, C API) are crates of their own in `crates/`.
 //!
 //! ## Embedding in a GL host (feature `gl`)
 //!
 //! The host keeps its context, framebuffer, depth buffer and camera; the renderer culls, sorts
-//! and draws into whatever is bound (`docs/embedding.md`; C and C++ hosts: feature `capi`):
+//! and draws into whatever is bound (`docs/embedding.md`; C and C++ hosts: the `splatgl-capi`
+//! crate):
 //!
 #![cfg_attr(feature = "gl", doc = "```no_run")]
 #![cfg_attr(feature = "gl", doc = include_str!("../docs/snippets/embed.rs"))]
@@ -21,11 +23,8 @@
 #![warn(missing_docs)]
 
 pub mod camera;
-#[cfg(feature = "capi")]
-pub mod capi;
 pub mod cloud;
 pub mod compare;
-pub mod conformance;
 pub mod convert;
 pub mod covariance;
 pub mod cull;
@@ -43,8 +42,6 @@ pub mod sh;
 pub mod sort;
 pub mod synthetic;
 pub mod tiles;
-#[cfg(feature = "viewer")]
-pub mod viewer;
 pub mod write;
 
 pub use cloud::SplatCloud;

@@ -4,10 +4,10 @@
 //! use is measured by a counting allocator; this binary holds one test so nothing else
 //! allocates at the same time.
 
-mod common;
 use common::{packed, random_cloud};
 use splatgl::load::codec::budget_for;
 use splatgl::load::{LoadOptions, load_bytes};
+use splatgl_testkit as common;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
 use std::path::Path;

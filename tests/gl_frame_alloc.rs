@@ -3,7 +3,7 @@
 //! sized by the first frame). Its own test binary, so no other test allocates meanwhile. The
 //! GL driver's own allocations (Mesa's, through libc) are not ours and not counted.
 
-mod common;
+use splatgl_testkit as common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

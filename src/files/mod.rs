@@ -139,11 +139,7 @@ pub(crate) fn contained(base: &Path, uri: &str, allow_outside: bool) -> Result<P
 /// (`..` resolved, symlinks followed) and the file must lie inside `base`. Absolute paths, `..`
 /// escapes and symlinks pointing outside are refused with a message naming the file and the
 /// rule, unless `allow_outside`. Returns the canonical path.
-pub(crate) fn contained_path(
-    base: &Path,
-    rel: &Path,
-    allow_outside: bool,
-) -> Result<PathBuf, String> {
+pub fn contained_path(base: &Path, rel: &Path, allow_outside: bool) -> Result<PathBuf, String> {
     contained_named(base, rel, &rel.to_string_lossy(), allow_outside)
 }
 

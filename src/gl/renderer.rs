@@ -500,7 +500,7 @@ impl SplatRenderer {
     }
 
     /// Forgets the objects without GL calls (their context is already gone).
-    pub(crate) fn abandon(&mut self) {
+    pub fn abandon(&mut self) {
         if let Some(mut t) = self.textures.take() {
             t.abandon();
         }

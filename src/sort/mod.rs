@@ -43,7 +43,7 @@ pub use quantize::quantized_bucket_width;
 use reuse::LastView;
 pub use reuse::Outcome;
 #[cfg(feature = "gl")]
-pub(crate) use stale::StaleOrders;
+pub use stale::StaleOrders;
 pub use stale::{Freshness, StaleBound};
 
 use quantize::{given_keys_range, quantized_key, visible_range};

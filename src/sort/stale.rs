@@ -94,7 +94,7 @@ pub enum Freshness {
 /// The decision for one frame: the order's eye moved `moved` from the request it was sorted
 /// for, which has exact radius `exact`; tolerance `tau`.
 #[cfg_attr(not(feature = "gl"), allow(dead_code))] // the users are GL's
-pub(crate) fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
+pub fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
     if moved <= exact {
         Some(Freshness::Exact)
     } else if 2.0 * moved <= tau {
@@ -110,7 +110,7 @@ pub(crate) fn decide(moved: f64, exact: f64, tau: f64) -> Option<Freshness> {
 /// [`Reuse::MotionBound`], and the staleness rule.
 #[derive(Debug)]
 #[cfg_attr(not(feature = "gl"), allow(dead_code))] // the users are GL's
-pub(crate) struct StaleOrders {
+pub struct StaleOrders {
     sorter: AsyncSorter,
     tau: f32,
     sync: bool,
@@ -124,7 +124,7 @@ pub(crate) struct StaleOrders {
 impl StaleOrders {
     /// A sorter thread for `positions`; `tau` from [`StaleBound::tolerance`]; `sync` makes
     /// every frame wait (`--sort-sync`).
-    pub(crate) fn new(positions: Arc<[[f32; 3]]>, tau: f32, sync: bool) -> std::io::Result<Self> {
+    pub fn new(positions: Arc<[[f32; 3]]>, tau: f32, sync: bool) -> std::io::Result<Self> {
         let sorter = Sorter::new().with_reuse(Reuse::MotionBound);
         Ok(StaleOrders {
             sorter: AsyncSorter::new(positions, sorter)?,
@@ -138,14 +138,14 @@ impl StaleOrders {
 
     /// Cuts every order from now on to `crop` ([`AsyncSorter::set_crop`]); the next frame
     /// waits for an order with the new crop.
-    pub(crate) fn set_crop(&mut self, crop: Option<crate::cull::CropBox>) {
+    pub fn set_crop(&mut self, crop: Option<crate::cull::CropBox>) {
         self.sorter.set_crop(crop);
         self.requested = None;
         self.first_valid = self.generation + 1;
     }
 
     /// Posts a sort for `eye` unless it is the last one posted (never waits).
-    pub(crate) fn request(&mut self, eye: Vec3) {
+    pub fn request(&mut self, eye: Vec3) {
         let e = eye.to_array();
         if self.requested.map(|r| r.map(f32::to_bits)) != Some(e.map(f32::to_bits)) {
             self.generation = self.sorter.request(SortRequest::distance(e));
@@ -155,7 +155,7 @@ impl StaleOrders {
 
     /// The order to draw from `eye`: the newest finished one if the bound allows it, else
     /// (waiting) the order sorted for `eye`. `None` only if the sorter thread died.
-    pub(crate) fn for_frame(&mut self, eye: Vec3) -> Option<(&SortedFrame, Freshness)> {
+    pub fn for_frame(&mut self, eye: Vec3) -> Option<(&SortedFrame, Freshness)> {
         let first_valid = self.first_valid;
         let decision = match self.sorter.latest() {
             Some(f) if !self.sync && f.generation() >= first_valid => f.request().and_then(|req| {
