@@ -4,7 +4,7 @@
 use glow::HasContext;
 
 use super::GlError;
-use super::fault;
+use super::caps::{self, injected};
 
 /// The versions the backend works on (WebGL2-class: GLSL ES 3.00 or GLSL 3.30).
 pub(crate) const NEEDED: &str = "OpenGL ≥ 3.3 or OpenGL ES ≥ 3.0";
@@ -41,7 +41,7 @@ impl ContextInfo {
     /// Checks the version (`GL_VERSION`, or the one injected by the fault hooks) and finds the
     /// profile.
     pub(crate) fn check(gl: &glow::Context) -> Result<Self, GlError> {
-        let version = fault::get(|f| f.gl_version.clone())
+        let version = injected!(String, |f| f.gl_version.clone())
             // SAFETY: a string query.
             .unwrap_or_else(|| unsafe { gl.get_parameter_string(glow::VERSION) });
         let Some((es, major, minor)) = parse_version(&version) else {
@@ -67,15 +67,15 @@ impl ContextInfo {
             // SAFETY: an integer query that exists from GL 3.2 on.
             let mask = unsafe { gl.get_parameter_i32(glow::CONTEXT_PROFILE_MASK) } as u32;
             let compat = mask & glow::CONTEXT_COMPATIBILITY_PROFILE_BIT != 0
-                || fault::has_extension(gl, "GL_ARB_compatibility");
+                || caps::has_extension(gl, "GL_ARB_compatibility");
             if compat {
                 Profile::Compat
             } else {
                 Profile::Core
             }
         };
-        let srgb_switch = !es || fault::has_extension(gl, "GL_EXT_sRGB_write_control");
-        let tf_objects = es || major >= 4 || fault::has_extension(gl, "GL_ARB_transform_feedback2");
+        let srgb_switch = !es || caps::has_extension(gl, "GL_EXT_sRGB_write_control");
+        let tf_objects = es || major >= 4 || caps::has_extension(gl, "GL_ARB_transform_feedback2");
         Ok(ContextInfo {
             profile,
             srgb_switch,

@@ -36,7 +36,7 @@
 use glow::HasContext;
 
 use super::GlError;
-use super::fault;
+use super::caps::{self, injected};
 use super::objects::{Creating, Owned};
 use crate::cloud::SplatCloud;
 pub use crate::profile::PAGE_SPLATS;
@@ -83,8 +83,8 @@ impl TextureLayout {
 
     /// The layout for the context's limits (as lowered by the fault hooks, if injected).
     pub(crate) fn for_context(gl: &glow::Context) -> Self {
-        let size = fault::limit(gl, glow::MAX_TEXTURE_SIZE);
-        let layers = fault::limit(gl, glow::MAX_ARRAY_TEXTURE_LAYERS);
+        let size = caps::limit(gl, glow::MAX_TEXTURE_SIZE);
+        let layers = caps::limit(gl, glow::MAX_ARRAY_TEXTURE_LAYERS);
         Self::for_limits(size, layers)
     }
 
@@ -220,7 +220,7 @@ fn allocate_texture(
 ) -> Result<(glow::Texture, RowTarget), GlError> {
     let (mut height, mut layers) = layout.shape(n, per_splat);
     let mut rows_total = height * layers;
-    if let Some(l) = fault::get(|f| f.oversize_layers) {
+    if let Some(l) = injected!(i32, |f| f.oversize_layers) {
         (height, layers) = (layout.layer_rows(), l as usize);
         rows_total = height;
     }

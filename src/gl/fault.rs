@@ -4,15 +4,14 @@
 //!
 //! The faults are per thread (a GL context is current on one thread, and the test harness runs
 //! each test on its own thread) and last while the `FaultGuard` returned by `inject` lives.
-//! Only with the cargo feature `testing` (the tests enable it): without it `inject` does not
-//! exist and every lookup below is the healthy driver's answer, with nothing thread-local read.
+//! The module exists only with the cargo feature `testing` (the tests enable it): without it
+//! the GL layer's lookups (`gl::caps`, `injected!`) are the healthy driver's answers, with
+//! nothing thread-local read and no symbol of this module in the binary.
 
-#[cfg(feature = "testing")]
 use std::cell::RefCell;
 
 /// The faults to inject. `Default` injects none.
 #[derive(Debug, Clone, Default)]
-#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub struct Faults {
     /// Read instead of `GL_VERSION` by the context check of `SplatRenderer::new`, e.g.
     /// `"2.1 Mesa 22.3.6"` or `"OpenGL ES 2.0 Mesa"`.
@@ -32,26 +31,22 @@ pub struct Faults {
     pub oversize_layers: Option<i32>,
 }
 
-#[cfg(feature = "testing")]
 thread_local! {
     static FAULTS: RefCell<Option<Faults>> = const { RefCell::new(None) };
 }
 
 /// Injects `faults` on this thread until the returned guard is dropped.
-#[cfg(feature = "testing")]
 pub fn inject(faults: Faults) -> FaultGuard {
     let previous = FAULTS.with(|f| f.replace(Some(faults)));
     FaultGuard { previous }
 }
 
 /// Removes the injected faults when dropped (restoring any injected before).
-#[cfg(feature = "testing")]
 #[derive(Debug)]
 pub struct FaultGuard {
     previous: Option<Faults>,
 }
 
-#[cfg(feature = "testing")]
 impl Drop for FaultGuard {
     fn drop(&mut self) {
         let previous = self.previous.take();
@@ -60,34 +55,7 @@ impl Drop for FaultGuard {
 }
 
 /// A value from the injected faults, if any are injected.
-#[cfg(feature = "testing")]
 pub(crate) fn get<T>(pick: impl FnOnce(&Faults) -> Option<T>) -> Option<T> {
     FAULTS.with(|f| f.borrow().as_ref().and_then(pick))
 }
 
-/// Without the `testing` feature nothing is ever injected.
-#[cfg(not(feature = "testing"))]
-#[inline(always)]
-pub(crate) fn get<T>(_pick: impl FnOnce(&Faults) -> Option<T>) -> Option<T> {
-    None
-}
-
-/// Whether the extension is supported, as the GL layer sees it.
-pub(crate) fn has_extension(gl: &glow::Context, name: &str) -> bool {
-    use glow::HasContext;
-    let missing = get(|f| f.missing_extensions.contains(&name).then_some(())).is_some();
-    !missing && gl.supported_extensions().contains(name)
-}
-
-/// An integer limit (`GL_MAX_TEXTURE_SIZE`, `GL_MAX_ARRAY_TEXTURE_LAYERS`), as the GL layer
-/// sees it: the injected value if one is, else the context's.
-pub(crate) fn limit(gl: &glow::Context, pname: u32) -> i32 {
-    use glow::HasContext;
-    let injected = match pname {
-        glow::MAX_TEXTURE_SIZE => get(|f| f.max_texture_size),
-        glow::MAX_ARRAY_TEXTURE_LAYERS => get(|f| f.max_array_layers),
-        _ => None,
-    };
-    // SAFETY: a plain integer query.
-    injected.unwrap_or_else(|| unsafe { gl.get_parameter_i32(pname) })
-}

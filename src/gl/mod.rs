@@ -39,18 +39,17 @@
 //! limits ([`GlError::Capacity`]; below them clouds larger than one texture are spread over
 //! array-texture layers), `GL_OUT_OF_MEMORY` ([`GlError::Gl`]).
 
+mod caps;
 mod context;
 pub(crate) mod data;
 mod draw;
 mod error;
 pub mod frame;
-// Fault injection for the GL tests: public (hidden) only with the `testing` feature; without
-// it every lookup is a constant and nothing thread-local is read on a production path.
+// Fault injection for the GL tests: only with the `testing` feature (hidden); without it every
+// lookup (`caps`) is the driver's answer and nothing thread-local is read on a production path.
 #[cfg(feature = "testing")]
 #[doc(hidden)]
 pub mod fault;
-#[cfg(not(feature = "testing"))]
-mod fault;
 mod glsl;
 mod host_sort;
 mod objects;

@@ -9,7 +9,7 @@ use glow::HasContext;
 
 use super::GlError;
 use super::error::ErrorScope;
-use super::fault;
+use super::caps;
 use super::objects::{Creating, Owned};
 use crate::image::Image;
 
@@ -86,8 +86,8 @@ impl ReadbackTarget {
     ) -> Result<Self, GlError> {
         if format == ColorFormat::Rgba16f
             && gl.version().is_embedded
-            && !fault::has_extension(gl, "GL_EXT_color_buffer_float")
-            && !fault::has_extension(gl, "GL_EXT_color_buffer_half_float")
+            && !caps::has_extension(gl, "GL_EXT_color_buffer_float")
+            && !caps::has_extension(gl, "GL_EXT_color_buffer_half_float")
         {
             return Err(GlError::MissingExtension {
                 extension: "GL_EXT_color_buffer_float or GL_EXT_color_buffer_half_float",

@@ -10,7 +10,7 @@ use super::GlError;
 use super::context::ContextInfo;
 use super::data::{CloudSet, PAGE_SPLATS, SplatTextures, TextureLayout};
 use super::error::ErrorScope;
-use super::fault;
+use super::caps::injected;
 use super::glsl::{self, Errata, GlslVersion};
 use super::objects::{Creating, Owned};
 use super::prepass::{PREPASS_MIN_SPLATS, PrePass, Sources};
@@ -103,7 +103,7 @@ impl SplatRenderer {
         let layout = TextureLayout::for_context(gl);
         let source = |stage: &str, body: &str| {
             let s = glsl::assemble(version, &errata, &layout, body);
-            match fault::get(|f| f.edit_shader) {
+            match injected!(fn(&str, String) -> String, |f| f.edit_shader) {
                 Some(edit) => edit(stage, s),
                 None => s,
             }

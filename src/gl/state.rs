@@ -89,7 +89,7 @@
 //! | `GL_TRANSFORM_FEEDBACK_BINDING` | TF objects | 0 |
 //!
 //! ("sRGB switch": desktop GL, or ES with `GL_EXT_sRGB_write_control`; "TF objects": ES 3.x,
-//! desktop GL ≥ 4.0 or `GL_ARB_transform_feedback2`.) `tests/gl_embedding.rs`
+//! desktop GL ≥ 4.0 or `GL_ARB_transform_feedback2`.) `tests/it/gl_embedding.rs`
 //! sets over 60 pieces of host state in ES, core and compatibility contexts and checks, in
 //! both modes, that every one reads back as this module says; a unit test checks that this
 //! table and [`LEFT_WITHOUT_RESTORE`] agree.

@@ -1,0 +1,36 @@
+//! What the GL layer sees of the context's extensions and limits: the driver's answers, or,
+//! with the cargo feature `testing`, the faults a test injected (`gl::fault`).
+
+/// A value from the faults a test injected on this thread (feature `testing`): `$f` is the
+/// `gl::fault::Faults`, `$e` picks an `Option<$t>` from it. Without the feature, `None`: the
+/// `fault` module does not exist and nothing thread-local is read.
+macro_rules! injected {
+    ($t:ty, |$f:ident| $e:expr) => {{
+        #[cfg(feature = "testing")]
+        let v: Option<$t> = crate::gl::fault::get(|$f| $e);
+        #[cfg(not(feature = "testing"))]
+        let v: Option<$t> = None;
+        v
+    }};
+}
+pub(crate) use injected;
+
+/// Whether the extension is supported, as the GL layer sees it.
+pub(crate) fn has_extension(gl: &glow::Context, name: &str) -> bool {
+    use glow::HasContext;
+    let missing = injected!((), |f| f.missing_extensions.contains(&name).then_some(())).is_some();
+    !missing && gl.supported_extensions().contains(name)
+}
+
+/// An integer limit (`GL_MAX_TEXTURE_SIZE`, `GL_MAX_ARRAY_TEXTURE_LAYERS`), as the GL layer
+/// sees it: the injected value if one is, else the context's.
+pub(crate) fn limit(gl: &glow::Context, pname: u32) -> i32 {
+    use glow::HasContext;
+    let injected = match pname {
+        glow::MAX_TEXTURE_SIZE => injected!(i32, |f| f.max_texture_size),
+        glow::MAX_ARRAY_TEXTURE_LAYERS => injected!(i32, |f| f.max_array_layers),
+        _ => None,
+    };
+    // SAFETY: a plain integer query.
+    injected.unwrap_or_else(|| unsafe { gl.get_parameter_i32(pname) })
+}
