@@ -4,7 +4,7 @@
 //! (`draw_with_matrices`), occluded by the cube through the host's depth buffer, with
 //! `restore_state = true` — so the host's next frame is bit-identical to one drawn before
 //! splatgl existed. The host logic is in `examples/host/modern.rs` (rendered and checked by
-//! `tests/gl_embedding.rs`).
+//! `tests/it/gl_embedding.rs`).
 //!
 //! `cargo run --release --example embed -- [SCENE] [OUT_PREFIX]` writes OUT_PREFIX-N.png.
 

@@ -2,7 +2,7 @@
 //! the host draws a textured ground quad in immediate mode, splatgl draws the splats with the
 //! host's fixed-function matrices and `restore_state = true`, then the host draws a cube from
 //! client arrays in the vertex buffer it expects still bound — frame after frame. The host
-//! logic is in `examples/host/legacy.rs` (rendered and checked by `tests/gl_embedding.rs`).
+//! logic is in `examples/host/legacy.rs` (rendered and checked by `tests/it/gl_embedding.rs`).
 //!
 //! `cargo run --release --example embed_legacy -- [SCENE] [OUT_PREFIX]` writes
 //! OUT_PREFIX-N.png.

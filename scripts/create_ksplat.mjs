@@ -1,5 +1,5 @@
 // Writes a .ksplat from an INRIA PLY with mkkellogg GaussianSplats3D's own generator, for the
-// cross-check in tests/splat_transform.rs (splat-transform reads .ksplat but cannot write it).
+// cross-check in tests/it/splat_transform.rs (splat-transform reads .ksplat but cannot write it).
 // Usage: node create_ksplat.mjs MODULE_JS IN.ply OUT.ksplat LEVEL SH_DEGREE
 import * as fs from 'fs';
 import { pathToFileURL } from 'url';

@@ -32,7 +32,9 @@ fast() {
   RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --all-features --locked
   cargo build --locked --quiet -p splatgl-cli
   python3 scripts/xcheck_reference.py "$target/debug/splatgl"
-  cargo test --workspace --all-targets --all-features --locked -- "${skip_slow[@]}"
+  cargo test --workspace --all-features --locked --lib --bins --tests --examples -- "${skip_slow[@]}"
+  # The benchmarks' smoke runs (each checks its own results; they take no harness options).
+  cargo test --workspace --all-features --locked --benches
 }
 
 slow() {

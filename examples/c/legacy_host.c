@@ -8,11 +8,11 @@
  *   - every frame is the same image (no state drifts from frame to frame);
  *   - each of the host's state pieces below reads back unchanged after every splatgl draw.
  *
- * Build (tests/capi_hosts.rs does this):
- *   cargo build --features capi
- *   cc -std=c99 -Wall -Wextra -Werror -Iinclude -Iexamples/c examples/c/legacy_host.c \
- *      -Ltarget/debug -lsplatgl -lEGL -lGL -lm -Wl,-rpath,$PWD/target/debug -o legacy_host
- *   ./legacy_host wall.ply     (tests/capi_hosts.rs writes the splat wall this expects)
+ * Build (crates/splatgl-capi/tests/it/capi_hosts.rs does this):
+ *   cargo build -p splatgl-capi
+ *   cc -std=c99 -Wall -Wextra -Werror -Icrates/splatgl-capi/include -Iexamples/c examples/c/legacy_host.c \
+ *      -Ltarget/debug -lsplatgl_capi -lEGL -lGL -lm -Wl,-rpath,$PWD/target/debug -o legacy_host
+ *   ./legacy_host wall.ply     (crates/splatgl-capi/tests/it/capi_hosts.rs writes the splat wall this expects)
  *
  * Exit status 0 when every check passes; each failure is printed.
  */

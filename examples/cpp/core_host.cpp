@@ -5,10 +5,10 @@
 // convention. Checks: where the front cube is, its pixels are untouched (the splats are
 // occluded); where the back cube is, the splats cover it; the error paths a host meets.
 //
-// Build (tests/capi_hosts.rs does this):
-//   cargo build --features capi
-//   c++ -std=c++17 -Wall -Wextra -Werror -Iinclude -Iexamples/c examples/cpp/core_host.cpp
-//       -Ltarget/debug -lsplatgl -lEGL -lm -Wl,-rpath,$PWD/target/debug -o core_host
+// Build (crates/splatgl-capi/tests/it/capi_hosts.rs does this):
+//   cargo build -p splatgl-capi
+//   c++ -std=c++17 -Wall -Wextra -Werror -Icrates/splatgl-capi/include -Iexamples/c examples/cpp/core_host.cpp
+//       -Ltarget/debug -lsplatgl_capi -lEGL -lm -Wl,-rpath,$PWD/target/debug -o core_host
 //   ./core_host
 #include <GL/glcorearb.h>
 

@@ -1,4 +1,4 @@
-//! The hosts of the embedding examples, shared with `tests/gl_embedding.rs` (which renders
+//! The hosts of the embedding examples, shared with `tests/it/gl_embedding.rs` (which renders
 //! both headlessly and checks their pixels): `modern` (GLES 3 / core profile, own shader and
 //! vertex array), `legacy` (compatibility profile: fixed function, immediate mode, client
 //! arrays), `legacy_gl` (the legacy entry points, loaded by hand).

@@ -1,5 +1,5 @@
 //! The embedding snippet is one text: `docs/snippets/embed.rs` is compiled as the crate's
-//! doc-test (and `gl`'s), and the README, `docs/embedding.md` and `docs/gl-backend.md` show
+//! doc-test (and `gl`'s), and `docs/guide.md`, `docs/embedding.md` and `docs/gl-backend.md` show
 //! exactly its visible lines, so what users copy is what compiles.
 
 use crate::common;
@@ -15,7 +15,7 @@ fn the_embedding_snippet_is_the_compiled_one_everywhere() {
         "{snippet}"
     );
     let block = format!("```rust\n{}\n```", visible.join("\n"));
-    for doc in ["README.md", "docs/embedding.md", "docs/gl-backend.md"] {
+    for doc in ["docs/guide.md", "docs/embedding.md", "docs/gl-backend.md"] {
         assert!(
             read(doc).contains(&block),
             "{doc} does not show docs/snippets/embed.rs"

@@ -1,6 +1,6 @@
 //! GL backend vs the CPU reference on Mesa EGL / llvmpipe: scene families, SH degrees, colour
 //! spaces, both targets, edge cases (near plane, image border, non-finite splats, orders), real
-//! files. Helpers and the error bound: `tests/common/gl.rs`.
+//! files. Helpers and the error bound: `crates/splatgl-testkit/src/gl.rs`.
 
 use crate::common;
 use common::gl::*;

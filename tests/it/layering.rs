@@ -128,10 +128,10 @@ fn no_module_uses_a_module_of_a_higher_layer_or_one_that_uses_it_back() {
                         "{at}: `{top}` (layer {a}) uses `{m}` (layer {b}), a higher layer"
                     )),
                     (None, _) => problems.push(format!(
-                        "{at}: module `{top}` is in no layer of tests/layering.rs"
+                        "{at}: module `{top}` is in no layer of tests/it/layering.rs"
                     )),
                     (_, None) => problems.push(format!(
-                        "{at}: module `{m}` is in no layer of tests/layering.rs"
+                        "{at}: module `{m}` is in no layer of tests/it/layering.rs"
                     )),
                     _ => {}
                 }

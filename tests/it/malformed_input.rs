@@ -19,7 +19,7 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 /// The load error in strict mode (without it, splats with unusable values are dropped: see
-/// `tests/hygiene.rs`).
+/// `crates/splatgl-cli/tests/it/hygiene.rs`).
 #[track_caller]
 fn err_of(bytes: &[u8], name: &str) -> String {
     match load_bytes(bytes, Some(Path::new(name)), &strict()) {

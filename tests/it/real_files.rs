@@ -275,7 +275,7 @@ fn bevy_camera_node() {
 }
 
 /// SPZ (v2 raw, v2, v3, v4), `.splat` and `.ksplat` used to be "not supported yet" errors;
-/// they load now, with the counts and degrees of SOURCES.md (details: tests/formats.rs).
+/// they load now, with the counts and degrees of SOURCES.md (details: tests/it/formats.rs).
 #[test]
 fn spz_splat_and_ksplat_files_load() {
     for (name, count) in [

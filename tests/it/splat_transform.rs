@@ -187,7 +187,7 @@ fn flipped(c: &SplatCloud) -> SplatCloud {
     f
 }
 
-/// SPZ with Niantic's packing (sh1Bits 5, shRestBits 4): see tests/format_roundtrip.rs.
+/// SPZ with Niantic's packing (sh1Bits 5, shRestBits 4): see tests/it/format_roundtrip.rs.
 fn spz_tol(version: u32) -> (f32, f32, [f32; 3]) {
     let d = 0.5f32 / 127.5;
     let rot = if version >= 3 {

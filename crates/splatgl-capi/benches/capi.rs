@@ -7,7 +7,7 @@
 //! nothing drawn), 1000 splats in view, and 100,000 splats (the sort and the draw dominate).
 //! glFinish after each draw, so each time is the whole frame; medians.
 //!
-//! `cargo bench --features capi --bench capi` (`SPLATGL_BENCH_DRAWS`, default 2000).
+//! `cargo bench -p splatgl-capi --bench capi` (`SPLATGL_BENCH_DRAWS`, default 2000).
 
 use splatgl_testkit as common;
 

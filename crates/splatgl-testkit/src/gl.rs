@@ -1,5 +1,5 @@
-//! Shared helpers of the GL test crates (`tests/gl_vs_reference.rs`, `tests/gl_embedding.rs`,
-//! `tests/gl_errata.rs`): GL backend (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU
+//! Shared helpers of the GL test crates (`tests/it/gl_vs_reference.rs`, `tests/it/gl_embedding.rs`,
+//! `tests/it/gl_errata.rs`): GL backend (OpenGL ES 3 on Mesa EGL / llvmpipe) against the CPU
 //! reference rasterizer. `use common::gl::*` brings these and the general helpers.
 //!
 //! Every test renders small images (≤ 96 px) so the suite stays fast on llvmpipe. Tests skip

@@ -1,4 +1,4 @@
-//! Helpers of the LOD fidelity tests (`tests/tiles_build.rs`, `tests/tiles_streamed_sog.rs`):
+//! Helpers of the LOD fidelity tests (`crates/splatgl-cli/tests/it/tiles_build.rs`, `crates/splatgl-cli/tests/it/tiles_streamed_sog.rs`):
 //! reference renders, PSNR, cameras around a cloud, and the comparison with uniform
 //! decimation to the same splat count.
 

@@ -1,5 +1,5 @@
 //! The C and C++ host examples, compiled with the system compiler (`-Wall -Wextra -Werror`)
-//! against the committed header and the C library built with feature `capi`, run headless
+//! against the committed header and the C library built with the `splatgl-capi` crate, run headless
 //! through EGL, and held to their own pixel and state checks (`examples/c/legacy_host.c`,
 //! `examples/cpp/core_host.cpp`).
 //!

@@ -36,7 +36,7 @@ const FILES: [&str; 15] = [
 ];
 // Not here, on purpose:
 // - bevy_khr_conformance_matrix.{glb,gltf}: 15 test primitives at one point, one of them a
-//   splat of scale (7.4, 0.05, 54.6); the eye must stay outside its 3σ box (tests/camera.rs,
+//   splat of scale (7.4, 0.05, 54.6); the eye must stay outside its 3σ box (tests/it/camera.rs,
 //   framing_from_extents_keeps_the_eye_outside_every_splat), which puts the 14 others at ~3 %
 //   of the frame.
 // - bevy_khr_extensible_fallback.gltf: one splat of scale 1.7e-48, a point at any distance.

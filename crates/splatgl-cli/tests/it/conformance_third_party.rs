@@ -71,7 +71,7 @@ fn gaussian_splats_3d_is_graded_by_the_rules_its_source_breaks() {
     // :8210–8222 the major axis `normalize(vec2(b, eigenValue1 - a))` in f32: vertical for
     // near-round footprints (the floor, or b below the rounding of mid² − det), which swaps
     // the axes of `opacity_one_cap`'s red splat and turns `sh_degree_1`'s; the
-    // `eigenvalue_floor` term follows it (src/conformance/model/footprint.rs).
+    // `eigenvalue_floor` term follows it (crates/splatgl-conformance/src/model/footprint.rs).
     // Where b is comparable with that rounding the axis may come out anywhere in the range
     // the rounding allows (`color0_fallback`'s faint tilted fringe); the term samples it.
     assert!(passes(&json, "sh_degree_1") && passes(&json, "opacity_one_cap"));

@@ -1,11 +1,11 @@
 //! The desktop viewer in a virtual X server (`xvfb-run`), driven with `xdotool`: what it shows
 //! equals the headless render of the same camera, mouse input moves the camera as the controls
 //! say, a file that fails to load keeps the previous scene, and `--crop` removes what
-//! `render --crop` removes. Helpers in `tests/common/viewer.rs`.
+//! `render --crop` removes. Helpers in `crates/splatgl-cli/tests/it/common/viewer.rs`.
 
 //! A tileset streams in the viewer to the selection `render` makes for the same camera.
 //!
-//! The interface is hidden (`--no-ui`) in these tests; `tests/viewer_panel.rs` tests it.
+//! The interface is hidden (`--no-ui`) in these tests; `crates/splatgl-cli/tests/it/viewer_panel.rs` tests it.
 
 use crate::common;
 

@@ -3,7 +3,7 @@
 //! camera); a click on a camera of its list moves the view there; dragging a face of the crop
 //! box removes the splats that `render --crop` removes with the box the viewer prints. The
 //! viewer prints where its buttons and handles are (`SPLATGL_VIEWER_LAYOUT`), and `xdotool`
-//! clicks them. Helpers in `tests/common/viewer.rs`.
+//! clicks them. Helpers in `crates/splatgl-cli/tests/it/common/viewer.rs`.
 
 use crate::common;
 

@@ -7,7 +7,7 @@
 //! it). It leaves the scissor test disabled and changes program, VAO, buffer and texture
 //! bindings, blend state, the viewport and (desktop) `GL_FRAMEBUFFER_SRGB`; the splat frame
 //! path sets every one of those it uses for each draw (`gl/state.rs`), so nothing the panel
-//! leaves reaches the splats — `tests/viewer_panel_gl.rs` holds it to that.
+//! leaves reaches the splats — `crates/splatgl-viewer/tests/it/viewer_panel_gl.rs` holds it to that.
 //!
 //! **Input.** Every window event goes to egui while the panel is shown; the viewer's own
 //! controls still get it unless it belongs to the interface: a press on the panel or on a crop

@@ -1,5 +1,5 @@
 //! Shared steps of the tests that grade renderers splatgl did not write
-//! (`tests/conformance_third_party.rs`, `tests/conformance_cesium.rs`): the tools they need,
+//! (`crates/splatgl-cli/tests/it/conformance_third_party.rs`, `crates/splatgl-cli/tests/it/conformance_cesium.rs`): the tools they need,
 //! the suite generated, rendered by an adapter in `scripts/conformance/`, graded by
 //! `splatgl conformance run`, and lookups in its report.json.
 #![allow(dead_code)]

@@ -1,5 +1,5 @@
 //! The desktop viewer in a virtual X server (`xvfb-run`), driven with `xdotool`: the helpers
-//! of `tests/viewer.rs` and `tests/viewer_panel.rs`. Every viewer gets a hard timeout and is
+//! of `crates/splatgl-cli/tests/it/viewer.rs` and `crates/splatgl-cli/tests/it/viewer_panel.rs`. Every viewer gets a hard timeout and is
 //! killed; without `xvfb-run` / `xdotool` / `import` the tests skip with a note.
 #![allow(dead_code)]
 
