@@ -58,4 +58,3 @@ impl Drop for FaultGuard {
 pub(crate) fn get<T>(pick: impl FnOnce(&Faults) -> Option<T>) -> Option<T> {
     FAULTS.with(|f| f.borrow().as_ref().and_then(pick))
 }
-

@@ -8,8 +8,8 @@
 use glow::HasContext;
 
 use super::GlError;
-use super::error::ErrorScope;
 use super::caps;
+use super::error::ErrorScope;
 use super::objects::{Creating, Owned};
 use crate::image::Image;
 

@@ -7,10 +7,10 @@ use glam::Mat4;
 use glow::HasContext;
 
 use super::GlError;
+use super::caps::injected;
 use super::context::ContextInfo;
 use super::data::{CloudSet, PAGE_SPLATS, SplatTextures, TextureLayout};
 use super::error::ErrorScope;
-use super::caps::injected;
 use super::glsl::{self, Errata, GlslVersion};
 use super::objects::{Creating, Owned};
 use super::prepass::{PREPASS_MIN_SPLATS, PrePass, Sources};
