@@ -13,7 +13,8 @@ use crate::reference::RenderOptions;
 pub enum Backend {
     /// The CPU reference rasterizer (float output).
     Reference,
-    /// OpenGL ES 3 through headless EGL (8-bit output, or RGBA16F resolved to 8 bits).
+    /// OpenGL ES 3 through headless EGL (blending in RGBA16F where the context can render to
+    /// it, else RGBA8; 8-bit output).
     Gl,
 }
 
@@ -38,6 +39,8 @@ pub enum Engine {
         renderer: Box<crate::headless::HeadlessRenderer>,
         /// The framebuffer it blends in.
         target: crate::headless::TargetKind,
+        /// Why it blends in RGBA8 although RGBA16F was preferred (a one-line warning).
+        fallback: Option<String>,
     },
 }
 
@@ -48,25 +51,63 @@ impl std::fmt::Debug for Engine {
 }
 
 impl Engine {
-    /// The engine of `backend` (GL: a new headless context, RGBA8 target).
+    /// The engine of `backend` (GL: a new headless context blending in RGBA16F where it can
+    /// render to it, see [`Engine::gl`]).
     pub fn new(backend: Backend) -> Result<Self, String> {
         match backend {
             Backend::Reference => Ok(Engine::Reference),
             #[cfg(feature = "gl")]
-            Backend::Gl => Self::gl(crate::headless::TargetKind::Rgba8),
+            Backend::Gl => Self::gl(None),
             #[cfg(not(feature = "gl"))]
             Backend::Gl => Err("this splatgl was built without the `gl` feature".into()),
         }
     }
 
-    /// A GL engine blending in `target`.
+    /// A GL engine blending in `target`, or with `None` in the framebuffer the RC recommends:
+    /// RGBA16F (floating-point blending, resolved to 8 bits) where the context can render to
+    /// it (desktop GL; ES with `EXT_color_buffer_half_float` or `_float`), else RGBA8 with a
+    /// warning ([`Engine::fallback`]).
     #[cfg(feature = "gl")]
-    pub fn gl(target: crate::headless::TargetKind) -> Result<Self, String> {
+    pub fn gl(target: Option<crate::headless::TargetKind>) -> Result<Self, String> {
+        use crate::headless::TargetKind;
         let renderer = crate::headless::HeadlessRenderer::new().map_err(|e| e.to_string())?;
+        let float = renderer.context().can_render_rgba16f();
+        let (target, fallback) = match target {
+            Some(t) => (t, None),
+            None if float => (TargetKind::Rgba16fResolve, None),
+            None => (
+                TargetKind::Rgba8,
+                Some(format!(
+                    "GL blends in RGBA8: the context ({}) cannot render to RGBA16F \
+                     (no EXT_color_buffer_half_float), so colours above 1 are clamped per splat",
+                    renderer.context().describe()
+                )),
+            ),
+        };
         Ok(Engine::Gl {
             renderer: Box::new(renderer),
             target,
+            fallback,
         })
+    }
+
+    /// The framebuffer a GL engine blends in (`None` for the reference).
+    #[cfg(feature = "gl")]
+    pub fn target(&self) -> Option<crate::headless::TargetKind> {
+        match self {
+            Engine::Reference => None,
+            Engine::Gl { target, .. } => Some(*target),
+        }
+    }
+
+    /// Why a GL engine blends in RGBA8 although RGBA16F was preferred: a one-line warning
+    /// for the user (`None` when it blends as asked or preferred, and for the reference).
+    pub fn fallback(&self) -> Option<&str> {
+        match self {
+            Engine::Reference => None,
+            #[cfg(feature = "gl")]
+            Engine::Gl { fallback, .. } => fallback.as_deref(),
+        }
     }
 
     /// Which backend this is.
@@ -124,7 +165,9 @@ impl Engine {
                 Ok((img, Some(stats.visible)))
             }
             #[cfg(feature = "gl")]
-            Engine::Gl { renderer, target } => {
+            Engine::Gl {
+                renderer, target, ..
+            } => {
                 let o = crate::headless::HeadlessOptions {
                     target: *target,
                     background: opts.background,

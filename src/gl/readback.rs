@@ -84,11 +84,7 @@ impl ReadbackTarget {
         format: ColorFormat,
         depth: Option<DepthFormat>,
     ) -> Result<Self, GlError> {
-        if format == ColorFormat::Rgba16f
-            && gl.version().is_embedded
-            && !caps::has_extension(gl, "GL_EXT_color_buffer_float")
-            && !caps::has_extension(gl, "GL_EXT_color_buffer_half_float")
-        {
+        if format == ColorFormat::Rgba16f && !caps::can_render_rgba16f(gl) {
             return Err(GlError::MissingExtension {
                 extension: "GL_EXT_color_buffer_float or GL_EXT_color_buffer_half_float",
                 needed_for: "an RGBA16F render target on OpenGL ES",

@@ -223,6 +223,12 @@ impl HeadlessContext {
             })
     }
 
+    /// Whether the context can render to (and blend in) an RGBA16F framebuffer: desktop GL,
+    /// or ES with `EXT_color_buffer_half_float` or `EXT_color_buffer_float`.
+    pub fn can_render_rgba16f(&self) -> bool {
+        crate::gl::can_render_rgba16f(&self.gl)
+    }
+
     /// `"GL_VERSION / GL_RENDERER"` of the context.
     pub fn describe(&self) -> String {
         // SAFETY: string queries on the current context.

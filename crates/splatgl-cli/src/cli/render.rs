@@ -31,9 +31,11 @@ pub enum Backend {
 /// GL framebuffer to blend in.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TargetArg {
-    /// Blend in 8-bit RGBA (sRGB8_ALPHA8 for lin_rec709_display clouds).
+    /// Blend in 8-bit RGBA (sRGB8_ALPHA8 for lin_rec709_display clouds): colours above 1 are
+    /// clamped per splat.
     Rgba8,
-    /// Blend in RGBA16F (the RC's recommendation), then resolve to 8 bits.
+    /// Blend in RGBA16F (the RC's recommendation; the default where the context can render
+    /// to it), then resolve to 8 bits.
     Rgba16f,
 }
 
@@ -80,8 +82,8 @@ pub struct Args {
     /// Renderer.
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     pub backend: Backend,
-    /// Framebuffer the GL backend blends in (default rgba8; asks auto for GL; an error with
-    /// --backend reference).
+    /// Framebuffer the GL backend blends in (default: rgba16f where the GL context can render
+    /// to it, else rgba8 with a warning; asks auto for GL; an error with --backend reference).
     #[arg(long, value_enum)]
     pub target: Option<TargetArg>,
     /// Output: .png (8-bit, or 16-bit with --depth16), .pfm (32-bit float RGB) or - (PNG on
@@ -333,6 +335,9 @@ fn go(a: &Args) -> Result<(), String> {
     let opts = render_options(a, bg, loaded.trained_antialiased);
     let t1 = Instant::now();
     let (mut engine, why) = wanted.engine(&cloud, &opts)?;
+    if let Some(w) = engine.fallback() {
+        eprintln!("warning: {w}");
+    }
     if a.verbose {
         eprintln!("backend: {} ({why})", engine.name());
         let kernel = if opts.antialiased {

@@ -93,10 +93,16 @@ impl Wanted {
                         ),
                     ));
                 }
+                let blend = match engine.target() {
+                    Some(splatgl::headless::TargetKind::Rgba16fResolve) => "RGBA16F",
+                    _ => "RGBA8",
+                };
                 let why = match self.backend {
-                    Backend::Gl => format!("--backend gl ({driver})"),
-                    _ if self.target.is_some() => format!("auto: --target asks for GL ({driver})"),
-                    _ => format!("auto: hardware GL driver ({driver})"),
+                    Backend::Gl => format!("--backend gl ({driver}), blending in {blend}"),
+                    _ if self.target.is_some() => {
+                        format!("auto: --target asks for GL ({driver}), blending in {blend}")
+                    }
+                    _ => format!("auto: hardware GL driver ({driver}), blending in {blend}"),
                 };
                 Ok((engine, why))
             }
@@ -110,10 +116,11 @@ impl Wanted {
     fn gl(&self, cloud: &SplatCloud, _: &RenderOptions) -> Result<(Engine, String), String> {
         use super::render::TargetArg;
         use splatgl::headless::TargetKind;
-        let target = match self.target.unwrap_or(TargetArg::Rgba8) {
+        // No --target: the RC's recommendation, float blending where the context can.
+        let target = self.target.map(|t| match t {
             TargetArg::Rgba8 => TargetKind::Rgba8,
             TargetArg::Rgba16f => TargetKind::Rgba16fResolve,
-        };
+        });
         let mut engine = Engine::gl(target)?;
         let driver = engine.describe().unwrap_or_default();
         // Software GL under auto falls back to the reference: no upload needed then.
