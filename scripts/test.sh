@@ -30,7 +30,9 @@ fast() {
   cargo clippy --workspace --locked -- -D warnings
   cargo clippy -p splatgl --no-default-features --locked -- -D warnings
   RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --all-features --locked
-  cargo build --locked --quiet -p splatgl-cli
+  # The command, and the C libraries the C and C++ host tests link (cargo test builds only
+  # the crates' rlibs).
+  cargo build --locked --quiet -p splatgl-cli -p splatgl-capi
   python3 scripts/xcheck_reference.py "$target/debug/splatgl"
   cargo test --workspace --all-features --locked --lib --bins --tests --examples -- "${skip_slow[@]}"
   # The benchmarks' smoke runs (each checks its own results; they take no harness options).

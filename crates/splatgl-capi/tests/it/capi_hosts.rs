@@ -19,16 +19,23 @@ fn root() -> PathBuf {
 }
 
 /// A folder holding this crate's C libraries under the names C hosts link (`libsplatgl.so`,
-/// `libsplatgl.a`, as cargo-c installs them), or why not. Cargo builds the crate's `cdylib` and
-/// `staticlib` (`libsplatgl_capi.*`, in `target/<profile>/`) before its tests run.
+/// `libsplatgl.a`, as cargo-c installs them), or why not. The test command builds them first
+/// (`cargo build -p splatgl-capi`: `libsplatgl_capi.*` in `target/<profile>/`); cargo test
+/// itself builds only the `rlib`, so where they are missing this builds them into a target
+/// folder of its own (`target/capi`: the main one is locked by the running cargo).
 fn library() -> &'static Result<PathBuf, String> {
     static LIB: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     LIB.get_or_init(|| {
         let exe = std::env::current_exe().map_err(|e| e.to_string())?;
-        let built = exe
+        let profile_dir = exe
             .ancestors()
             .nth(2)
             .ok_or("the test binary is not in target/<profile>/deps")?;
+        let built = if profile_dir.join("libsplatgl_capi.so").is_file() {
+            profile_dir.to_path_buf()
+        } else {
+            build_apart(profile_dir)?
+        };
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi-lib");
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
         for (from, to) in [
@@ -40,6 +47,33 @@ fn library() -> &'static Result<PathBuf, String> {
         }
         Ok(dir)
     })
+}
+
+/// Builds the C libraries into `target/capi` (beside `profile_dir`'s target folder); returns
+/// the folder holding them.
+fn build_apart(profile_dir: &Path) -> Result<PathBuf, String> {
+    let target = profile_dir.parent().ok_or("no target folder")?.join("capi");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .current_dir(root())
+        .args([
+            "build",
+            "-p",
+            "splatgl-capi",
+            "--lib",
+            "--locked",
+            "--target-dir",
+        ])
+        .arg(&target)
+        .output()
+        .map_err(|e| format!("cargo: {e}"))?;
+    if !out.status.success() {
+        return Err(format!(
+            "cargo build -p splatgl-capi failed:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    Ok(target.join("debug"))
 }
 
 /// Compiles `source` with `compiler` into the temporary folder, or `None` (skipped) when the
