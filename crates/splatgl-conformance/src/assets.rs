@@ -103,6 +103,23 @@ impl AssetSpec {
         self
     }
     /// Variants the asset is designed to detect.
+    /// What of the choices the judged region leaves out this asset tests: the extent when it
+    /// detects a cut-off shape (or catches erratum f by design), the order when it detects
+    /// view-depth order, the dilation when it catches erratum i by design or detects the
+    /// eigenvalue floor.
+    pub(crate) fn tested(&self) -> super::judge::Tested {
+        super::judge::Tested {
+            extent: self.designed_for.contains(&Erratum::F)
+                || self
+                    .detects
+                    .iter()
+                    .any(|v| matches!(v, Variant::BoxCut | Variant::SquareCut)),
+            order: self.detects.contains(&Variant::ViewDepthOrder),
+            dilation: self.designed_for.contains(&Erratum::I)
+                || self.detects.contains(&Variant::EigenvalueFloor),
+        }
+    }
+
     pub(crate) fn detects(mut self, v: &'static [Variant]) -> Self {
         self.detects = v;
         self

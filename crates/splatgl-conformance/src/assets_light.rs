@@ -21,10 +21,12 @@ fn sh_degree(l: usize) -> AssetSpec {
             [0.25, 0.3, 0.95],
             [0.75, 0.75, 0.2],
         ];
+        // Well apart (6σ): no splat overlaps another, so neither the blending order (two
+        // splats equally far from the front camera) nor the extent decides a judged pixel.
         for (k, rgb) in cols.into_iter().enumerate() {
             splat(
                 &mut c,
-                [k as f32 * 0.6 - 0.9, 0.0, 0.0],
+                [k as f32 * 1.2 - 1.8, 0.0, 0.0],
                 [0.2; 3],
                 ID,
                 0.9,
@@ -34,11 +36,12 @@ fn sh_degree(l: usize) -> AssetSpec {
     } else {
         // One splat per coefficient m = −l..l, only that coefficient set: (a, −a, a/2) on a
         // grey base (DC 0 → 0.5). |Y| ≤ 0.75 for every degree here, so colours stay in
-        // 0.5 ± 0.3 from every direction.
+        // 0.5 ± 0.3 from every direction. 6.5σ apart: no two overlap (order and extent decide
+        // no judged pixel).
         let n = 2 * l + 1;
         for j in 0..n {
-            let x = (j as f32 - (n - 1) as f32 / 2.0) * 0.42;
-            splat(&mut c, [x, 0.0, 0.0], [0.16; 3], ID, 0.9, [0.5; 3]);
+            let x = (j as f32 - (n - 1) as f32 / 2.0) * 0.65;
+            splat(&mut c, [x, 0.0, 0.0], [0.1; 3], ID, 0.9, [0.5; 3]);
             let k = c.coeffs_per_splat();
             c.sh[j * k + l * l + j] = [0.4, -0.4, 0.2];
         }

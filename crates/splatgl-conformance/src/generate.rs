@@ -4,7 +4,7 @@
 use super::assets::{AssetSpec, CameraSpec};
 use super::isolation::{admit, admitted_errata};
 use super::manifest::{AssetEntry, CameraEntry, Manifest, Tolerance};
-use super::{Erratum, HEIGHT, WIDTH, model};
+use super::{Erratum, HEIGHT, WIDTH, judge, model};
 use glam::{DMat3, DQuat, DVec3};
 use serde_json::json;
 use splatgl::camera::Camera;
@@ -63,7 +63,13 @@ fn gltf_axes(c: &CameraSpec) -> DMat3 {
 /// The measures a camera is judged by: the comparison, and the largest ratio of a pixel's
 /// error to its bound.
 pub(crate) fn measure(img: &Image, want: &Image, bound: &[f64]) -> (Comparison, f64) {
-    let (a, b) = (clamped(img), clamped(want));
+    let (mut a, b) = (clamped(img), clamped(want));
+    // Pixels outside the judged region (an infinite bound) count as equal.
+    for ((p, q), bd) in a.pixels.iter_mut().zip(&b.pixels).zip(bound) {
+        if bd.is_infinite() {
+            *p = *q;
+        }
+    }
     let c = compare(&a, &b, 0.0).expect("same size");
     let ratio = a
         .pixels
@@ -85,10 +91,11 @@ pub(crate) fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
         .zip(&b.pixels)
         .zip(bound)
         .filter(|((p, q), bd)| {
-            (0..3).any(|k| {
-                let e = (p[k] - q[k]).abs() as f64;
-                e.is_nan() || e > **bd
-            })
+            bd.is_finite()
+                && (0..3).any(|k| {
+                    let e = (p[k] - q[k]).abs() as f64;
+                    e.is_nan() || e > **bd
+                })
         })
         .count()
 }
@@ -142,8 +149,10 @@ pub(crate) fn clamped(img: &Image) -> Image {
 /// The tolerance from the model's per-pixel bound: `max_abs` is the largest bound, and if
 /// every pixel's error is within its bound the MSE is at most the mean squared bound.
 pub(crate) fn tolerance(m: &model::ModelImage) -> Tolerance {
-    let max_abs = m.bound.iter().copied().fold(0.0, f64::max);
-    let mse = m.bound.iter().map(|b| b * b).sum::<f64>() / m.bound.len().max(1) as f64;
+    // Over the judged region (finite bounds); the other pixels count as equal ([`measure`]).
+    let judged = || m.bound.iter().copied().filter(|b| b.is_finite());
+    let max_abs = judged().fold(0.0, f64::max);
+    let mse = judged().map(|b| b * b).sum::<f64>() / m.bound.len().max(1) as f64;
     Tolerance {
         max_abs,
         min_psnr: 10.0 * (1.0 / mse).log10(),
@@ -290,15 +299,39 @@ fn camera_entry(
     write(&dir.join(&pfm), &reference.encode_pfm())?;
     let mut exact = model::render(cloud, &cam, &[]);
     admit(&mut exact, spec, cloud, &cam);
-    let tolerance = tolerance(&exact);
+    if let Some((i, j, d)) = judge::sort_tie(cloud, &cam) {
+        return Err(design(format!(
+            "camera {}: splats {i} and {j} overlap with distances {d:.1e} apart \
+             (a sort tie: their order is f32 rounding's)",
+            spec_cam.name
+        )));
+    }
+    let judged = judge::judged_region(cloud, &cam, spec.tested());
     let bound_pfm = format!("reference/{image}.bound.pfm");
+    let judge_mask = format!("reference/{image}.judge.png");
     let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
-    for (p, b) in bound_img.pixels.iter_mut().zip(&exact.bound) {
+    let mut mask_img = Image::filled(WIDTH, HEIGHT, [0.0, 0.0, 0.0, 1.0]);
+    for ((p, m), (b, j)) in bound_img
+        .pixels
+        .iter_mut()
+        .zip(&mut mask_img.pixels)
+        .zip(exact.bound.iter().zip(&judged))
+    {
         p[3] = *b as f32;
+        let v = if *j { 1.0 } else { 0.0 };
+        *m = [v, v, v, 1.0];
     }
     write(&dir.join(&bound_pfm), &bound_img.encode_pfm_alpha())?;
-    // The bound as the runner reads it back (f32).
-    let bound: Vec<f64> = bound_img.pixels.iter().map(|p| p[3] as f64).collect();
+    let mask_png = mask_img.encode_png(PngDepth::Eight, false);
+    write(
+        &dir.join(&judge_mask),
+        &mask_png.map_err(|e| design(e.to_string()))?,
+    )?;
+    judge::apply(&mut exact.bound, &judged);
+    let tolerance = tolerance(&exact);
+    // The bound as the runner reads it back (f32), outside the judged region infinite.
+    let mut bound: Vec<f64> = bound_img.pixels.iter().map(|p| p[3] as f64).collect();
+    judge::apply(&mut bound, &judged);
     let caught = catches_of(
         spec,
         spec_cam,
@@ -321,6 +354,7 @@ fn camera_entry(
         reference_png: png,
         reference_pfm: pfm,
         bound_pfm,
+        judge_mask,
         tolerance,
     };
     Ok((entry, json_cam, caught))
@@ -388,6 +422,7 @@ pub fn generate(dir: &Path) -> Result<Manifest, GenerateError> {
     }
     let m = Manifest {
         generator: format!("splatgl {}", env!("CARGO_PKG_VERSION")),
+        rules_version: super::manifest::RULES_VERSION,
         background: [0.0; 3],
         assets,
     };

@@ -1,6 +1,7 @@
-//! Isolation: the deviations an asset's bound admits because the asset does not test them
-//! (`docs/conformance.md`, "RC rules and profile choices"), so that a renderer with one of
-//! them fails only the assets designed for it.
+//! Isolation by terms: the small choices an asset's bound admits because the asset does not
+//! test them (`docs/conformance.md`, "The RC-silent choices"), so that a renderer making them
+//! fails only the assets designed for them. The large ones are left out of the judged region
+//! ([`super::judge`]).
 
 use super::Erratum;
 use super::assets::AssetSpec;
@@ -18,31 +19,20 @@ enum Admitted {
 /// The field of [`model::Terms`] a deviation widens.
 type TermField = fn(&mut model::Terms) -> &mut f64;
 
-/// The deviations every asset admits unless it is designed to detect them, each with the
-/// [`model::Terms`] field it widens. Isolation: a renderer that makes one of them fails the
-/// assets designed for it and no other.
-/// - the 0.3 px² dilation (erratum i): an RC-silent choice (the RC leaves Σ' to "the same
-///   forward pass algorithm used during training"), detected by `subpixel_dilation`;
-/// - the shape of the cut-off (erratum f's 2.83σ, a 3.33σ bounding box, a 2.83σ square): an RC rule,
-///   detected by `cutoff_three_sigma` alone;
-/// - the order by view depth instead of camera distance: an RC rule, detected by the sorting
-///   assets;
+/// The small choices every asset's bound admits unless it is designed to detect them, each
+/// with the [`model::Terms`] field it widens: choices about Σ' at the scale of a pixel and
+/// about storage precision, which change a pixel by a fraction of what a rule does. (The
+/// choices that move whole rims or swap overlapping splats — the extent of a splat, the
+/// blending order — are left out of the judged region instead, [`super::judge`].)
+/// - the dilation of Σ' (erratum i: none; 0.1–0.3 px² in between): an RC-silent choice (the
+///   RC leaves Σ' to "the same forward pass algorithm used during training"), detected by
+///   `subpixel_dilation`, a profile asset;
 /// - 8-bit storage of the DC colour and the opacity (rounded down), and half-float storage
-///   of the 3D covariance: precisions the RC does not specify, admitted everywhere (no asset
-///   detects them);
+///   of the 3D covariance: precisions the RC does not specify, admitted everywhere;
 /// - Σ' rebuilt from eigenvalues floored at mid ± √0.1 (GaussianSplats3D's numerical
-///   safeguard): like the dilation, a choice about Σ' at the scale of a pixel, detected by
-///   `subpixel_dilation` (a profile asset) alone.
-const ISOLATED: [(Admitted, TermField); 8] = [
+///   safeguard): like the dilation, detected by `subpixel_dilation` alone.
+const ISOLATED: [(Admitted, TermField); 4] = [
     (Admitted::Erratum(Erratum::I), |t| &mut t.dilation),
-    (Admitted::Erratum(Erratum::F), |t| &mut t.cutoff_shape),
-    (Admitted::Variant(Variant::BoxCut), |t| &mut t.cutoff_shape),
-    (Admitted::Variant(Variant::SquareCut), |t| {
-        &mut t.cutoff_shape
-    }),
-    (Admitted::Variant(Variant::ViewDepthOrder), |t| {
-        &mut t.sort_order
-    }),
     (Admitted::Variant(Variant::Colour8Bit), |t| {
         &mut t.colour_8bit
     }),

@@ -18,6 +18,7 @@ mod assets_scene;
 pub mod diagnosis;
 mod generate;
 mod isolation;
+pub mod judge;
 pub mod manifest;
 pub mod model;
 pub mod render;

@@ -36,6 +36,12 @@ pub struct CameraEntry {
     /// Per-pixel error bound (grey PFM, relative to the suite folder): a pixel whose error
     /// exceeds its bound fails the camera.
     pub bound_pfm: String,
+    /// The judged region (greyscale PNG beside `bound_pfm`, relative to the suite folder):
+    /// white pixels are judged; black ones are where a choice the asset does not test (a
+    /// splat's rim between 2.83σ and where its α falls below 1/1020, two overlapping splats
+    /// whose distance and view-depth orders disagree) can move the image, reported but never
+    /// failing the camera ([`super::judge`]).
+    pub judge_mask: String,
     /// Pass thresholds.
     pub tolerance: Tolerance,
 }
@@ -96,27 +102,41 @@ pub struct AssetEntry {
 pub struct Manifest {
     /// Who wrote it (`splatgl X.Y.Z`).
     pub generator: String,
+    /// The version of the verdict rules the suite was generated for ([`RULES_VERSION`]);
+    /// the runner refuses another.
+    pub rules_version: u32,
     /// Background every image is rendered over (display RGB).
     pub background: [f64; 3],
     /// Assets.
     pub assets: Vec<AssetEntry>,
 }
 
+/// The version of the verdict rules (`docs/conformance.md`, "The verdict rules"): written
+/// into `manifest.json` and `report.json`; a suite of another version must be generated again.
+/// 3: judged regions (`judge_mask`), the early-stop term, `unknown_kernel` a profile asset.
+pub const RULES_VERSION: u32 = 3;
+
 fn terms_json(t: &Terms) -> Value {
     json!({
         "output_quantization": t.output, "blend_rounding": t.blend, "cutoff_edge": t.cutoff,
         "alpha_threshold": t.threshold, "alpha_cap": t.cap, "sh_f16": t.sh_f16,
-        "overbright": t.overbright, "float": t.float, "dilation": t.dilation,
-        "cutoff_shape": t.cutoff_shape, "sort_order": t.sort_order,
+        "overbright": t.overbright, "float": t.float, "early_stop": t.early_stop,
+        "dilation": t.dilation,
         "colour_8bit": t.colour_8bit, "covariance_f16": t.covariance_f16,
         "eigenvalue_floor": t.eigenvalue_floor, "combined": t.combined,
     })
 }
 
-/// The terms as written by [`terms_json`] (a missing key reads as 0: older manifests).
-fn terms_from_json(v: &Value) -> Terms {
-    let f = |k: &str| v[k].as_f64().unwrap_or(0.0);
-    Terms {
+/// The terms as written by [`terms_json`]; a missing key is an error naming it.
+fn terms_from_json(v: &Value) -> Result<Terms, String> {
+    let mut missing = None;
+    let mut f = |k: &'static str| {
+        v[k].as_f64().unwrap_or_else(|| {
+            missing.get_or_insert(k);
+            0.0
+        })
+    };
+    let t = Terms {
         output: f("output_quantization"),
         blend: f("blend_rounding"),
         cutoff: f("cutoff_edge"),
@@ -125,13 +145,18 @@ fn terms_from_json(v: &Value) -> Terms {
         sh_f16: f("sh_f16"),
         overbright: f("overbright"),
         float: f("float"),
+        early_stop: f("early_stop"),
         dilation: f("dilation"),
-        cutoff_shape: f("cutoff_shape"),
-        sort_order: f("sort_order"),
         colour_8bit: f("colour_8bit"),
         covariance_f16: f("covariance_f16"),
         eigenvalue_floor: f("eigenvalue_floor"),
         combined: f("combined"),
+    };
+    match missing {
+        Some(k) => Err(format!(
+            "manifest: `tolerance.terms.{k}` missing or not a number"
+        )),
+        None => Ok(t),
     }
 }
 
@@ -151,7 +176,7 @@ impl Manifest {
                             "cameras_json_index": c.gltf_camera,
                             "width": c.width, "height": c.height, "image": c.image,
                             "reference_png": c.reference_png, "reference_pfm": c.reference_pfm,
-                            "bound_pfm": c.bound_pfm,
+                            "bound_pfm": c.bound_pfm, "judge_mask": c.judge_mask,
                             "tolerance": {
                                 "max_abs": c.tolerance.max_abs, "min_psnr": c.tolerance.min_psnr,
                                 "terms": terms_json(&c.tolerance.terms),
@@ -173,6 +198,7 @@ impl Manifest {
             "suite": "KHR_gaussian_splatting conformance",
             "spec": "KHR_gaussian_splatting, Release Candidate",
             "generator": self.generator,
+            "rules_version": self.rules_version,
             "background": self.background,
             "color": "display-referred RGB (sRGB-encoded for lin_rec709_display), over the background, clamped to [0, 1]",
             "assets": assets,
@@ -190,7 +216,15 @@ impl Manifest {
         if bgv.len() != 3 {
             return Err("manifest: `background` must be 3 numbers".into());
         }
+        let rules_version = number(v, "rules_version")? as u32;
+        if rules_version != RULES_VERSION {
+            return Err(format!(
+                "manifest: `rules_version` is {rules_version}, this splatgl judges by rules \
+                 version {RULES_VERSION}: generate the suite again with this splatgl"
+            ));
+        }
         Ok(Manifest {
+            rules_version,
             generator: string(v, "generator")?,
             background: [bgv[0], bgv[1], bgv[2]],
             assets,
@@ -301,10 +335,11 @@ fn camera_from_json(c: &Value) -> Result<CameraEntry, String> {
         reference_png: string(c, "reference_png")?,
         reference_pfm: string(c, "reference_pfm")?,
         bound_pfm: string(c, "bound_pfm")?,
+        judge_mask: string(c, "judge_mask")?,
         tolerance: Tolerance {
             max_abs: number(t, "max_abs")?,
             min_psnr: number(t, "min_psnr")?,
-            terms: terms_from_json(&t["terms"]),
+            terms: terms_from_json(&t["terms"])?,
         },
     })
 }

@@ -138,7 +138,10 @@ impl Judge {
         if input != InputPrecision::Spz {
             return own();
         }
-        let m = derived_bound(&l.0.cloud, &l.1[ci], (&a.catches, &a.detects));
+        let mut m = derived_bound(&l.0.cloud, &l.1[ci], (&a.catches, &a.detects));
+        // The camera's judged region (the suite's bound is infinite outside it).
+        let judged: Vec<bool> = bound.iter().map(|b| b.is_finite()).collect();
+        super::judge::apply(&mut m.bound, &judged);
         Judge {
             camera: CameraEntry {
                 tolerance: tolerance(&m),
@@ -333,6 +336,13 @@ fn reference_and_bound(dir: &Path, c: &CameraEntry) -> Result<(Image, Vec<f64>),
     if bound.len() != want.pixels.len() {
         return Err(format!("{}: wrong size", c.bound_pfm));
     }
+    let mask = Image::read(suite_path(dir, &c.judge_mask)?).map_err(|e| e.to_string())?;
+    if mask.pixels.len() != want.pixels.len() {
+        return Err(format!("{}: wrong size", c.judge_mask));
+    }
+    let judged: Vec<bool> = mask.pixels.iter().map(|p| p[0] > 0.5).collect();
+    let mut bound = bound;
+    super::judge::apply(&mut bound, &judged);
     Ok((want, bound))
 }
 

@@ -15,28 +15,34 @@ use splatgl::camera::Camera;
 use splatgl::cloud::{ColorSpace, SplatCloud};
 use splatgl::image::Image;
 use splatgl::profile::srgb_encode;
-use splatgl::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2};
+use splatgl::profile::{ALPHA_MAX, ALPHA_MIN, CUTOFF_M2, DILATION_PX2};
 
+mod choices;
 mod footprint;
 mod project;
 mod quantized;
 mod terms;
 mod variant;
+pub use choices::{Choices, Extent, render_choices};
 pub(crate) use footprint::AXIS_SAMPLES as axis_samples;
-use project::project;
+pub(crate) use project::project;
 pub(crate) use quantized::spz as spz_copy;
 pub use terms::Terms;
 pub use variant::Variant;
 
 /// One projected splat.
 #[derive(Debug, Clone, Copy)]
-struct Layer {
+pub(crate) struct Layer {
+    /// The splat's index in the cloud.
+    pub(crate) index: usize,
     /// Where the Gaussian is evaluated (pixels, y down).
-    centre: [f64; 2],
+    pub(crate) centre: [f64; 2],
+    /// Σ' `[xx, xy, yy]` (dilated; pixels²).
+    pub(crate) cov: [f64; 3],
     /// Σ'⁻¹ `[xx, xy, yy]`.
-    conic: [f64; 3],
-    opacity: f64,
-    color: [f64; 3],
+    pub(crate) conic: [f64; 3],
+    pub(crate) opacity: f64,
+    pub(crate) color: [f64; 3],
     /// Colour error of f16 SH storage: Σₖ maxₓ|coefₖ·Yₖ|·2⁻¹¹ (bound term).
     f16_err: f64,
     /// Pixels `[x0, x1] × [y0, y1]` (centres, inclusive float bounds) the splat may touch.
@@ -54,10 +60,13 @@ pub struct ModelImage {
     pub bound: Vec<f64>,
     /// The largest value of each term over the image.
     pub worst: Terms,
-    /// Per pixel, the admitted-deviation terms (`dilation`, `cutoff_shape`, `sort_order`)
+    /// Per pixel, the admitted-deviation terms (`dilation`, `colour_8bit`, …)
     /// the generator added to `bound`.
     pub extra: Vec<Terms>,
 }
+
+/// 3DGS stops blending a pixel before its transmittance falls below this.
+const EARLY_STOP_T: f64 = 1e-4;
 
 /// Relative width of the band around the 3σ cut and the α threshold where f32 and f64
 /// (or two implementations' operation orders) can disagree.
@@ -91,7 +100,7 @@ pub(crate) fn render_with_axis(
         None
     };
     let cloud = quantized.as_ref().unwrap_or(cloud);
-    let layers = project(cloud, cam, x, v, axis);
+    let layers = project(cloud, cam, (x, v), axis, DILATION_PX2);
     let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display
         && !v.contains(&Variant::ColorSpaceIgnored);
     let blend = Blending {
@@ -100,18 +109,30 @@ pub(crate) fn render_with_axis(
         } else {
             CUTOFF_M2 as f64
         },
-        no_cap: x.contains(&Erratum::K),
+        cap: if x.contains(&Erratum::K) {
+            f64::INFINITY
+        } else {
+            ALPHA_MAX as f64
+        },
         alpha_squared: x.contains(&Erratum::G),
         // CesiumJS's square quads draw every fragment they cover: no 1/255 skip.
         every_fragment: v.contains(&Variant::SquareCut),
+        early_stop: false,
+        extent: Extent::Ellipse,
     };
+    shade_image(&layers, cam, &blend, linear)
+}
+
+/// The image of `layers` blended by `blend` (display-referred, sRGB-encoded when `linear`),
+/// with the per-pixel bound of the exact profile.
+fn shade_image(layers: &[Layer], cam: &Camera, blend: &Blending, linear: bool) -> ModelImage {
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut image = Image::filled(cam.width, cam.height, [0.0, 0.0, 0.0, 1.0]);
     let mut bound = vec![0.0; w * h];
     let mut worst = Terms::default();
     for py in 0..h {
         for px in 0..w {
-            let (c, a, mut t) = shade(&layers, (px as f64 + 0.5, py as f64 + 0.5), &blend);
+            let (c, a, mut t) = shade(layers, (px as f64 + 0.5, py as f64 + 0.5), blend);
             let disp = c.map(|v| if linear { srgb_encode(v) } else { v }.clamp(0.0, 1.0));
             if linear {
                 through_srgb_curve(&mut t, c);
@@ -130,13 +151,17 @@ pub(crate) fn render_with_axis(
     }
 }
 
-/// How the layers are blended: the cut-off (Mahalanobis²), the errata k (no α cap) and g
-/// (α² weighting), and whether fragments under the 1/255 threshold are drawn too.
+/// How the layers are blended: the cut-off (Mahalanobis²) of the ellipse extent, the α cap
+/// (erratum k: none), erratum g (α² weighting), whether fragments under the 1/255 threshold
+/// are drawn too, whether blending stops where T would fall below 10⁻⁴ (3DGS), and the
+/// extent of a splat ([`Extent`]).
 struct Blending {
     cut: f64,
-    no_cap: bool,
+    cap: f64,
     alpha_squared: bool,
     every_fragment: bool,
+    early_stop: bool,
+    extent: Extent,
 }
 
 /// One pixel centre: the blended linear colour, the alpha and the error terms, walking the
@@ -150,6 +175,8 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
         ..Default::default()
     };
     let mut layers_here = 0usize;
+    // What each drawn layer contributes, uncapped, for the early-stop term.
+    let mut drawn: Vec<(f64, [f64; 3])> = Vec::new();
     for l in layers {
         let [x0, x1, y0, y1] = l.rect;
         if xc < x0 || xc > x1 || yc < y0 || yc > y1 {
@@ -161,22 +188,19 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
         if (m2 - cut).abs() <= EDGE_BAND * cut {
             t.cutoff += raw.min(ALPHA_MAX as f64);
         }
-        let inside = match l.box_axes {
+        let inside = match (l.box_axes, b.extent) {
             // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
-            Some(ax) => ax.iter().all(|h| {
+            (Some(ax), _) => ax.iter().all(|h| {
                 let n2 = h[0] * h[0] + h[1] * h[1];
                 (dx * h[0] + dy * h[1]).abs() <= n2 + 1e-12
             }),
-            None => (0.0..=cut).contains(&m2),
+            (None, Extent::Ellipse) => (0.0..=cut).contains(&m2),
+            (None, e) => e.contains(l, (xc, yc)),
         };
         if !inside {
             continue;
         }
-        let alpha = if b.no_cap {
-            raw
-        } else {
-            raw.min(ALPHA_MAX as f64)
-        };
+        let alpha = raw.min(b.cap);
         if raw < ALPHA_MIN as f64 * (1.0 + 10.0 * EDGE_BAND) {
             t.threshold += raw;
         }
@@ -187,12 +211,16 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
             continue;
         }
         layers_here += 1;
+        drawn.push((raw.min(1.0), l.color));
         t.sh_f16 += alpha * l.f16_err;
         t.overbright += l
             .color
             .iter()
             .map(|v| (v - 1.0).max(0.0))
             .fold(0.0, f64::max);
+        if b.early_stop && (1.0 - a) * (1.0 - alpha) < EARLY_STOP_T {
+            break; // 3DGS: the splat that would take T below 10⁻⁴ is not blended
+        }
         let wgt = if b.alpha_squared {
             alpha * alpha
         } else {
@@ -207,14 +235,42 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
     // two half-steps per blended splat.
     t.blend = 2.0 * q * layers_here as f64;
     t.float = 1e-5 * (layers_here + 1) as f64;
+    t.early_stop = early_stop_change(&drawn);
     (c, a, t)
+}
+
+/// The most a stop at T < 10⁻⁴ (3DGS) changes a pixel whose drawn layers are `drawn` (α
+/// uncapped, colour), under each admitted α cap (0.99, 0.999, 1): with α up to 1 a nearly
+/// opaque layer can end the blending while much transmittance is left.
+fn early_stop_change(drawn: &[(f64, [f64; 3])]) -> f64 {
+    let walk = |cap: f64, stop: bool| {
+        let (mut c, mut t) = ([0.0f64; 3], 1.0f64);
+        for &(raw, col) in drawn {
+            let a = raw.min(cap);
+            if stop && t * (1.0 - a) < EARLY_STOP_T {
+                break;
+            }
+            for (v, lc) in c.iter_mut().zip(col) {
+                *v += lc * a * t;
+            }
+            t *= 1.0 - a;
+        }
+        c
+    };
+    [ALPHA_MAX as f64, 0.999, 1.0]
+        .into_iter()
+        .map(|cap| {
+            let (a, b) = (walk(cap, false), walk(cap, true));
+            (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
 }
 
 /// For `lin_rec709_display`: the α-convention terms act on linear values, so their interval
 /// around the pixel's linear colour `c` is mapped through the sRGB curve (the rounding terms
 /// are already in encoded units).
 fn through_srgb_curve(t: &mut Terms, c: [f64; 3]) {
-    let lin = t.cutoff + t.threshold + t.cap + t.sh_f16 + t.overbright;
+    let lin = t.cutoff + t.threshold + t.cap + t.sh_f16 + t.overbright + t.early_stop;
     let span = c
         .iter()
         .map(|&v| {
@@ -230,6 +286,7 @@ fn through_srgb_curve(t: &mut Terms, c: [f64; 3]) {
         &mut t.cap,
         &mut t.sh_f16,
         &mut t.overbright,
+        &mut t.early_stop,
     ] {
         *term *= scale;
     }

@@ -8,7 +8,7 @@ use glam::{DMat3, DQuat, DVec3};
 use splatgl::camera::Camera;
 use splatgl::cloud::SplatCloud;
 use splatgl::covariance::c_matrix;
-use splatgl::profile::{ALPHA_MAX, ALPHA_MIN, DILATION_PX2, JACOBIAN_CLAMP, NEAR_CULL};
+use splatgl::profile::{ALPHA_MAX, ALPHA_MIN, JACOBIAN_CLAMP, NEAR_CULL};
 use splatgl::reference::SortMode;
 
 use super::footprint::{BOX_SIGMA, SQUARE_SIGMA, box_half_axes, eigenvalue_floor};
@@ -76,6 +76,8 @@ struct View<'a> {
     lim: [f64; 2],
     /// Where in the f32 rounding's range of angles `EigenvalueFloor` takes its major axis.
     axis: Option<f64>,
+    /// The dilation added to Σ' (px²; 0 with erratum i).
+    dilation: f64,
 }
 
 impl View<'_> {
@@ -87,12 +89,14 @@ impl View<'_> {
     }
 }
 
-pub(super) fn project(
+/// The splats of `cloud` seen by `cam` with the errata `x` and the variants `vars`, as
+/// [`Layer`]s in blending order; Σ' dilated by `dilation` px² (erratum i: none).
+pub(crate) fn project(
     cloud: &SplatCloud,
     cam: &Camera,
-    x: &[Erratum],
-    vars: &[Variant],
+    (x, vars): (&[Erratum], &[Variant]),
     axis: Option<f64>,
+    dilation: f64,
 ) -> Vec<Layer> {
     let w2c = cam.world_to_camera.as_dmat4();
     let w_cv = DMat3::from_mat4(w2c);
@@ -116,6 +120,11 @@ pub(super) fn project(
             [JACOBIAN_CLAMP * tan.x, JACOBIAN_CLAMP * tan.y]
         },
         axis,
+        dilation: if x.contains(&Erratum::I) {
+            0.0
+        } else {
+            dilation
+        },
     };
     let mode = if view.var(Variant::ViewDepthOrder) {
         SortMode::ViewDepth
@@ -161,6 +170,8 @@ fn project_one(cloud: &SplatCloud, i: usize, view: &View) -> Option<Layer> {
     .map(|(_, k)| box_half_axes(a, b, cc, k));
     let (centre, rect) = centre_and_rect(view, [a, cc, det], [u, v], t.z, box_axes);
     Some(Layer {
+        index: i,
+        cov: [a, b, cc],
         centre,
         conic: [cc / det, -b / det, a / det],
         opacity,
@@ -209,11 +220,7 @@ fn screen_covariance(
         return half_covariance(view, m, [j0, j1]);
     }
     let (p0, p1) = (m * j0, m * j1);
-    let d = if view.on(Erratum::I) {
-        0.0
-    } else {
-        DILATION_PX2
-    };
+    let d = view.dilation;
     let (mut a, mut b, mut cc) = (p0.dot(p0) + d, p0.dot(p1), p1.dot(p1) + d);
     let mut det = p0.cross(p1).length_squared() + d * (p0.dot(p0) + p1.dot(p1)) + d * d;
     if !(det > 0.0 && det.is_finite()) {
@@ -241,11 +248,7 @@ fn half_covariance(view: &View, m: DMat3, [j0, j1]: [DVec3; 2]) -> Option<([f64;
     let wt = view.w.transpose();
     let (u0, u1) = (wt * j0, wt * j1);
     let (a0, b, c0) = (u0.dot(sq * u0), u0.dot(sq * u1), u1.dot(sq * u1));
-    let d = if view.on(Erratum::I) {
-        0.0
-    } else {
-        DILATION_PX2
-    };
+    let d = view.dilation;
     let (mut a, mut b, mut cc) = (a0 + d, b, c0 + d);
     let mut det = a * cc - b * b;
     if !(det > 0.0 && det.is_finite()) {

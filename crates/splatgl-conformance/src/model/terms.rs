@@ -19,13 +19,11 @@ pub struct Terms {
     pub overbright: f64,
     /// f32 arithmetic.
     pub float: f64,
+    /// A stop at T < 10⁻⁴ (3DGS; the RC is silent), under any admitted α cap.
+    pub early_stop: f64,
     /// Deviations an asset admits because it does not test them (set by the generator, not by
-    /// [`super::render`]; isolation): the difference the model shows without the 0.3 px² dilation,
+    /// [`super::render`]; isolation): the difference the model shows with another dilation,
     pub dilation: f64,
-    /// …with another cut-off shape (2.83σ, a 3.33σ bounding box, a 2.83σ square),
-    pub cutoff_shape: f64,
-    /// …with splats ordered by view depth,
-    pub sort_order: f64,
     /// …with the DC colour and the opacity stored in 8 bits (rounded down),
     pub colour_8bit: f64,
     /// …with the 3D covariance stored as half floats,
@@ -48,9 +46,8 @@ impl Terms {
             + self.sh_f16
             + self.overbright
             + self.float
+            + self.early_stop
             + self.dilation
-            + self.cutoff_shape
-            + self.sort_order
             + self.colour_8bit
             + self.covariance_f16
             + self.eigenvalue_floor
@@ -66,9 +63,8 @@ impl Terms {
             sh_f16: self.sh_f16.max(o.sh_f16),
             overbright: self.overbright.max(o.overbright),
             float: self.float.max(o.float),
+            early_stop: self.early_stop.max(o.early_stop),
             dilation: self.dilation.max(o.dilation),
-            cutoff_shape: self.cutoff_shape.max(o.cutoff_shape),
-            sort_order: self.sort_order.max(o.sort_order),
             colour_8bit: self.colour_8bit.max(o.colour_8bit),
             covariance_f16: self.covariance_f16.max(o.covariance_f16),
             eigenvalue_floor: self.eigenvalue_floor.max(o.eigenvalue_floor),
