@@ -174,6 +174,11 @@ fn unknown(kernel: bool) -> AssetSpec {
         )
     };
     a.optional = !kernel;
+    if kernel {
+        // The RC's fallback for an unknown kernel is a lowercase "should", in an example
+        // section ("Adding additional Kernel Types"): a recommendation, not a rule.
+        a = a.profile();
+    }
     a
 }
 

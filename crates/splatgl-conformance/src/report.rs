@@ -9,14 +9,15 @@ use serde_json::{Value, json};
 use splatgl::compare::diff_image;
 use splatgl::image::{Image, PngDepth};
 
-/// Counts over a run. `passed`, `failed` and `skipped` count the assets that check a rule of
-/// the RC (`"checks": "rc"`); the profile assets (choices the RC leaves open) are counted
-/// apart and never fail a run.
+/// Counts over a run. `passed` and `failed` count the required assets that check a rule of
+/// the RC (`"checks": "rc"`), `skipped` the optional ones without images; the optional
+/// assets rendered and the profile assets (choices the RC leaves open) are counted apart and
+/// never fail a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Summary {
     /// RC assets that passed.
     pub passed: usize,
-    /// RC assets that failed (optional ones included when their images were given).
+    /// Required RC assets that failed.
     pub failed: usize,
     /// Optional assets without images.
     pub skipped: usize,
@@ -25,6 +26,10 @@ pub struct Summary {
     /// Profile assets whose images differ from it (informative: another RC-silent choice, or
     /// an error the RC assets do not see).
     pub profile_differ: usize,
+    /// Optional assets rendered that pass.
+    pub optional_passed: usize,
+    /// Optional assets rendered that fail (informative: they never fail a run).
+    pub optional_failed: usize,
 }
 
 /// Counts the results.
@@ -32,13 +37,16 @@ pub fn summary(results: &[AssetResult]) -> Summary {
     let mut s = Summary::default();
     for r in results {
         let profile = r.asset.checks == Checks::Profile;
-        match (r.skipped, profile, r.pass()) {
-            (true, _, _) => s.skipped += 1,
-            (false, true, true) => s.profile_matched += 1,
-            (false, true, false) => s.profile_differ += 1,
-            (false, false, true) => s.passed += 1,
-            (false, false, false) => s.failed += 1,
-        }
+        let count = match (r.skipped, r.asset.optional, profile, r.pass()) {
+            (true, ..) => &mut s.skipped,
+            (false, true, _, true) => &mut s.optional_passed,
+            (false, true, _, false) => &mut s.optional_failed,
+            (false, false, true, true) => &mut s.profile_matched,
+            (false, false, true, false) => &mut s.profile_differ,
+            (false, false, false, true) => &mut s.passed,
+            (false, false, false, false) => &mut s.failed,
+        };
+        *count += 1;
     }
     s
 }
@@ -55,8 +63,9 @@ fn num(v: Option<f64>) -> Value {
 /// `skipped`, `catches`, `cause`, `cameras` with the same per camera plus the tolerance, `cause`
 /// and `nearest`: the model an unexplained failure came nearest to, `rules`, `pixels_over`,
 /// `worst_ratio`),
-/// `passed`, `failed`, `skipped` (counts of the RC assets), `profile` {`matched`, `differ`},
-/// `source`.
+/// `passed`, `failed` (counts of the required RC assets), `skipped` (optional assets without
+/// images), `optional` {`passed`, `failed`} (optional assets rendered), `profile` {`matched`,
+/// `differ`}, `rules_version`, `source`.
 pub fn to_json(results: &[AssetResult], source: &str) -> Value {
     let s = summary(results);
     let diagnosis = diagnosis(results);
@@ -99,6 +108,8 @@ pub fn to_json(results: &[AssetResult], source: &str) -> Value {
         "failed": s.failed,
         "skipped": s.skipped,
         "profile": {"matched": s.profile_matched, "differ": s.profile_differ},
+        "optional": {"passed": s.optional_passed, "failed": s.optional_failed},
+        "rules_version": super::manifest::RULES_VERSION,
         "assets": assets,
     })
 }

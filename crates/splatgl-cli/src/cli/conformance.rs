@@ -91,10 +91,13 @@ fn run_cmd(a: &RunArgs) -> Result<bool, String> {
     let s = report::summary(&results);
     print_failures(&results);
     println!(
-        "{} passed, {} failed, {} skipped (RC rules); profile: {} match, {} differ -> {}",
+        "{} passed, {} failed, {} skipped (RC rules); optional: {} pass, {} fail; \
+         profile: {} match, {} differ -> {}",
         s.passed,
         s.failed,
         s.skipped,
+        s.optional_passed,
+        s.optional_failed,
         s.profile_matched,
         s.profile_differ,
         out.join("report.html").display()

@@ -267,7 +267,10 @@ fn failed_conformance_writes_leave_the_previous_suite_and_report_byte_identical(
     std::fs::create_dir_all(empty.join("report")).unwrap();
     std::fs::write(
         empty.join("manifest.json"),
-        r#"{"generator": "test", "background": [0, 0, 0], "assets": []}"#,
+        format!(
+            r#"{{"generator": "test", "rules_version": {}, "background": [0, 0, 0], "assets": []}}"#,
+            splatgl_conformance::manifest::RULES_VERSION
+        ),
     )
     .unwrap();
     for f in ["report.json", "report.html"] {
