@@ -36,12 +36,18 @@ fn sh_degree(l: usize) -> AssetSpec {
     } else {
         // One splat per coefficient m = −l..l, only that coefficient set: (a, −a, a/2) on a
         // grey base (DC 0 → 0.5). |Y| ≤ 0.75 for every degree here, so colours stay in
-        // 0.5 ± 0.3 from every direction. 6.5σ apart: no two overlap (order and extent decide
-        // no judged pixel).
+        // 0.5 ± 0.3 from every direction. 6σ apart in a row (degree 3: two rows, the second
+        // shifted by half a step so that they do not line up seen from above): no two overlap
+        // from the front or the back, so neither the blending order nor the extent decides a
+        // judged pixel.
         let n = 2 * l + 1;
         for j in 0..n {
-            let x = (j as f32 - (n - 1) as f32 / 2.0) * 0.65;
-            splat(&mut c, [x, 0.0, 0.0], [0.1; 3], ID, 0.9, [0.5; 3]);
+            let (x, y) = match (n, j) {
+                (7, 0..=3) => ((j as f32 - 1.5) * 0.96, 0.55),
+                (7, _) => ((j as f32 - 5.0) * 0.96, -0.55),
+                _ => ((j as f32 - (n - 1) as f32 / 2.0) * 0.96, 0.0),
+            };
+            splat(&mut c, [x, y, 0.0], [0.16; 3], ID, 0.9, [0.5; 3]);
             let k = c.coeffs_per_splat();
             c.sh[j * k + l * l + j] = [0.4, -0.4, 0.2];
         }

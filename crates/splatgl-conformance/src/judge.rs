@@ -13,9 +13,14 @@ use splatgl::camera::Camera;
 use splatgl::cloud::SplatCloud;
 use splatgl::profile::DILATION_PX2;
 
+/// How much smaller than the profile's (beyond the dilation) a renderer's footprint may be
+/// where it stores scales in 8 bits (SPZ, Spark's packed splats: σ off by up to ~4 %) or
+/// floors Σ''s eigenvalues (GaussianSplats3D): a rim starts this much further in.
+pub const FOOTPRINT_MARGIN: f64 = 0.06;
 /// Mahalanobis² of the smallest cut-off a renderer may make (2√2σ: the review draft's
-/// `power > 4` and CesiumJS's square), less a margin: from here outwards is a splat's rim.
-const RIM_M2: f64 = 8.0 * 0.999;
+/// `power > 4` and CesiumJS's square) on a footprint [`FOOTPRINT_MARGIN`] smaller: from here
+/// outwards is a splat's rim.
+const RIM_M2: f64 = 8.0 * (1.0 - FOOTPRINT_MARGIN) * (1.0 - FOOTPRINT_MARGIN);
 /// The α below which one layer cannot move a pixel beyond the generic bound (a quarter of an
 /// 8-bit step): a rim or an overlap fainter than this is judged.
 pub const QUIET_ALPHA: f64 = 0.25 / 255.0;

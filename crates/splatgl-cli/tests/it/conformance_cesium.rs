@@ -83,10 +83,11 @@ fn cesium_is_graded_by_the_rules_its_source_breaks() {
         named(&json)
     );
     // Graded by what its SPZ copies carry (with the bound derived from each copy), the square
-    // cut (admitted wherever the cut-off is not what an asset tests), its near-zero dilation
-    // and 8-bit colour pass most assets: measured 24 of 29 (docs/conformance.md).
+    // cut (outside the judged region wherever the cut-off is not what an asset tests), its
+    // near-zero dilation and 8-bit colour pass every other required asset: measured 23 of 26
+    // (docs/conformance.md).
     let passed = json["passed"].as_u64().unwrap();
-    assert!(passed >= 22, "{passed} RC assets pass");
+    assert!(passed >= 23, "{passed} RC assets pass");
     // wasm-splats src/radix.rs:25-33: the key is view-space z (positions · the model-view
     // matrix's third row), not the distance to the camera; the diagnosis says so.
     assert!(!pass("sort_distance_not_depth"));
@@ -99,19 +100,15 @@ fn cesium_is_graded_by_the_rules_its_source_breaks() {
     // And the linear asset shown as display values is named as the colour space ignored.
     let ignored = named_for(&json, "color_space_ignored").unwrap_or_default();
     assert!(ignored.contains(&"color_space_linear".to_owned()));
-    // Every other RC asset it fails is one of the two near misses docs/conformance.md lists
-    // (a pixel of an instanced copy's rim, the rotated node's SH seen from the side).
+    // It fails no other required RC asset: the two near misses of round 2 (a pixel of an
+    // instanced copy's rim, the rotated node's SH seen from the side) lie outside the judged
+    // regions (a rim; splats whose order a renderer may choose).
     for a in rc_assets(&json).filter(|a| !a["pass"].as_bool().unwrap_or(false)) {
         let name = a["name"].as_str().unwrap_or("");
         assert!(
-            [
-                "cutoff_three_sigma",
-                "sort_distance_not_depth",
-                "color_space_linear",
-                "node_instanced_mesh",
-                "sh_rotated_node"
-            ]
-            .contains(&name),
+            a["optional"] == true
+                || ["cutoff_three_sigma", "sort_distance_not_depth", "color_space_linear"]
+                    .contains(&name),
             "{a:#}"
         );
     }
