@@ -186,7 +186,7 @@ fn mahalanobis2(l: &Layer, (xc, yc): (f64, f64)) -> f64 {
 }
 
 /// Leaves the pixels outside `judged` out of a bound: an infinite bound, which
-/// [`super::generate::measure`] skips (no error, no ratio, no PSNR contribution).
+/// the runner's measure skips (no error, no ratio, no PSNR contribution).
 pub fn apply(bound: &mut [f64], judged: &[bool]) {
     for (b, &j) in bound.iter_mut().zip(judged) {
         if !j {
