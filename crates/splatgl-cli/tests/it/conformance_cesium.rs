@@ -107,8 +107,12 @@ fn cesium_is_graded_by_the_rules_its_source_breaks() {
         let name = a["name"].as_str().unwrap_or("");
         assert!(
             a["optional"] == true
-                || ["cutoff_three_sigma", "sort_distance_not_depth", "color_space_linear"]
-                    .contains(&name),
+                || [
+                    "cutoff_three_sigma",
+                    "sort_distance_not_depth",
+                    "color_space_linear"
+                ]
+                .contains(&name),
             "{a:#}"
         );
     }
