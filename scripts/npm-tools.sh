@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the pinned npm tools the tests cross-check against into .npm-tools/ (where the tests
 # look): splat-transform and GaussianSplats3D's .ksplat writer (with three) for
-# tests/splat_transform*.rs, and the Khronos glTF-Validator (scripts/gltf_validate.mjs) for the
+# tests/it/splat_transform.rs and crates/splatgl-cli/tests/it/splat_transform_gltf.rs, and the Khronos glTF-Validator (scripts/gltf_validate.mjs) for the
 # converter and conformance tests. Reinstalled only when the pinned list changes
 # (.npm-tools/ci-installed records it). Without npm it says so and returns 1.
 set -euo pipefail

@@ -9,7 +9,7 @@
 //! orbit while tiles stream, and its peak memory. The first N is the
 //! baseline: the others are given as ratios to it (peak memory should not grow with N).
 //!
-//! `cargo bench --bench lod` (`SPLATGL_BENCH_LOD_SPLATS`, default `10000000,30000000`; run
+//! `cargo bench -p splatgl-cli --bench lod` (`SPLATGL_BENCH_LOD_SPLATS`, default `10000000,30000000`; run
 //! without `--bench`, as `cargo test --all-targets` does, 50,000 and 150,000;
 //! files under `target/tmp/lod-bench`, about 56 bytes a splat for the PLY and twice that for
 //! the tileset, removed at the end unless `SPLATGL_BENCH_KEEP=1`).

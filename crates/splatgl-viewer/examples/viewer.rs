@@ -1,6 +1,6 @@
 //! The desktop viewer from library code: what `splatgl view` runs, with default options.
 //!
-//! `cargo run --release --example viewer -- [SCENE]` (H or F1 in the window prints the
+//! `cargo run --release -p splatgl-viewer --example viewer -- [SCENE]` (H or F1 in the window prints the
 //! controls). An application that wants its own window and loop embeds `splatgl::gl`
 //! instead (see `examples/embed.rs`).
 

@@ -39,7 +39,7 @@ use std::path::PathBuf;
 use splatgl::camera::ViewOptions;
 use splatgl::load::LoadOptions;
 
-/// The controls, as `H` / `F1` print them (the README's table says the same).
+/// The controls, as `H` / `F1` print them (docs/guide.md's and docs/viewer.md's tables say the same).
 pub const HELP: &str = "\
 splatgl view controls
   orbit mode (default)           fly mode (Tab)

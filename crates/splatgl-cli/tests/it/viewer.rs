@@ -50,7 +50,7 @@ fn viewer_shows_the_render_and_mouse_input_moves_the_camera() {
     let (p_shot, p_import) = (psnr(&shot, &want), psnr(&imported, &want));
     assert!(p_shot >= 40.0, "P screenshot vs render: {p_shot} dB");
     assert!(p_import >= 40.0, "import -window vs render: {p_import} dB");
-    // The README's screenshot comes from here.
+    // docs/guide.md's screenshot comes from here.
     let keep = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer-screenshot.png");
     shot.write_png(&keep, splatgl::image::PngDepth::Eight, false)
         .unwrap();

@@ -81,7 +81,7 @@ fn panel_shows_hides_and_its_camera_list_moves_the_view() {
     eprintln!("panel shown: {p_left:.1} dB over the panel, {p_right:.1} dB right of it");
     assert!(p_left < 25.0, "no panel in the capture: {p_left} dB");
     assert!(p_right >= 40.0, "the scene beside the panel: {p_right} dB");
-    // The README's screenshot with the panel open comes from here.
+    // docs/guide.md's screenshot with the panel open comes from here.
     let keep = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer-panel.png");
     shown
         .write_png(&keep, splatgl::image::PngDepth::Eight, false)
