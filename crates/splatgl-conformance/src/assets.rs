@@ -102,7 +102,6 @@ impl AssetSpec {
         self.designed_for = e;
         self
     }
-    /// Variants the asset is designed to detect.
     /// What of the choices the judged region leaves out this asset tests: the extent when it
     /// detects a cut-off shape (or catches erratum f by design), the order when it detects
     /// view-depth order, the dilation when it catches erratum i by design or detects the
@@ -120,6 +119,7 @@ impl AssetSpec {
         }
     }
 
+    /// Variants the asset is designed to detect.
     pub(crate) fn detects(mut self, v: &'static [Variant]) -> Self {
         self.detects = v;
         self

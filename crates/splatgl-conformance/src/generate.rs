@@ -307,6 +307,15 @@ fn camera_entry(
         )));
     }
     let judged = judge::judged_region(cloud, &cam, spec.tested());
+    let share = judged.iter().filter(|&&j| j).count() as f64 / judged.len().max(1) as f64;
+    if share < 0.05 {
+        return Err(design(format!(
+            "camera {}: only {:.0} % of its pixels are judged (rims and overlaps whose order \
+             a renderer may choose cover the rest)",
+            spec_cam.name,
+            100.0 * share
+        )));
+    }
     let bound_pfm = format!("reference/{image}.bound.pfm");
     let judge_mask = format!("reference/{image}.judge.png");
     let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);

@@ -36,7 +36,7 @@ pub struct CameraEntry {
     /// Per-pixel error bound (grey PFM, relative to the suite folder): a pixel whose error
     /// exceeds its bound fails the camera.
     pub bound_pfm: String,
-    /// The judged region (greyscale PNG beside `bound_pfm`, relative to the suite folder):
+    /// The judged region (a PNG beside `bound_pfm`, relative to the suite folder):
     /// white pixels are judged; black ones are where a choice the asset does not test (a
     /// splat's rim between 2.83σ and where its α falls below 1/1020, two overlapping splats
     /// whose distance and view-depth orders disagree) can move the image, reported but never
@@ -216,7 +216,7 @@ impl Manifest {
         if bgv.len() != 3 {
             return Err("manifest: `background` must be 3 numbers".into());
         }
-        let rules_version = number(v, "rules_version")? as u32;
+        let rules_version = v["rules_version"].as_u64().unwrap_or(0) as u32;
         if rules_version != RULES_VERSION {
             return Err(format!(
                 "manifest: `rules_version` is {rules_version}, this splatgl judges by rules \

@@ -191,12 +191,6 @@ impl Choices {
     pub fn tested(&self) -> (bool, bool) {
         (self.extent != Extent::Ellipse, self.view_depth_order)
     }
-
-    /// Whether the dilation differs from the profile's (`subpixel_dilation`, a profile asset,
-    /// tests it).
-    pub fn dilation_differs(&self) -> bool {
-        (self.dilation - DILATION_PX2).abs() > 1e-9
-    }
 }
 
 /// What a renderer making `c` draws of `cloud` from `cam` (display-referred RGB, A = 1 − T).

@@ -164,9 +164,50 @@ struct Blending {
     extent: Extent,
 }
 
+/// Layer `l` at pixel centre `p`: `None` outside its rectangle; else its Mahalanobis² and
+/// uncapped α, and whether it is drawn there (inside its extent, and not skipped as α < 1/255).
+fn fragment(l: &Layer, (xc, yc): (f64, f64), b: &Blending) -> Option<(f64, f64, bool, bool)> {
+    let [x0, x1, y0, y1] = l.rect;
+    if xc < x0 || xc > x1 || yc < y0 || yc > y1 {
+        return None;
+    }
+    let (dx, dy) = (xc - l.centre[0], yc - l.centre[1]);
+    let m2 = l.conic[0] * dx * dx + 2.0 * l.conic[1] * dx * dy + l.conic[2] * dy * dy;
+    let raw = l.opacity * (-0.5 * m2).exp();
+    let inside = match (l.box_axes, b.extent) {
+        // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
+        (Some(ax), _) => ax.iter().all(|h| {
+            let n2 = h[0] * h[0] + h[1] * h[1];
+            (dx * h[0] + dy * h[1]).abs() <= n2 + 1e-12
+        }),
+        (None, Extent::Ellipse) => (0.0..=b.cut).contains(&m2),
+        (None, e) => e.contains(l, (xc, yc)),
+    };
+    let drawn = inside && (raw.min(b.cap) >= ALPHA_MIN as f64 || b.every_fragment);
+    Some((m2, raw, inside, drawn))
+}
+
+/// With [`Blending::early_stop`]: the index of the layer (blending order, back to front) at
+/// which 3DGS stops at pixel `p` — walking front to back, the first drawn layer that would
+/// take T below 10⁻⁴; it and every layer behind it are not blended.
+fn early_stop_at(layers: &[Layer], p: (f64, f64), b: &Blending) -> Option<usize> {
+    let mut t = 1.0f64;
+    for (i, l) in layers.iter().enumerate().rev() {
+        let Some((_, raw, _, true)) = fragment(l, p, b) else {
+            continue;
+        };
+        let alpha = raw.min(b.cap);
+        if t * (1.0 - alpha) < EARLY_STOP_T {
+            return Some(i);
+        }
+        t *= 1.0 - alpha;
+    }
+    None
+}
+
 /// One pixel centre: the blended linear colour, the alpha and the error terms, walking the
 /// layers in blending order.
-fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64, Terms) {
+fn shade(layers: &[Layer], p: (f64, f64), b: &Blending) -> ([f64; 3], f64, Terms) {
     let q = 0.5 / 255.0;
     let cut = b.cut;
     let (mut c, mut a) = ([0.0f64; 3], 0.0f64);
@@ -174,29 +215,21 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
         output: q,
         ..Default::default()
     };
+    let stop = if b.early_stop {
+        early_stop_at(layers, p, b)
+    } else {
+        None
+    };
     let mut layers_here = 0usize;
     // What each drawn layer contributes, uncapped, for the early-stop term.
-    let mut drawn: Vec<(f64, [f64; 3])> = Vec::new();
-    for l in layers {
-        let [x0, x1, y0, y1] = l.rect;
-        if xc < x0 || xc > x1 || yc < y0 || yc > y1 {
+    let mut drawn_here: Vec<(f64, [f64; 3])> = Vec::new();
+    for (i, l) in layers.iter().enumerate() {
+        let Some((m2, raw, inside, drawn)) = fragment(l, p, b) else {
             continue;
-        }
-        let (dx, dy) = (xc - l.centre[0], yc - l.centre[1]);
-        let m2 = l.conic[0] * dx * dx + 2.0 * l.conic[1] * dx * dy + l.conic[2] * dy * dy;
-        let raw = l.opacity * (-0.5 * m2).exp();
+        };
         if (m2 - cut).abs() <= EDGE_BAND * cut {
             t.cutoff += raw.min(ALPHA_MAX as f64);
         }
-        let inside = match (l.box_axes, b.extent) {
-            // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
-            (Some(ax), _) => ax.iter().all(|h| {
-                let n2 = h[0] * h[0] + h[1] * h[1];
-                (dx * h[0] + dy * h[1]).abs() <= n2 + 1e-12
-            }),
-            (None, Extent::Ellipse) => (0.0..=cut).contains(&m2),
-            (None, e) => e.contains(l, (xc, yc)),
-        };
         if !inside {
             continue;
         }
@@ -207,20 +240,17 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
         if raw > ALPHA_MAX as f64 * (1.0 - EDGE_BAND) {
             t.cap += (raw.min(1.0) - ALPHA_MAX as f64).max(0.0);
         }
-        if alpha < ALPHA_MIN as f64 && !b.every_fragment {
+        if !drawn || stop.is_some_and(|s| i <= s) {
             continue;
         }
         layers_here += 1;
-        drawn.push((raw.min(1.0), l.color));
+        drawn_here.push((raw.min(1.0), l.color));
         t.sh_f16 += alpha * l.f16_err;
         t.overbright += l
             .color
             .iter()
             .map(|v| (v - 1.0).max(0.0))
             .fold(0.0, f64::max);
-        if b.early_stop && (1.0 - a) * (1.0 - alpha) < EARLY_STOP_T {
-            break; // 3DGS: the splat that would take T below 10⁻⁴ is not blended
-        }
         let wgt = if b.alpha_squared {
             alpha * alpha
         } else {
@@ -235,17 +265,18 @@ fn shade(layers: &[Layer], (xc, yc): (f64, f64), b: &Blending) -> ([f64; 3], f64
     // two half-steps per blended splat.
     t.blend = 2.0 * q * layers_here as f64;
     t.float = 1e-5 * (layers_here + 1) as f64;
-    t.early_stop = early_stop_change(&drawn);
+    t.early_stop = early_stop_change(&drawn_here);
     (c, a, t)
 }
 
-/// The most a stop at T < 10⁻⁴ (3DGS) changes a pixel whose drawn layers are `drawn` (α
-/// uncapped, colour), under each admitted α cap (0.99, 0.999, 1): with α up to 1 a nearly
+/// The most a stop at T < 10⁻⁴ (3DGS) changes a pixel whose drawn layers are `drawn` (back to
+/// front; α uncapped, colour), under each admitted α cap (0.99, 0.999, 1): with α up to 1 a nearly
 /// opaque layer can end the blending while much transmittance is left.
 fn early_stop_change(drawn: &[(f64, [f64; 3])]) -> f64 {
+    // `drawn` is back to front; 3DGS walks front to back.
     let walk = |cap: f64, stop: bool| {
         let (mut c, mut t) = ([0.0f64; 3], 1.0f64);
-        for &(raw, col) in drawn {
+        for &(raw, col) in drawn.iter().rev() {
             let a = raw.min(cap);
             if stop && t * (1.0 - a) < EARLY_STOP_T {
                 break;
