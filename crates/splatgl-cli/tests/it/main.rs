@@ -22,6 +22,7 @@ mod cli_messages;
 mod cli_options;
 mod conformance;
 mod conformance_cesium;
+mod conformance_playcanvas;
 mod conformance_third_party;
 mod convert;
 mod file_access;

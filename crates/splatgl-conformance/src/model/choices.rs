@@ -223,6 +223,7 @@ pub fn render_choices(cloud: &SplatCloud, cam: &Camera, c: &Choices) -> Image {
         cap: c.alpha_cap,
         alpha_squared: false,
         every_fragment: !c.skip_below_1_255,
+        normalized_kernel: false,
         early_stop: c.early_stop,
         extent: c.extent,
     };

@@ -104,7 +104,7 @@ pub(crate) fn render_with_axis(
     let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display
         && !v.contains(&Variant::ColorSpaceIgnored);
     let blend = Blending {
-        cut: if x.contains(&Erratum::F) {
+        cut: if x.contains(&Erratum::F) || v.contains(&Variant::NormalizedKernel) {
             8.0
         } else {
             CUTOFF_M2 as f64
@@ -117,6 +117,7 @@ pub(crate) fn render_with_axis(
         alpha_squared: x.contains(&Erratum::G),
         // CesiumJS's square quads draw every fragment they cover: no 1/255 skip.
         every_fragment: v.contains(&Variant::SquareCut),
+        normalized_kernel: v.contains(&Variant::NormalizedKernel),
         early_stop: false,
         extent: Extent::Ellipse,
     };
@@ -160,6 +161,8 @@ struct Blending {
     cap: f64,
     alpha_squared: bool,
     every_fragment: bool,
+    /// [`Variant::NormalizedKernel`]: α = opacity·(G − e⁻⁴)/(1 − e⁻⁴).
+    normalized_kernel: bool,
     early_stop: bool,
     extent: Extent,
 }
@@ -173,7 +176,13 @@ fn fragment(l: &Layer, (xc, yc): (f64, f64), b: &Blending) -> Option<(f64, f64, 
     }
     let (dx, dy) = (xc - l.centre[0], yc - l.centre[1]);
     let m2 = l.conic[0] * dx * dx + 2.0 * l.conic[1] * dx * dy + l.conic[2] * dy * dy;
-    let raw = l.opacity * (-0.5 * m2).exp();
+    let g = (-0.5 * m2).exp();
+    let raw = if b.normalized_kernel {
+        let e4 = (-4.0f64).exp();
+        l.opacity * ((g - e4) / (1.0 - e4)).max(0.0)
+    } else {
+        l.opacity * g
+    };
     let inside = match (l.box_axes, b.extent) {
         // Inside the box: |d·eₖ| ≤ |half axis k| for both axes.
         (Some(ax), _) => ax.iter().all(|h| {

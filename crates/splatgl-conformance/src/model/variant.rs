@@ -49,11 +49,15 @@ pub enum Variant {
     /// Spark's default packed splats (half-float centres, 8-bit colour, opacity in steps of
     /// 2/255, 8-bit ln scales over [−12, 9], 8+8+8-bit octahedral quaternions, SH 7/8/6 bits).
     PackedSplat,
+    /// PlayCanvas's kernel: α = opacity·(G − e⁻⁴)/(1 − e⁻⁴), which reaches 0 at 2√2σ where
+    /// it cuts (its `normExp`, gsplat fragment shader): every splat a little more opaque
+    /// inside and fainter towards its edge than α = opacity·G.
+    NormalizedKernel,
 }
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 16] = [
+    pub const ALL: [Variant; 17] = [
         Variant::BoxCut,
         Variant::SquareCut,
         Variant::ViewDepthOrder,
@@ -70,6 +74,7 @@ impl Variant {
         Variant::SpzPrecision,
         Variant::PackedSplat,
         Variant::ColorSpaceIgnored,
+        Variant::NormalizedKernel,
     ];
     /// A short identifier (the diagnosis's `rule`).
     pub fn name(self) -> &'static str {
@@ -90,6 +95,7 @@ impl Variant {
             Variant::SpzPrecision => "spz_precision",
             Variant::PackedSplat => "packed_splat_precision",
             Variant::ColorSpaceIgnored => "color_space_ignored",
+            Variant::NormalizedKernel => "normalized_kernel",
         }
     }
     /// What a renderer with this variant does, for reports.
@@ -127,6 +133,9 @@ impl Variant {
             Variant::ColorSpaceIgnored => {
                 "colorSpace ignored: lin_rec709_display blended and shown as display values"
             }
+            Variant::NormalizedKernel => {
+                "kernel α = opacity·(G − e⁻⁴)/(1 − e⁻⁴), cut at 2.83σ (PlayCanvas's normExp) instead of opacity·G cut at 3σ"
+            }
         }
     }
     /// The RC section whose rule the variant departs from.
@@ -157,6 +166,7 @@ impl Variant {
             Variant::ColorSpaceIgnored => {
                 "RC Color Space (all blending before any transfer-function conversion)"
             }
+            Variant::NormalizedKernel => "RC Ellipse Kernel Rendering (α = opacity · G(x))",
         }
     }
     /// Whether the RC allows it: an image that matches it passes.
