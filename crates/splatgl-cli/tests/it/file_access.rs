@@ -307,6 +307,7 @@ fn conformance_inputs_are_regular_files_inside_the_suite() {
     splatgl::write::save(&random_cloud(3, 0, 5.0, 5), &d.join("outside.glb"), &[]).unwrap();
     let manifest = serde_json::json!({
         "generator": "test", "background": [0, 0, 0],
+        "rules_version": splatgl_conformance::manifest::RULES_VERSION,
         "assets": [{"name": "a", "file": "../outside.glb", "cameras_json": "a.json",
             "rule": "r", "rc_section": "s", "failure_means": "f", "catches": [],
             "cameras": []}]
