@@ -41,7 +41,8 @@ fast() {
 }
 
 slow() {
-  cargo test -p splatgl-cli --all-features --locked --test it -- "${slow[@]}"
+  # The fast lane's feature resolution (--workspace), so nothing is built again.
+  cargo test --workspace --all-features --locked --test it -- "${slow[@]}"
 }
 
 # The pinned npm tools both lanes' cross-checks use (when npm is present).
