@@ -181,6 +181,7 @@ export function renderViews({ name, page, prefix, views, tmp, out, mounts = {}, 
     }
     let file = null;
     if (url === '/' || url === '/page') file = path.join(here, page);
+    else if (url === '/page.mjs') file = path.join(here, 'page.mjs');
     else if (url === '/views.json') return send(res, 200, 'application/json', JSON.stringify(views));
     else {
       const served = { '/files/': tmp, '/npm/': npm, ...mounts };
