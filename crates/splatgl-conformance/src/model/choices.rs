@@ -83,6 +83,11 @@ pub struct Choices {
     pub colour_8bit: bool,
     /// The 3D covariance stored as half floats.
     pub covariance_f16: bool,
+    /// Blended in an 8-bit target (colour sums above 1 clamped between blends) instead of
+    /// floating point.
+    pub blending_8bit: bool,
+    /// Each splat's colour clamped to 1 before blending.
+    pub colour_clamp: bool,
 }
 
 impl Choices {
@@ -96,6 +101,8 @@ impl Choices {
         dilation: DILATION_PX2,
         colour_8bit: false,
         covariance_f16: false,
+        blending_8bit: false,
+        colour_clamp: false,
     };
 
     /// The original 3DGS rasterizer: tile-granular extent, view-depth order (per tile), α cap
@@ -183,6 +190,20 @@ impl Choices {
                     ..p
                 },
             ),
+            (
+                "blending_8bit",
+                Choices {
+                    blending_8bit: true,
+                    ..p
+                },
+            ),
+            (
+                "colour_clamped_per_splat",
+                Choices {
+                    colour_clamp: true,
+                    ..p
+                },
+            ),
         ]
     }
 
@@ -201,6 +222,7 @@ pub fn render_choices(cloud: &SplatCloud, cam: &Camera, c: &Choices) -> Image {
         (c.colour_8bit, Variant::Colour8Bit),
         (c.covariance_f16, Variant::HalfCovariance),
         (c.extent == Extent::Square, Variant::SquareCut),
+        (c.colour_clamp, Variant::ColourClamped),
     ] {
         if on {
             vars.push(v);
@@ -224,6 +246,7 @@ pub fn render_choices(cloud: &SplatCloud, cam: &Camera, c: &Choices) -> Image {
         alpha_squared: false,
         every_fragment: !c.skip_below_1_255,
         normalized_kernel: false,
+        unorm: c.blending_8bit,
         early_stop: c.early_stop,
         extent: c.extent,
     };

@@ -31,6 +31,31 @@ pub(super) fn eigenvalue_floor(
     ])
 }
 
+/// [`Variant::AxesSwapped`](super::Variant::AxesSwapped): Σ' = [[a, b], [b, c]] rebuilt as
+/// Babylon.js 9 does (Shaders/ShadersInclude/gaussianSplatting.js, `gaussianSplatting()`):
+/// eigenvalues `mid ± r + 10⁻⁴`, major axis `normalize(b, λ₁ − a)`, which is vertical
+/// whatever the footprint's shape when `|b|` ≪ 10⁻⁴; `None` when `λ₂` < 0 (dropped there
+/// too). Returns `[a, b, c, det]`.
+pub(super) fn babylon_axes(a: f64, b: f64, c: f64) -> Option<[f64; 4]> {
+    const EPS: f64 = 1e-4;
+    let mid = 0.5 * (a + c);
+    let r = (0.5 * (a - c)).hypot(b);
+    let (l1, l2) = (mid + r + EPS, mid - r + EPS);
+    if l2 < 0.0 {
+        return None;
+    }
+    let (x, y) = (b, l1 - a);
+    let n = x.hypot(y);
+    let e1 = [x / n, y / n];
+    let e2 = [e1[1], -e1[0]];
+    Some([
+        l1 * e1[0] * e1[0] + l2 * e2[0] * e2[0],
+        l1 * e1[0] * e1[1] + l2 * e2[0] * e2[1],
+        l1 * e1[1] * e1[1] + l2 * e2[1] * e2[1],
+        l1 * l2,
+    ])
+}
+
 /// Where in [`f32_axis_within_rounding`]'s range the `eigenvalue_floor` term samples the
 /// major axis: its ends, its middle and between (the image changes with the angle as a
 /// sinusoid of twice it, so a range of up to ~120° needs more than its ends).

@@ -63,6 +63,9 @@ pub struct ModelImage {
     /// Per pixel, the admitted-deviation terms (`dilation`, `colour_8bit`, …)
     /// the generator added to `bound`.
     pub extra: Vec<Terms>,
+    /// Per pixel, the `overbright` term of `bound` (what an 8-bit target's clamping of
+    /// colours above 1 may change): an asset that tests float blending takes it out.
+    pub overbright: Vec<f64>,
 }
 
 /// 3DGS stops blending a pixel before its transmittance falls below this.
@@ -92,15 +95,31 @@ pub(crate) fn render_with_axis(
     v: &[Variant],
     axis: Option<f64>,
 ) -> ModelImage {
+    render_with_dilation(cloud, cam, (x, v), axis, DILATION_PX2)
+}
+
+/// [`render_with_axis`] with Σ' dilated by `dilation` px² instead of the profile's 0.3
+/// (erratum i still sets it to 0).
+pub(crate) fn render_with_dilation(
+    cloud: &SplatCloud,
+    cam: &Camera,
+    (x, v): (&[Erratum], &[Variant]),
+    axis: Option<f64>,
+    dilation: f64,
+) -> ModelImage {
     let quantized = if v.contains(&Variant::SpzPrecision) {
         quantized::spz(cloud)
     } else if v.contains(&Variant::PackedSplat) {
         Some(quantized::packed(cloud, cam.eye().to_array()))
+    } else if v.contains(&Variant::Attributes8Bit) {
+        Some(quantized::babylon(cloud))
+    } else if v.contains(&Variant::ScaleLog8) {
+        Some(quantized::playcanvas(cloud))
     } else {
         None
     };
     let cloud = quantized.as_ref().unwrap_or(cloud);
-    let layers = project(cloud, cam, (x, v), axis, DILATION_PX2);
+    let layers = project(cloud, cam, (x, v), axis, dilation);
     let linear = cloud.meta.color_space.effective() == ColorSpace::LinRec709Display
         && !v.contains(&Variant::ColorSpaceIgnored);
     let blend = Blending {
@@ -118,6 +137,7 @@ pub(crate) fn render_with_axis(
         // CesiumJS's square quads draw every fragment they cover: no 1/255 skip.
         every_fragment: v.contains(&Variant::SquareCut),
         normalized_kernel: v.contains(&Variant::NormalizedKernel),
+        unorm: v.contains(&Variant::Unorm8Blending),
         early_stop: false,
         extent: Extent::Ellipse,
     };
@@ -130,6 +150,7 @@ fn shade_image(layers: &[Layer], cam: &Camera, blend: &Blending, linear: bool) -
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut image = Image::filled(cam.width, cam.height, [0.0, 0.0, 0.0, 1.0]);
     let mut bound = vec![0.0; w * h];
+    let mut overbright = vec![0.0; w * h];
     let mut worst = Terms::default();
     for py in 0..h {
         for px in 0..w {
@@ -141,6 +162,7 @@ fn shade_image(layers: &[Layer], cam: &Camera, blend: &Blending, linear: bool) -
             let i = py * w + px;
             image.pixels[i] = [disp[0] as f32, disp[1] as f32, disp[2] as f32, a as f32];
             bound[i] = t.total();
+            overbright[i] = t.overbright;
             worst = worst.max(t);
         }
     }
@@ -149,6 +171,7 @@ fn shade_image(layers: &[Layer], cam: &Camera, blend: &Blending, linear: bool) -
         image,
         bound,
         worst,
+        overbright,
     }
 }
 
@@ -163,6 +186,8 @@ struct Blending {
     every_fragment: bool,
     /// [`Variant::NormalizedKernel`]: α = opacity·(G − e⁻⁴)/(1 − e⁻⁴).
     normalized_kernel: bool,
+    /// [`Variant::Unorm8Blending`]: colour sums clamped to 1 between blends.
+    unorm: bool,
     early_stop: bool,
     extent: Extent,
 }
@@ -266,7 +291,11 @@ fn shade(layers: &[Layer], p: (f64, f64), b: &Blending) -> ([f64; 3], f64, Terms
             alpha
         };
         for (v, lc) in c.iter_mut().zip(l.color) {
-            *v = lc * wgt + *v * (1.0 - alpha);
+            *v = if b.unorm {
+                ((lc * wgt).min(1.0) + *v * (1.0 - alpha)).min(1.0)
+            } else {
+                lc * wgt + *v * (1.0 - alpha)
+            };
         }
         a = wgt + a * (1.0 - alpha);
     }

@@ -11,7 +11,7 @@ use splatgl::covariance::c_matrix;
 use splatgl::profile::{ALPHA_MAX, ALPHA_MIN, JACOBIAN_CLAMP, NEAR_CULL};
 use splatgl::reference::SortMode;
 
-use super::footprint::{BOX_SIGMA, SQUARE_SIGMA, box_half_axes, eigenvalue_floor};
+use super::footprint::{BOX_SIGMA, SQUARE_SIGMA, babylon_axes, box_half_axes, eigenvalue_floor};
 
 /// The appendix's SH basis (erratum e): no Condon–Shortley signs, 2.89 for coefficient 14.
 fn appendix_basis(d: [f64; 3]) -> [f64; 16] {
@@ -59,6 +59,11 @@ fn colour(cloud: &SplatCloud, i: usize, dir: [f64; 3], e: bool, v: &[Variant]) -
         sum.map(|v| 1.0 / (1.0 + (-v).exp()))
     } else {
         sum.map(|v| (v + splatgl::profile::SH_DC_BIAS).max(0.0))
+    };
+    let c = if v.contains(&Variant::ColourClamped) {
+        c.map(|v| v.min(1.0))
+    } else {
+        c
     };
     (c, f16_err)
 }
@@ -216,7 +221,7 @@ fn screen_covariance(
     let j0 = DVec3::new(fx / t.z, 0.0, -fx * txtz / t.z);
     let j1 = DVec3::new(0.0, fy / t.z, -fy * tytz / t.z);
     let m = c_matrix(scale, q).transpose() * view.w.transpose();
-    if view.var(Variant::HalfCovariance) {
+    if view.var(Variant::HalfCovariance) || view.var(Variant::Attributes8Bit) {
         return half_covariance(view, m, [j0, j1]);
     }
     let (p0, p1) = (m * j0, m * j1);
@@ -228,6 +233,9 @@ fn screen_covariance(
     }
     if view.var(Variant::EigenvalueFloor) {
         [a, b, cc, det] = eigenvalue_floor(a, b, cc, det, view.axis)?;
+    }
+    if view.var(Variant::AxesSwapped) {
+        [a, b, cc, det] = babylon_axes(a, b, cc)?;
     }
     Some(([a, b, cc, det], p0.cross(p1).length_squared()))
 }
@@ -256,6 +264,9 @@ fn half_covariance(view: &View, m: DMat3, [j0, j1]: [DVec3; 2]) -> Option<([f64;
     }
     if view.var(Variant::EigenvalueFloor) {
         [a, b, cc, det] = eigenvalue_floor(a, b, cc, det, view.axis)?;
+    }
+    if view.var(Variant::AxesSwapped) {
+        [a, b, cc, det] = babylon_axes(a, b, cc)?;
     }
     Some(([a, b, cc, det], (a0 * c0 - b * b).max(0.0)))
 }

@@ -12,6 +12,14 @@
 //!   colour and opacity in 8 bits (opacity halved once more: steps of 2/255), scales as 8-bit
 //!   ln s over [−12, 9], quaternions as an 8+8-bit octahedral axis and an 8-bit angle, SH 7/8/6
 //!   bits in ±1.
+//! - [`babylon`]: Babylon.js 9's splat buffer, as its glTF loader fills it
+//!   (loaders/glTF/2.0/Extensions/KHR_gaussian_splatting.pure.js: `Clamp255` of the DC colour,
+//!   opacity, `q·127.5 + 127.5` and `coef·128 + 128`): colour, opacity and quaternion in 8
+//!   bits, rounded; SH above degree 0 in 8 bits over ±1, clamped.
+//! - [`playcanvas`]: PlayCanvas 2.23's compact work buffer
+//!   (scene/shader-lib/glsl/chunks/gsplat/frag/formats/containerCompactWrite.js and
+//!   containerCompactRead.js): scales as 8-bit ln σ over [−12, 9] (255 steps, σ off by up to
+//!   ±4.2 %), opacity in 8 bits, the quaternion as 11-11-10 bits of `xyz/√(1 + w)`.
 
 use splatgl::cloud::SplatCloud;
 use splatgl::sh::SH_C0;
@@ -72,6 +80,84 @@ pub(crate) fn packed(cloud: &SplatCloud, eye: [f32; 3]) -> SplatCloud {
         };
     }
     out
+}
+
+/// `cloud` as Babylon.js 9's glTF loader stores it (see the module docs).
+pub(crate) fn babylon(cloud: &SplatCloud) -> SplatCloud {
+    let byte = |v: f64| v.clamp(0.0, 255.0).round();
+    let mut out = cloud.clone();
+    for q in &mut out.rotations {
+        *q = q.map(|c| ((byte(c as f64 * 127.5 + 127.5) - 127.5) / 127.5) as f32);
+        let n = q.iter().map(|c| c * c).sum::<f32>().sqrt();
+        if n > 0.0 {
+            *q = q.map(|c| c / n);
+        }
+    }
+    for a in &mut out.opacities {
+        *a = (byte(*a as f64 * 255.0) / 255.0) as f32;
+    }
+    let k = out.coeffs_per_splat();
+    for (j, c) in out.sh.iter_mut().enumerate() {
+        *c = if j % k == 0 {
+            c.map(|dc| {
+                let rgb = byte((0.5 + SH_C0 * dc as f64) * 255.0) / 255.0;
+                ((rgb - 0.5) / SH_C0) as f32
+            })
+        } else {
+            c.map(|v| (byte(v as f64 * 128.0 + 128.0) * 2.0 / 255.0 - 1.0) as f32)
+        };
+    }
+    out
+}
+
+/// `cloud` as PlayCanvas's compact work buffer carries it (see the module docs).
+pub(crate) fn playcanvas(cloud: &SplatCloud) -> SplatCloud {
+    const LOG_MIN: f64 = -12.0;
+    let step = 21.0 / 255.0;
+    let mut out = cloud.clone();
+    for s in &mut out.scales {
+        *s = s.map(|v| {
+            if (v as f64) < 1e-10 {
+                return 0.0;
+            }
+            let code = (((v as f64).ln() - LOG_MIN) / step + 0.5)
+                .clamp(1.0, 255.0)
+                .floor();
+            (code * step + LOG_MIN).exp() as f32
+        });
+    }
+    for a in &mut out.opacities {
+        *a = ((a.clamp(0.0, 1.0) as f64 * 255.0 + 0.5).floor() / 255.0) as f32;
+    }
+    for q in &mut out.rotations {
+        *q = compact_quat(*q);
+    }
+    out
+}
+
+/// A unit quaternion `[x, y, z, w]` through PlayCanvas's 11-11-10-bit `xyz/√(1 + w)` code.
+fn compact_quat(q: [f32; 4]) -> [f32; 4] {
+    let n = q.iter().map(|c| (*c as f64).powi(2)).sum::<f64>().sqrt();
+    if n == 0.0 {
+        return q;
+    }
+    let mut v = q.map(|c| c as f64 / n);
+    if v[3] < 0.0 {
+        v = v.map(|c| -c);
+    }
+    let k = (1.0 + v[3]).sqrt();
+    let code = |c: f64, max: f64| {
+        ((c / k * 0.5 + 0.5) * max + 0.5).clamp(0.0, max).floor() / max * 2.0 - 1.0
+    };
+    let p = [code(v[0], 2047.0), code(v[1], 2047.0), code(v[2], 1023.0)];
+    let d = p.iter().map(|c| c * c).sum::<f64>();
+    let r = (2.0 - d).max(0.0).sqrt();
+    [
+        (p[0] * r) as f32,
+        (p[1] * r) as f32,
+        (p[2] * r) as f32,
+        (1.0 - d) as f32,
+    ]
 }
 
 /// `v` in ±1 with `steps` steps each side (Spark's SH codes, rounded, clamped).

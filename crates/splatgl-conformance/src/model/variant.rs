@@ -53,11 +53,29 @@ pub enum Variant {
     /// it cuts (its `normExp`, gsplat fragment shader): every splat a little more opaque
     /// inside and fainter towards its edge than α = opacity·G.
     NormalizedKernel,
+    /// Σ' rebuilt from its eigenvalues `mid ± r + 10⁻⁴` along the eigenvector
+    /// `normalize(b, λ₁ − a)`, which degenerates when `|b|` ≪ 10⁻⁴: a footprint wider than
+    /// tall with no x–y covariance (a round splat off the image's centre row, an axis-aligned
+    /// one) is drawn taller than wide (Babylon.js 9's vertex shader, as the review draft's
+    /// Appendix A).
+    AxesSwapped,
+    /// Babylon.js 9's splat buffer: colour, opacity and quaternion in 8 bits (rounded), SH
+    /// above degree 0 in 8 bits over ±1, the covariance in half floats.
+    Attributes8Bit,
+    /// PlayCanvas 2.23's compact work buffer: scales as 8-bit ln σ over [−12, 9] (σ off by
+    /// up to ±4.2 %), opacity in 8 bits, the quaternion in 11-11-10 bits.
+    ScaleLog8,
+    /// Each splat's colour clamped to 1 before it is blended (a straight-alpha or 8-bit
+    /// colour path): colours above 1 lose what they add under translucent splats.
+    ColourClamped,
+    /// Blending into an 8-bit (UNORM) target: each fragment's premultiplied colour and each
+    /// blended result clamped to 1, so a sum above 1 behind a translucent splat is lost.
+    Unorm8Blending,
 }
 
 impl Variant {
     /// All of them.
-    pub const ALL: [Variant; 17] = [
+    pub const ALL: [Variant; 22] = [
         Variant::BoxCut,
         Variant::SquareCut,
         Variant::ViewDepthOrder,
@@ -75,6 +93,11 @@ impl Variant {
         Variant::PackedSplat,
         Variant::ColorSpaceIgnored,
         Variant::NormalizedKernel,
+        Variant::AxesSwapped,
+        Variant::Attributes8Bit,
+        Variant::ScaleLog8,
+        Variant::ColourClamped,
+        Variant::Unorm8Blending,
     ];
     /// A short identifier (the diagnosis's `rule`).
     pub fn name(self) -> &'static str {
@@ -96,6 +119,11 @@ impl Variant {
             Variant::PackedSplat => "packed_splat_precision",
             Variant::ColorSpaceIgnored => "color_space_ignored",
             Variant::NormalizedKernel => "normalized_kernel",
+            Variant::AxesSwapped => "footprint_axes_swapped",
+            Variant::Attributes8Bit => "attributes_8bit",
+            Variant::ScaleLog8 => "scale_log8",
+            Variant::ColourClamped => "colour_clamped_per_splat",
+            Variant::Unorm8Blending => "blending_8bit",
         }
     }
     /// What a renderer with this variant does, for reports.
@@ -136,6 +164,19 @@ impl Variant {
             Variant::NormalizedKernel => {
                 "kernel α = opacity·(G − e⁻⁴)/(1 − e⁻⁴), cut at 2.83σ (PlayCanvas's normExp) instead of opacity·G cut at 3σ"
             }
+            Variant::AxesSwapped => {
+                "footprint axes swapped where Σ' has no x–y term: the eigenvector normalize(b, λ₁ − a) degenerates, so a footprint wider than tall is drawn taller than wide"
+            }
+            Variant::Attributes8Bit => {
+                "colour, opacity and quaternion stored in 8 bits, SH in 8 bits over ±1, covariance in half floats (Babylon.js's splat buffer)"
+            }
+            Variant::ScaleLog8 => {
+                "scales stored as 8-bit ln σ over [−12, 9] (σ off by up to ±4.2 %), opacity in 8 bits, quaternions in 11-11-10 bits (PlayCanvas's compact work buffer)"
+            }
+            Variant::ColourClamped => "each splat's colour clamped to 1 before blending",
+            Variant::Unorm8Blending => {
+                "blended in an 8-bit target: colour sums above 1 clamped between blends"
+            }
         }
     }
     /// The RC section whose rule the variant departs from.
@@ -167,6 +208,16 @@ impl Variant {
                 "RC Color Space (all blending before any transfer-function conversion)"
             }
             Variant::NormalizedKernel => "RC Ellipse Kernel Rendering (α = opacity · G(x))",
+            Variant::AxesSwapped => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
+            Variant::ColourClamped | Variant::Unorm8Blending => {
+                "RC Splat Composition (note: \"blending should be performed using floating-point color buffer formats\"); profile"
+            }
+            Variant::ScaleLog8 => {
+                "RC Attributes (float SCALE); the RC does not specify a renderer's precision, but scales off by up to ±4.2 % change footprints beyond any bound"
+            }
+            Variant::Attributes8Bit => {
+                "RC Attributes (float ROTATION, SH, OPACITY); the RC does not specify a renderer's precision, but 8-bit quaternions turn long splats by up to ~0.5°"
+            }
         }
     }
     /// Whether the RC allows it: an image that matches it passes.
