@@ -8,84 +8,13 @@
 //! against the reference.
 
 use super::Erratum;
+pub use super::deviation::Deviation;
 use super::generate::{measure, over_bound};
 use super::manifest::{AssetEntry, CameraEntry};
 use super::model::{self, Variant};
 use splatgl::SplatCloud;
 use splatgl::camera::Camera;
 use splatgl::image::Image;
-
-/// A way of rendering differently from the RC that the diagnosis knows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Deviation {
-    /// A review-draft Appendix A erratum.
-    Erratum(Erratum),
-    /// An implementation variant.
-    Variant(Variant),
-    /// The image upside down (rows not flipped after a GL read-back, or y up vs down).
-    UpsideDown,
-    /// The image mirrored left-right (handedness or x axis flipped).
-    Mirrored,
-}
-
-impl Deviation {
-    /// Every deviation tried singly.
-    pub fn all() -> Vec<Deviation> {
-        let mut v: Vec<Deviation> = Erratum::ALL.into_iter().map(Deviation::Erratum).collect();
-        v.extend(Variant::ALL.into_iter().map(Deviation::Variant));
-        v.extend([Deviation::UpsideDown, Deviation::Mirrored]);
-        v
-    }
-    /// A short identifier (`rule` in `report.json`'s `diagnosis`).
-    pub fn name(self) -> String {
-        match self {
-            Deviation::Erratum(e) => format!("erratum_{}", e.letter()),
-            Deviation::Variant(v) => v.name().to_owned(),
-            Deviation::UpsideDown => "upside_down".into(),
-            Deviation::Mirrored => "mirrored".into(),
-        }
-    }
-    /// What the renderer does, in words.
-    pub fn describe(self) -> String {
-        match self {
-            Deviation::Erratum(e) => {
-                format!("review-draft erratum {}: {}", e.letter(), e.describe())
-            }
-            Deviation::Variant(v) => v.describe().to_owned(),
-            Deviation::UpsideDown => {
-                "the image is upside down (rows not flipped after a GL read-back, or y up vs down)"
-                    .into()
-            }
-            Deviation::Mirrored => {
-                "the image is mirrored left-right (handedness or x axis flipped)".into()
-            }
-        }
-    }
-    /// The section of the RC whose rule it breaks (or allows, for the SH degree caps).
-    pub fn rc_section(self) -> String {
-        match self {
-            Deviation::Erratum(e) => match e {
-                Erratum::A => "RC Splat Reconstruction (C = R(q)·S)",
-                Erratum::B => "RC Splat Projection (Σ' = J W Σ Wᵀ Jᵀ)",
-                Erratum::D => "RC Splat Projection (pixel mapping)",
-                Erratum::E => "RC Lighting (basis with Condon–Shortley signs, Σ SH·Y + 0.5)",
-                Erratum::F => "RC Ellipse Kernel Rendering (3σ cut-off)",
-                Erratum::G => "RC Splat Composition (premultiplied, back to front)",
-                Erratum::I => "profile: dilation (RC: the training forward pass)",
-                Erratum::K => "profile: J clamp and α cap (3DGS computeCov2D)",
-            }
-            .into(),
-            Deviation::Variant(v) => v.rc_section().into(),
-            Deviation::UpsideDown | Deviation::Mirrored => {
-                "glTF 2.0 §3.4 coordinate system; image rows top to bottom".into()
-            }
-        }
-    }
-    /// Whether the RC allows it (an image matching it passes).
-    pub fn rc_allowed(self) -> bool {
-        matches!(self, Deviation::Variant(v) if v.rc_allowed())
-    }
-}
 
 /// One candidate that explains a camera, with its evidence.
 #[derive(Debug, Clone, PartialEq)]
@@ -114,7 +43,14 @@ pub fn model_image(cloud: &SplatCloud, cam: &Camera, devs: &[Deviation]) -> Imag
             _ => None,
         })
         .collect();
-    let mut img = model::render_with(cloud, cam, &errata, &variants).image;
+    let dilation = devs.iter().find_map(|d| match d {
+        Deviation::Dilation(m) => Some(f64::from(*m) / 1000.0),
+        _ => None,
+    });
+    let mut img = match dilation {
+        Some(d) => model::render_with_dilation(cloud, cam, (&errata, &variants), None, d).image,
+        None => model::render_with(cloud, cam, &errata, &variants).image,
+    };
     if devs.contains(&Deviation::UpsideDown) {
         img = flipped(&img, true);
     }
@@ -291,7 +227,37 @@ impl<'a> Search<'a> {
                 break;
             }
         }
+        let no_dilation = Deviation::Erratum(Erratum::I);
+        if out.is_empty() && named.contains(&no_dilation) {
+            let others: Vec<Deviation> = named
+                .iter()
+                .copied()
+                .filter(|d| *d != no_dilation)
+                .collect();
+            self.estimate_dilation(&others, &mut out);
+        }
         out
+    }
+
+    /// The dilation estimated from the image: with each set of at most [`DILATION_WITH`] of
+    /// `others` (none included), Σ' dilated by every value of [`DILATION_GRID`] is tried; the
+    /// sets that then explain the camera go into `out` (every value that does, so that the
+    /// run's cover can pick the one most cameras share).
+    fn estimate_dilation(&mut self, others: &[Deviation], out: &mut Vec<Explanation>) {
+        for size in 0..=others.len().min(DILATION_WITH) {
+            for set in combinations(others, size) {
+                for m in DILATION_GRID.into_iter().filter(|m| *m != 300) {
+                    let mut with = set.clone();
+                    with.push(Deviation::Dilation(m));
+                    if let (Some(e), _) = self.score(&with) {
+                        out.push(e);
+                    }
+                }
+            }
+            if !out.is_empty() {
+                return;
+            }
+        }
     }
 
     /// The `size`-element subsets of `items` that explain the camera, into `out`.
@@ -304,8 +270,23 @@ impl<'a> Search<'a> {
     }
 }
 
+/// The dilations (thousandths of a px²) [`Search::explain_with`] estimates between: 0 to
+/// 0.6 px² in steps of 0.025.
+const DILATION_GRID: [u16; 25] = {
+    let mut g = [0u16; 25];
+    let mut i = 0;
+    while i < 25 {
+        g[i] = 25 * i as u16;
+        i += 1;
+    }
+    g
+};
+
+/// At most this many other deviations go with an estimated dilation.
+const DILATION_WITH: usize = 2;
+
 /// At most this many of a run's named deviations are combined on a second look.
-pub const SECOND_LOOK: usize = 4;
+pub const SECOND_LOOK: usize = 6;
 
 /// Evidence for one camera: the image against the reference and against the deviation's
 /// model.

@@ -5,16 +5,10 @@
 
 use super::Erratum;
 use super::assets::AssetSpec;
+use super::deviation::Deviation;
 use super::model::{self, Variant};
 use splatgl::camera::Camera;
 use splatgl::image::Image;
-
-/// A deviation an asset's bound can admit: an erratum or an implementation variant.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Admitted {
-    Erratum(Erratum),
-    Variant(Variant),
-}
 
 /// The field of [`model::Terms`] a deviation widens.
 type TermField = fn(&mut model::Terms) -> &mut f64;
@@ -31,24 +25,25 @@ type TermField = fn(&mut model::Terms) -> &mut f64;
 ///   of the 3D covariance: precisions the RC does not specify, admitted everywhere;
 /// - Σ' rebuilt from eigenvalues floored at mid ± √0.1 (GaussianSplats3D's numerical
 ///   safeguard): like the dilation, detected by `subpixel_dilation` alone.
-const ISOLATED: [(Admitted, TermField); 4] = [
-    (Admitted::Erratum(Erratum::I), |t| &mut t.dilation),
-    (Admitted::Variant(Variant::Colour8Bit), |t| {
+const ISOLATED: [(Deviation, TermField); 4] = [
+    (Deviation::Erratum(Erratum::I), |t| &mut t.dilation),
+    (Deviation::Variant(Variant::Colour8Bit), |t| {
         &mut t.colour_8bit
     }),
-    (Admitted::Variant(Variant::HalfCovariance), |t| {
+    (Deviation::Variant(Variant::HalfCovariance), |t| {
         &mut t.covariance_f16
     }),
-    (Admitted::Variant(Variant::EigenvalueFloor), |t| {
+    (Deviation::Variant(Variant::EigenvalueFloor), |t| {
         &mut t.eigenvalue_floor
     }),
 ];
 
 /// Whether `spec` is designed to detect `d` (then its bound does not admit it).
-fn detects(spec: &AssetSpec, d: Admitted) -> bool {
+fn detects(spec: &AssetSpec, d: Deviation) -> bool {
     match d {
-        Admitted::Erratum(e) => spec.designed_for.contains(&e),
-        Admitted::Variant(v) => spec.detects.contains(&v),
+        Deviation::Erratum(e) => spec.designed_for.contains(&e),
+        Deviation::Variant(v) => spec.detects.contains(&v),
+        _ => false,
     }
 }
 
@@ -58,7 +53,7 @@ pub(crate) fn admitted_errata(spec: &AssetSpec) -> Vec<Erratum> {
     ISOLATED
         .iter()
         .filter_map(|(d, _)| match d {
-            Admitted::Erratum(e) if !detects(spec, *d) => Some(*e),
+            Deviation::Erratum(e) if !detects(spec, *d) => Some(*e),
             _ => None,
         })
         .collect()
@@ -66,13 +61,14 @@ pub(crate) fn admitted_errata(spec: &AssetSpec) -> Vec<Erratum> {
 
 /// The deviations of [`ISOLATED`] that an asset which catches `catches` and detects
 /// `detects` (its manifest entry) admits.
-fn admitted_by(catches: &[Erratum], detects: &[String]) -> Vec<(Admitted, TermField)> {
+fn admitted_by(catches: &[Erratum], detects: &[String]) -> Vec<(Deviation, TermField)> {
     ISOLATED
         .iter()
         .copied()
         .filter(|&(d, _)| match d {
-            Admitted::Erratum(e) => !catches.contains(&e),
-            Admitted::Variant(v) => !detects.iter().any(|n| n == v.name()),
+            Deviation::Erratum(e) => !catches.contains(&e),
+            Deviation::Variant(v) => !detects.iter().any(|n| n == v.name()),
+            _ => true,
         })
         .collect()
 }
@@ -87,18 +83,8 @@ fn same_term(a: TermField, b: TermField) -> bool {
 /// The deviations an asset that catches `catches` and detects `detects` admits (its bound is
 /// widened for them), singly and in pairs of different terms, as the diagnosis names them:
 /// what an image may still show and pass as (the runner's admitted choices).
-pub(crate) fn admitted_sets(
-    catches: &[Erratum],
-    detects: &[String],
-) -> Vec<Vec<super::diagnosis::Deviation>> {
-    use super::diagnosis::Deviation;
-    let admitted: Vec<(Deviation, TermField)> = admitted_by(catches, detects)
-        .into_iter()
-        .map(|(d, f)| match d {
-            Admitted::Erratum(e) => (Deviation::Erratum(e), f),
-            Admitted::Variant(v) => (Deviation::Variant(v), f),
-        })
-        .collect();
+pub(crate) fn admitted_sets(catches: &[Erratum], detects: &[String]) -> Vec<Vec<Deviation>> {
+    let admitted = admitted_by(catches, detects);
     let mut out: Vec<Vec<Deviation>> = admitted.iter().map(|(d, _)| vec![*d]).collect();
     for (i, (a, fa)) in admitted.iter().enumerate() {
         for (b, fb) in &admitted[i + 1..] {
@@ -113,7 +99,7 @@ pub(crate) fn admitted_sets(
 /// The model images with the deviations `ds` at once: one, or where `ds` holds the eigenvalue
 /// floor, one per major axis f32 rounding allows it ([`model::axis_samples`]) besides the
 /// representative one — the term admits whichever GaussianSplats3D's rounding picks.
-fn render_admitted(cloud: &splatgl::SplatCloud, cam: &Camera, ds: &[Admitted]) -> Vec<Image> {
+fn render_admitted(cloud: &splatgl::SplatCloud, cam: &Camera, ds: &[Deviation]) -> Vec<Image> {
     let (errata, variants) = split(ds);
     let mut axes = vec![None];
     if variants.contains(&Variant::EigenvalueFloor) {
@@ -125,12 +111,13 @@ fn render_admitted(cloud: &splatgl::SplatCloud, cam: &Camera, ds: &[Admitted]) -
 }
 
 /// The errata and the variants of `ds`.
-fn split(ds: &[Admitted]) -> (Vec<Erratum>, Vec<Variant>) {
+fn split(ds: &[Deviation]) -> (Vec<Erratum>, Vec<Variant>) {
     let mut out = (Vec::new(), Vec::new());
     for d in ds {
         match *d {
-            Admitted::Erratum(e) => out.0.push(e),
-            Admitted::Variant(v) => out.1.push(v),
+            Deviation::Erratum(e) => out.0.push(e),
+            Deviation::Variant(v) => out.1.push(v),
+            _ => {}
         }
     }
     out
@@ -156,18 +143,29 @@ pub(crate) fn admit(
     cloud: &splatgl::SplatCloud,
     cam: &Camera,
 ) {
-    let admitted: Vec<(Admitted, TermField)> = ISOLATED
+    let admitted: Vec<(Deviation, TermField)> = ISOLATED
         .iter()
         .copied()
         .filter(|(d, _)| !detects(spec, *d))
         .collect();
     admit_all(exact, &admitted, cloud, cam);
+    if spec.detects.contains(&Variant::Unorm8Blending) {
+        drop_overbright(exact);
+    }
+}
+
+/// Takes the `overbright` term out of `exact`'s bound: the asset tests float blending, so an
+/// 8-bit target's clamping is what it judges.
+fn drop_overbright(exact: &mut model::ModelImage) {
+    for (b, o) in exact.bound.iter_mut().zip(&exact.overbright) {
+        *b = (*b - o).max(0.0);
+    }
 }
 
 /// [`admit`] with the admitted deviations given.
 fn admit_all(
     exact: &mut model::ModelImage,
-    admitted: &[(Admitted, TermField)],
+    admitted: &[(Deviation, TermField)],
     cloud: &splatgl::SplatCloud,
     cam: &Camera,
 ) {
@@ -195,7 +193,7 @@ fn admit_all(
 /// (the two cut-off shapes) are alternatives, not a combination, and are skipped.
 fn admit_combined(
     exact: &mut model::ModelImage,
-    admitted: &[(Admitted, TermField)],
+    admitted: &[(Deviation, TermField)],
     cloud: &splatgl::SplatCloud,
     cam: &Camera,
 ) -> f64 {
@@ -217,7 +215,7 @@ fn admit_combined(
     });
     let mut worst = 0.0f64;
     for s in sets {
-        let ds: Vec<Admitted> = s.iter().map(|&i| admitted[i].0).collect();
+        let ds: Vec<Deviation> = s.iter().map(|&i| admitted[i].0).collect();
         let others = render_admitted(cloud, cam, &ds);
         for i in 0..exact.bound.len() {
             let mut own: f64 = 0.0;
@@ -247,5 +245,8 @@ pub(crate) fn derived_bound(
 ) -> model::ModelImage {
     let mut exact = model::render(cloud, cam, &[]);
     admit_all(&mut exact, &admitted_by(catches, detects), cloud, cam);
+    if detects.iter().any(|d| d == Variant::Unorm8Blending.name()) {
+        drop_overbright(&mut exact);
+    }
     exact
 }

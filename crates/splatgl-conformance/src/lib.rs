@@ -15,6 +15,7 @@ pub mod assets;
 mod assets_light;
 mod assets_pixel;
 mod assets_scene;
+pub mod deviation;
 pub mod diagnosis;
 mod generate;
 mod isolation;
