@@ -290,6 +290,44 @@ fn pixel_mapping() -> AssetSpec {
     .catches(&[Erratum::D])
 }
 
+fn overbright() -> AssetSpec {
+    let mut c = SplatCloud::new(0);
+    // Behind: red 3.0 and green 1.5 at α 0.6 (c·α = 1.8 and 0.9; blue 0.8 stays below 1);
+    // in front, half over it, a dark splat at α 0.6. Float blending keeps 0.4 × 1.8 = 0.72 of
+    // the red under it; an 8-bit target clamps the red sum to 1 first (0.4), a per-splat
+    // clamp the colour (0.24). 1.0 apart in depth: no order is in doubt.
+    splat(
+        &mut c,
+        [-0.2, 0.0, -0.5],
+        [0.3; 3],
+        ID,
+        0.6,
+        [3.0, 1.5, 0.8],
+    );
+    splat(
+        &mut c,
+        [0.25, 0.05, 0.5],
+        [0.25; 3],
+        ID,
+        0.6,
+        [0.1, 0.1, 0.1],
+    );
+    AssetSpec::new(
+        "overbright_blending",
+        "colours above 1 (red 3.0, green 1.5) under a translucent splat: blended in floating point (the RC's note: \"blending should be performed using floating-point color buffer formats\"), only the final colour clamped",
+        "RC Splat Composition (the final colour MUST be clamped; float buffers a note's \"should\"): profile",
+        "a dull red under the dark splat: the colour sum is clamped to 1 between blends (8-bit target) or each splat's colour is clamped before blending",
+        single(vec![prim(c)]),
+        vec![cam("front", [0.0, 0.0, 3.0])],
+    )
+    .detects(&[
+        Variant::ColourClamped,
+        Variant::Unorm8Blending,
+        Variant::Colour8Bit,
+    ])
+    .profile()
+}
+
 /// The assets of this file, in manifest order.
 pub(super) fn all() -> Vec<AssetSpec> {
     vec![
@@ -299,6 +337,7 @@ pub(super) fn all() -> Vec<AssetSpec> {
         needles(),
         faint(),
         opaque(),
+        overbright(),
         cutoff(),
         blend_order(),
         jacobian_clamp(),

@@ -72,8 +72,16 @@ fn render_suite_with(
     mut r: splatgl::headless::HeadlessRenderer,
     front_to_back: bool,
 ) -> Result<Images, String> {
-    use splatgl::headless::HeadlessOptions;
+    use splatgl::headless::{HeadlessOptions, TargetKind};
+    // Blended as `conformance run --backend gl` blends (Engine::gl): in RGBA16F where the
+    // context can render to it.
+    let target = if r.context().can_render_rgba16f() {
+        TargetKind::Rgba16fResolve
+    } else {
+        TargetKind::Rgba8
+    };
     let opts = HeadlessOptions {
+        target,
         background: m.background.map(|v| v as f32),
         ..Default::default()
     };

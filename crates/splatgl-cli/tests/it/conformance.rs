@@ -477,6 +477,8 @@ fn rc_silent_choices_in_any_combination_fail_only_the_asset_that_tests_them() {
         dilation: 0.1,
         colour_8bit: true,
         covariance_f16: true,
+        blending_8bit: true,
+        colour_clamp: true,
         ..p
     };
     let mut planted: Vec<(String, Choices)> = Choices::rows()
@@ -533,6 +535,8 @@ fn rc_silent_choices_in_any_combination_fail_only_the_asset_that_tests_them() {
             dilation: [0.1, 0.2, 0.3][pick(3)],
             colour_8bit: pick(2) == 0,
             covariance_f16: pick(2) == 0,
+            blending_8bit: pick(2) == 0,
+            colour_clamp: pick(2) == 0,
         };
         planted.push((format!("sample_{k}: {c:?}"), c));
     }
