@@ -14,7 +14,9 @@ npm_tools=(@playcanvas/splat-transform@3.7.0 @mkkellogg/gaussian-splats-3d@0.4.7
   @sparkjsdev/spark@2.2.0 three-spark@npm:three@0.180.0 --force
   cesium@1.145.0
   # PlayCanvas 2.23 reads KHR_gaussian_splatting glTF itself (scripts/conformance/playcanvas.mjs).
-  playcanvas@2.23.3)
+  playcanvas@2.23.3
+  # Babylon.js 9 reads KHR_gaussian_splatting glTF itself (scripts/conformance/babylon.mjs).
+  @babylonjs/core@9.28.0 @babylonjs/loaders@9.28.0)
 if [ "$(cat .npm-tools/ci-installed 2>/dev/null)" = "${npm_tools[*]}" ]; then
   exit 0
 fi

@@ -18,7 +18,7 @@ skipped="$target/tmp/skipped-tests.txt"
 
 # The integration-test modules (in crates/splatgl-cli/tests/it) of the slow lane: filters for
 # the test harness, each a module path prefix.
-slow=(conformance_third_party:: conformance_cesium:: conformance_playcanvas:: tiles_cesium::
+slow=(conformance_third_party:: conformance_cesium:: conformance_playcanvas:: conformance_babylon:: tiles_cesium::
   tiles_streamed_sog::
   splat_transform_gltf:: viewer:: viewer_panel::)
 skip_slow=()

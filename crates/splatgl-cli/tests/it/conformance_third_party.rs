@@ -50,16 +50,23 @@ fn gaussian_splats_3d_is_graded_by_the_rules_its_source_breaks() {
     assert!(named_for("view_depth_order").contains(&"sort_distance_not_depth".to_owned()));
     // The diagnosis names its three deviations that an asset decides (the eigenvalue floor
     // rather than erratum d, which 30 passing assets contradict), and the colour space the
-    // PLY the adapter gives it cannot carry (the linear asset shown as display values), and
-    // nothing else.
+    // PLY the adapter gives it cannot carry (the linear asset shown as display values), its
+    // 8-bit colour storage on the asset with colours above 1 (clamped before blending: the
+    // profile asset `overbright_blending` differs), and nothing else.
     assert_eq!(
         named(&json),
         [
             "color_space_ignored",
+            "colour_and_opacity_8bit",
             "eigenvalue_floor",
             "erratum_f",
             "view_depth_order"
         ]
+    );
+    assert!(
+        named_for("colour_and_opacity_8bit") == ["overbright_blending"],
+        "{:?}",
+        named(&json)
     );
     // :12364 "Valid values are 0 - 2": degree 3 ignored, which the RC allows.
     for a in ["sh_degree_3", "sh_rotated_node"] {

@@ -21,6 +21,7 @@ mod cli_kernel_crop;
 mod cli_messages;
 mod cli_options;
 mod conformance;
+mod conformance_babylon;
 mod conformance_cesium;
 mod conformance_playcanvas;
 mod conformance_third_party;
