@@ -50,5 +50,13 @@ fn babylon_is_graded_by_the_rules_its_source_breaks() {
     ] {
         assert!(passes(&json, ok), "{ok}");
     }
+    // What is left unexplained is what the source shows and the models do not follow (the
+    // per-primitive sort, the SH direction through M⁻¹) or follow only at the modelled
+    // dilations (its 0.075 px²: the cut-off asset, the axis swap seen from above).
+    let left = unexplained_rc(&json);
+    for a in ["primitives_interleaved_depth", "node_hierarchy_trs"] {
+        assert!(left.contains(&a.to_owned()), "{left:?}");
+    }
+    assert!(left.len() <= 5, "{left:?}");
     clean(&[&suite, &images, &report]);
 }

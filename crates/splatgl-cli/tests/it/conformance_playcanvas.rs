@@ -36,6 +36,18 @@ fn playcanvas_is_graded_by_the_rules_its_source_breaks() {
     // scene/gsplat/gsplat-sort-worker.js: the key is `x·dx + y·dy + z·dz` along the camera's
     // direction (gsplat-instance.js: `cameraMat.getZ`), view depth: the sort asset fails.
     assert!(!passes(&json, "sort_distance_not_depth"));
+    // The unified path's compact work buffer (…/gsplat/frag/formats/containerCompactWrite.js):
+    // scales as 8-bit ln σ over [−12, 9], σ off by up to ±4.2 %: named beside the kernel on
+    // the assets whose footprints it moves; with both, the sort asset is view depth.
+    assert!(named_for("scale_log8").len() >= 8);
+    assert!(named_for("view_depth_order").contains(&"sort_distance_not_depth".to_owned()));
+    // What is left unexplained is what the source shows and the models do not follow:
+    // scene/gsplat/gsplat-resource.js:105 stores SCALE as f16, u16 65535 → +Inf; the node
+    // matrix split into rotation and scale (gsplat-work-buffer-render-pass.js:156–157).
+    assert_eq!(
+        unexplained_rc(&json),
+        ["attr_scale_types", "node_hierarchy_trs"]
+    );
     // The unknown kernel and sort values are read like the known ones (the extension's
     // object is not looked into), so the profile asset is drawn, not rejected.
     assert!(psnr(&json, "unknown_kernel") > 30.0);

@@ -140,6 +140,23 @@ pub fn named_for(json: &serde_json::Value, rule: &str) -> Option<Vec<String>> {
     )
 }
 
+/// The required RC assets with a camera the diagnosis leaves `unexplained`, sorted.
+pub fn unexplained_rc(json: &serde_json::Value) -> Vec<String> {
+    let mut v: Vec<String> = rc_assets(json)
+        .filter(|a| a["optional"] != true)
+        .filter(|a| {
+            a["cameras"].as_array().unwrap().iter().any(|c| {
+                c["cause"]
+                    .as_str()
+                    .is_some_and(|t| t.contains("unexplained"))
+            })
+        })
+        .map(|a| a["name"].as_str().unwrap().to_owned())
+        .collect();
+    v.sort();
+    v
+}
+
 /// Removes the test's folders.
 pub fn clean(dirs: &[&Path]) {
     for d in dirs {
