@@ -39,7 +39,9 @@ pub use check::{LevelSummary, TilesetReport, check};
 pub use lod_meta::{MAX_LOD_LEVELS, level_error};
 pub use lod_meta_write::{LodMetaLayout, layout as lod_meta_layout};
 pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
-pub use select::{SelectOptions, Selection, TileCache, screen_space_error, select, visible};
+pub use select::{
+    SelectOptions, Selection, TileCache, Y_UP_TO_Z_UP, screen_space_error, select, visible,
+};
 pub use stream::{
     LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover, merged, select_resident,
 };

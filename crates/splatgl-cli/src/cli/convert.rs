@@ -101,6 +101,10 @@ pub struct Args {
     /// Overwrite OUT if it exists.
     #[arg(short, long)]
     pub force: bool,
+    /// Print the matrix that takes the input's coordinates to the output's (for a tileset:
+    /// to the tileset's z-up frame), so that a camera can be carried over (docs/lod.md).
+    #[arg(short, long)]
+    pub verbose: bool,
     #[command(flatten)]
     pub load: super::LoadArgs,
 }
@@ -324,6 +328,9 @@ fn go(a: &Args) -> Result<(), String> {
         }
         cameras.push(node);
     }
+    if a.verbose {
+        eprintln!("{}", transform_note(r, tree));
+    }
     let cloud = rotate(cloud, r, &p)?;
     if let Some(kind) = tree {
         return super::convert_lod::write_tree(a, kind, &cloud, &o, &p, t0);
@@ -343,6 +350,22 @@ fn go(a: &Args) -> Result<(), String> {
         t0.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// `-v`'s line: the matrix from the input's coordinates to the output's — the up-axis and
+/// `--rotate-*` rotation `r`, and for a 3D Tiles tileset glTF's +Y turned to +Z after it.
+pub(super) fn transform_note(r: glam::DMat3, tree: Option<TreeOutput>) -> String {
+    let m = glam::DMat4::from_mat3(r);
+    match tree {
+        Some(TreeOutput::Tiles3d) => format!(
+            "transform: input → tileset (z-up) {} (a camera at eye e in the input is at M·e in the tileset; its look and up vectors turn by M too)",
+            super::tileset::matrix_text(splatgl::tiles::Y_UP_TO_Z_UP * m)
+        ),
+        _ => format!(
+            "transform: input → output {} (a camera at eye e in the input is at M·e in the output)",
+            super::tileset::matrix_text(m)
+        ),
+    }
 }
 
 /// Runs it. Exit status 0 on success, 2 on any error.

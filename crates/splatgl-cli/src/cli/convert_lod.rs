@@ -286,5 +286,11 @@ pub(super) fn write_tileset_streamed(
         report.scratch_bytes,
         scratch.display()
     ));
+    if let (true, Some(r)) = (a.verbose, src.rotation) {
+        eprintln!(
+            "{}",
+            super::convert::transform_note(r, Some(TreeOutput::Tiles3d))
+        );
+    }
     w.finish(&root, report.splats, t0)
 }

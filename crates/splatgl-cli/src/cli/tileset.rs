@@ -16,7 +16,9 @@ pub struct TileArgs {
     /// are chosen by screen-space error, coarse to fine, within it).
     #[arg(long, value_name = "N", default_value_t = SelectOptions::DEFAULT_SPLAT_BUDGET)]
     pub splat_budget: u64,
-    /// For a tileset: refine tiles whose screen-space error is above PX pixels.
+    /// For a tileset: never refine a tile whose screen-space error is at or below PX pixels
+    /// (a floor; above it the tiles with the largest error are refined first until the
+    /// budget is spent).
     #[arg(long, value_name = "PX", default_value_t = SelectOptions::DEFAULT_MAX_SCREEN_ERROR)]
     pub max_screen_error: f64,
     /// For a tileset: keep at most about MB megabytes of tile content in memory across
@@ -53,6 +55,30 @@ pub fn is_tileset_file(file: &Path, opts: &LoadOptions) -> bool {
         .is_ok_and(|b| splatgl::tiles::is_tileset(&b))
 }
 
+/// The frame a tileset's coordinates (and a camera given for it) are in.
+fn frame_name(ts: &splatgl::tiles::Tileset) -> &'static str {
+    match ts.format {
+        splatgl::tiles::TilesetFormat::Tiles3d => {
+            "z-up (3D Tiles: glTF content turned +Y → +Z, then the tiles' transforms)"
+        }
+        splatgl::tiles::TilesetFormat::StreamedSog => "the content's own (streamed SOG)",
+    }
+}
+
+/// A 4 × 4 matrix as `identity` or its rows, `[a b c d; …]`.
+pub fn matrix_text(m: glam::DMat4) -> String {
+    if m == glam::DMat4::IDENTITY {
+        return "identity".into();
+    }
+    let rows: Vec<String> = (0..4)
+        .map(|r| {
+            let row = m.row(r);
+            format!("{} {} {} {}", row.x, row.y, row.z, row.w)
+        })
+        .collect();
+    format!("[{}]", rows.join("; "))
+}
+
 /// `info` of a tileset: per level the tiles, content files, splats and largest geometric
 /// error, and the root's bounding sphere. Exit status 0, or 2 when it cannot be read.
 pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
@@ -84,6 +110,8 @@ pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
         "splat_count": t.report.splat_count,
         "bounds_centre": sphere.map(|s| s.0.to_array()),
         "bounds_radius": sphere.map(|s| s.1),
+        "frame": frame_name(ts),
+        "root_transform": ts.root.transform.to_cols_array(),
         "problems": problems,
     });
     if a.json {
@@ -110,6 +138,8 @@ pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
             c.x, c.y, c.z
         );
     }
+    println!("frame:          {}", frame_name(ts));
+    println!("root transform: {}", matrix_text(ts.root.transform));
     println!("levels:");
     for l in &t.levels {
         println!(

@@ -113,9 +113,10 @@ fn statistics(ui: &mut Ui, l: &Live, resident: usize) {
                     row(
                         "tile splats",
                         format!(
-                            "{} of {}",
+                            "{} of {} ({:.0} % of the budget)",
                             thousands(t.splats as usize),
-                            thousands(t.budget as usize)
+                            thousands(t.budget as usize),
+                            100.0 * t.splats as f64 / t.budget.max(1) as f64
                         ),
                     );
                     row(
