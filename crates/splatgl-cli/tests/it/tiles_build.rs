@@ -84,7 +84,12 @@ fn a_built_tileset_validates_and_its_leaves_are_the_input() {
 fn far_views_beat_uniform_decimation(ts: &Tileset, dir: Vec3, up: Vec3) -> Vec<String> {
     let mut cache = TileCache::new(ts, &Default::default());
     let full = leaves(ts, &mut cache);
-    let select = SelectOptions::default();
+    // At CesiumJS's 16 px, far views draw the coarse tiles (the default 1 px floor with a
+    // budget above the whole scene would draw its leaves).
+    let select = SelectOptions {
+        max_screen_error: 16.0,
+        ..Default::default()
+    };
     let mut report = Vec::new();
     for distance in [6.0, 3.0, 2.0, 1.5, 1.2] {
         let cam = common::lod::camera_at(&full, dir, distance, up);
@@ -401,7 +406,17 @@ fn a_batch_whose_views_keep_their_selection_draws_it_without_uploading_again() {
     let ts = d.join("tileset.json");
     let ts = ts.to_str().unwrap();
     let pattern = d.join("o_{index}.png");
-    let common_args = ["--backend", "gl", "--width", "96", "--height", "72"];
+    // At 16 px the orbit's far views keep one selection (at the default 1 px each refines).
+    let common_args = [
+        "--backend",
+        "gl",
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "--max-screen-error",
+        "16",
+    ];
     let mut args = vec![
         "render",
         ts,
@@ -452,5 +467,174 @@ fn a_batch_whose_views_keep_their_selection_draws_it_without_uploading_again() {
             c.max_abs
         );
     }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The selection spends its budget and never passes it: for budgets from the root's size to
+/// more than the whole tileset and cameras from far to inside it, with the default options,
+/// the selection is never empty, holds at most the budget, and every tile left unrefined
+/// is a leaf, out of view, at or under the error floor, or one whose refinement would pass
+/// the budget (nothing is left unspent that a refinement could have used).
+#[test]
+fn the_selection_fills_its_budget_and_never_passes_it() {
+    use splatgl::tiles::{Refine, screen_space_error, visible};
+    let d = dir("budget");
+    let input = d.join("in.glb");
+    let cloud = common::random_cloud(6000, 0, 4.0, 5);
+    std::fs::write(&input, splatgl::write::to_glb(&cloud, &Default::default())).unwrap();
+    let ts = build(&input, &d, &["--chunk-splats", "200"]);
+    let mut cache = TileCache::new(&ts, &Default::default());
+    let root = cache.splats(&ts.root);
+    let cams = [
+        Vec3::new(0.0, -60.0, 20.0),
+        Vec3::new(0.0, -9.0, 3.0),
+        Vec3::new(0.5, 0.2, 0.1),
+    ]
+    .map(|eye| Camera::look_at(eye, Vec3::ZERO, Vec3::Z, 0.9, 320, 240));
+    let mut filled = 0;
+    for budget in [root, root + 150, 800, 2500, 7000, 100_000] {
+        let o = SelectOptions {
+            splat_budget: budget,
+            ..Default::default()
+        };
+        for cam in &cams {
+            let sel = splatgl::tiles::select(&ts, cam, &o, &mut |t| cache.splats(t)).unwrap();
+            assert!(!sel.tiles.is_empty(), "budget {budget}: nothing selected");
+            let drawn: u64 = sel.tiles.iter().map(|t| cache.splats(t)).sum();
+            assert_eq!(drawn, sel.splats);
+            assert!(drawn <= budget, "{drawn} splats over the budget {budget}");
+            for t in &sel.tiles {
+                let kids: Vec<_> = t.children.iter().filter(|c| visible(c, cam)).collect();
+                let floor = screen_space_error(t, cam) <= o.max_screen_error;
+                if kids.is_empty() || floor || !visible(t, cam) {
+                    continue;
+                }
+                let cost: u64 = kids.iter().map(|c| cache.splats(c)).sum();
+                let freed = if t.refine == Refine::Replace {
+                    cache.splats(t)
+                } else {
+                    0
+                };
+                assert!(
+                    drawn - freed + cost > budget,
+                    "budget {budget}: {} left unrefined with {} splats to spare",
+                    t.path,
+                    budget - drawn
+                );
+            }
+            filled += usize::from(sel.held_back > 0);
+        }
+    }
+    // Small budgets are what end the refinement, not the error floor.
+    assert!(
+        filled >= 6,
+        "only {filled} selections were held back by their budget"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `convert … tileset.json -v` prints the matrix from the input's coordinates to the
+/// tileset's, and `info` names the tileset's frame and root transform: a camera carried over
+/// by that matrix sees in the tileset (every leaf drawn: a budget above the scene) what the
+/// same camera sees in the PLY.
+#[test]
+fn convert_prints_the_transform_that_carries_a_camera_into_the_tileset() {
+    let d = dir("carry");
+    let input = d.join("in.ply");
+    let cloud = common::random_cloud(1500, 0, 1.0, 21);
+    std::fs::write(&input, splatgl::write::to_inria_ply(&cloud)).unwrap();
+    let out = d.join("tileset.json");
+    let r = run(&[
+        "convert",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--chunk-splats",
+        "256",
+        "-v",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.all());
+    let line = r
+        .stderr
+        .lines()
+        .find(|l| l.starts_with("transform: input → tileset (z-up) ["))
+        .unwrap_or_else(|| panic!("no transform line: {}", r.all()));
+    let rows: Vec<Vec<f64>> = line
+        .split('[')
+        .nth(1)
+        .unwrap()
+        .split(']')
+        .next()
+        .unwrap()
+        .split(';')
+        .map(|row| row.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let m = |v: [f64; 3], w: f64| -> String {
+        (0..3)
+            .map(|i| {
+                format!(
+                    "{}",
+                    (0..3).map(|k| rows[i][k] * v[k]).sum::<f64>() + rows[i][3] * w
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let info = run(&["info", out.to_str().unwrap()]);
+    assert!(
+        info.out().contains("frame:          z-up"),
+        "{}",
+        info.all()
+    );
+    assert!(
+        info.out().contains("root transform: identity"),
+        "{}",
+        info.all()
+    );
+    let (e, t, u) = ([0.3, -0.4, -3.0], [0.0, 0.0, 0.0], [0.0, -1.0, 0.0]);
+    let text = |v: [f64; 3]| v.map(|x| x.to_string()).join(",");
+    let look = format!("{},{},{}", text(e), text(t), text(u));
+    let carried = format!("{},{},{}", m(e, 1.0), m(t, 1.0), m(u, 0.0));
+    let (a, b) = (d.join("ply.png"), d.join("tiles.png"));
+    let size = [
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--backend",
+        "reference",
+    ];
+    let mut args = vec!["render", input.to_str().unwrap(), "--look-at", &look, "-o"];
+    args.push(a.to_str().unwrap());
+    args.extend(size);
+    assert_eq!(run(&args).code, 0);
+    let mut args = vec!["render", out.to_str().unwrap(), "--look-at", &carried, "-o"];
+    args.push(b.to_str().unwrap());
+    args.extend(size);
+    args.extend(["--splat-budget", "100000"]);
+    let r = run(&args);
+    assert_eq!(r.code, 0, "{}", r.all());
+    let (ia, ib) = (
+        splatgl::image::Image::read(&a).unwrap(),
+        splatgl::image::Image::read(&b).unwrap(),
+    );
+    let lit = ia
+        .pixels
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 0.1)
+        .count();
+    assert!(
+        lit > ia.pixels.len() / 20,
+        "the view misses the scene: {lit} pixels lit"
+    );
+    let p = common::lod::psnr(&ia, &ib);
+    assert!(p >= 45.0, "the carried camera sees another view: {p:.1} dB");
+    // The uncarried numbers in the tileset: another view.
+    let mut args = vec!["render", out.to_str().unwrap(), "--look-at", &look, "-o"];
+    args.push(b.to_str().unwrap());
+    args.extend(size);
+    args.extend(["--splat-budget", "100000", "-f"]);
+    assert_eq!(run(&args).code, 0);
+    let other = splatgl::image::Image::read(&b).unwrap();
+    assert!(common::lod::psnr(&ia, &other) < 30.0);
     let _ = std::fs::remove_dir_all(&d);
 }

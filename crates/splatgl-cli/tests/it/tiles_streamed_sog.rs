@@ -116,7 +116,12 @@ fn far_views_of_a_streamed_sog_beat_uniform_decimation_and_a_close_view_is_fines
         .unwrap()
         .cloud;
     let mut cache = TileCache::new(&ts, &Default::default());
-    let select = SelectOptions::default();
+    // At CesiumJS's 16 px (the default 1 px floor with a budget above the whole scene draws
+    // its finest level): what the LOD levels give at a given error.
+    let select = SelectOptions {
+        max_screen_error: 16.0,
+        ..Default::default()
+    };
     let mut report = Vec::new();
     for distance in [6.0, 3.0, 2.0, 1.5] {
         let cam = camera_at(&full, Vec3::new(0.3, -0.4, 1.0), distance);
