@@ -1,5 +1,5 @@
 //! [`Deviation`]: one type for every way of rendering differently from the RC that the kit
-//! knows — what an asset's bound admits ([`super::isolation`]) and what the diagnosis names
+//! knows — what an asset's bound admits (`isolation`) and what the diagnosis names
 //! ([`super::diagnosis`]).
 
 use super::Erratum;
@@ -17,7 +17,7 @@ pub enum Deviation {
     /// The image mirrored left-right (handedness or x axis flipped).
     Mirrored,
     /// Σ' dilated by this many thousandths of a px² instead of 0.3: a value the diagnosis
-    /// estimates from the images ([`Search::explain_with`]) when erratum i (no dilation)
+    /// estimates from the images ([`crate::diagnosis::Search::explain_with`]) when erratum i (no dilation)
     /// comes close but does not explain them.
     Dilation(u16),
 }

@@ -1,6 +1,6 @@
 //! Comparing a set of images with the suite's references, per the manifest's tolerances, and
 //! naming the likely cause of known failure patterns: [`run`] here (each camera compared),
-//! [`judge`] (what an image is judged by, and the choices it may pass with), [`explain`]
+//! `judge` (what an image is judged by, and the choices it may pass with), `explain`
 //! (the models' search, the second look and the causes).
 
 mod explain;
@@ -29,7 +29,7 @@ pub struct CameraResult {
     pub pass: bool,
     /// The likely cause of a failure (or the RC-allowed choice a pass was found with).
     pub cause: Option<String>,
-    /// What explains a failure ([`diagnosis::Search::explain`]; empty when it passes or has no image).
+    /// What explains a failure ([`crate::diagnosis::Search::explain`]; empty when it passes or has no image).
     pub explained_by: Vec<Explanation>,
     /// For a failure nothing explains, the model it came nearest to (reported as `nearest`).
     pub closest: Option<Closest>,
