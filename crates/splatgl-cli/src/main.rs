@@ -1,7 +1,5 @@
 //! The `splatgl` command-line tool.
 
-mod cli;
-
 fn main() -> std::process::ExitCode {
     // Behave like other Unix tools when the reader of our output goes away (`| head`): exit
     // quietly instead of panicking on a failed write to stdout.
@@ -10,5 +8,5 @@ fn main() -> std::process::ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    cli::run()
+    splatgl_cli::run()
 }

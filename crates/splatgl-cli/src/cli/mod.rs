@@ -218,7 +218,26 @@ pub(crate) fn exit_status(result: Result<(), String>) -> ExitCode {
 
 /// Parses the arguments and runs the subcommand.
 pub fn run() -> ExitCode {
-    let cli = Cli::parse();
+    dispatch(Cli::parse())
+}
+
+/// [`run`] with `args`: a usage error or `--help` is printed and its status returned.
+pub fn run_from<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    match Cli::try_parse_from(args) {
+        Ok(cli) => dispatch(cli),
+        Err(e) => {
+            let _ = e.print();
+            ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
+        }
+    }
+}
+
+/// Runs the parsed command.
+fn dispatch(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Info(a) => info::run(a),
         Command::Validate(a) => validate::run(a),
