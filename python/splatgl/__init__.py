@@ -1,0 +1,49 @@
+"""splatgl for Python: load every 3D Gaussian splat format as NumPy arrays, save them, render
+exact cameras headless (GL through EGL, or the CPU reference), validate
+KHR_gaussian_splatting files, and run the conformance kit.
+
+    import splatgl
+    cloud = splatgl.load("scene.ply")
+    cam = splatgl.Camera.look_at(eye=(0, 0, 4), target=(0, 0, 0), width=640, height=480)
+    image = splatgl.render(cloud, cam)          # (480, 640, 4) float32
+
+See docs/python.md.
+"""
+
+from ._splatgl import (
+    Camera,
+    CameraError,
+    Cloud,
+    ConformanceError,
+    LoadError,
+    RenderError,
+    SaveError,
+    SplatglError,
+    __version__,
+    compare,
+    load,
+    load_bytes,
+    render,
+    save,
+    validate,
+)
+from . import conformance
+
+__all__ = [
+    "Camera",
+    "CameraError",
+    "Cloud",
+    "ConformanceError",
+    "LoadError",
+    "RenderError",
+    "SaveError",
+    "SplatglError",
+    "__version__",
+    "compare",
+    "conformance",
+    "load",
+    "load_bytes",
+    "render",
+    "save",
+    "validate",
+]
