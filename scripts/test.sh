@@ -4,10 +4,14 @@
 #         (default, --no-default-features, --all-features), docs without broken links, an
 #         independent Python re-implementation of the reference's math, and every unit and
 #         integration test of every crate except the slow cross-checks;
+#   python: the Python package (crates/splatgl-python) installed into a venv under the target
+#         folder with `pip install .` (maturin, the dev profile: the fast lane's dependencies
+#         are reused), then its pytest suite (python/tests) against the command;
 #   slow: the cross-checks that drive a browser or an X server: the engines graded in headless
-#         Chromium (GaussianSplats3D, Spark, CesiumJS), splat-transform's streamed SOG and glTF,
-#         and the viewer under Xvfb.
-# `scripts/test.sh fast` or `scripts/test.sh slow` runs one lane. Tests that cannot run here (no
+#         Chromium (GaussianSplats3D, Spark, CesiumJS, PlayCanvas, Babylon.js), splat-transform's
+#         streamed SOG and glTF, and the viewer under Xvfb.
+# `scripts/test.sh fast`, `python` or `slow` runs one lane (python after fast: it uses the
+# command fast builds). Tests that cannot run here (no
 # EGL, no real data, no npm tool) are listed at the end; with SPLATGL_REQUIRE=all (.ci/run sets
 # it) each of them fails instead.
 set -euo pipefail
@@ -35,9 +39,21 @@ fast() {
   # the crates' rlibs).
   cargo build --locked --quiet -p splatgl-cli -p splatgl-capi
   python3 scripts/xcheck_reference.py "$target/debug/splatgl"
-  cargo test --workspace --all-features --locked --lib --bins --tests --examples -- "${skip_slow[@]}"
+  # The Python extension is tested by its own lane (it links no libpython: no Rust test).
+  cargo test --workspace --exclude splatgl-python --all-features --locked --lib --bins --tests \
+    --examples -- "${skip_slow[@]}"
   # The benchmarks' smoke runs (each checks its own results; they take no harness options).
-  cargo test --workspace --all-features --locked --benches
+  cargo test --workspace --exclude splatgl-python --all-features --locked --benches
+}
+
+python() {
+  local venv="$target/pyvenv"
+  [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+  "$venv/bin/pip" install --quiet --disable-pip-version-check \
+    maturin==1.16.0 pytest==9.2.0 numpy==2.4.6
+  PATH="$PWD/$venv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/pip" install --quiet \
+    --disable-pip-version-check --no-build-isolation --force-reinstall --no-deps .
+  SPLATGL_BIN="$target/debug/splatgl" "$venv/bin/python" -m pytest -q python/tests
 }
 
 slow() {
@@ -58,8 +74,9 @@ run_lane() {
 case "$lane" in
   fast) run_lane fast ;;
   slow) run_lane slow ;;
-  all) run_lane fast; run_lane slow ;;
-  *) echo "usage: scripts/test.sh [fast|slow|all]" >&2; exit 2 ;;
+  python) run_lane python ;;
+  all) run_lane fast; run_lane python; run_lane slow ;;
+  *) echo "usage: scripts/test.sh [fast|python|slow|all]" >&2; exit 2 ;;
 esac
 if [ -s "$skipped" ]; then
   echo "skipped tests (what they need is missing here; SPLATGL_REQUIRE=all makes these failures):"
