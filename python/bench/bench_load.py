@@ -8,7 +8,6 @@ for docs/python.md and the issue's note.
 """
 
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -46,9 +45,12 @@ LOADERS = {
 
 
 def run(loader: str, path: Path) -> tuple:
-    code = (f"import time, resource; P = {str(path)!r}; t = time.perf_counter(); "
+    # VmHWM: the peak of this process's own memory (ru_maxrss would carry the parent's
+    # across fork and exec).
+    code = (f"import time; P = {str(path)!r}; t = time.perf_counter(); "
             f"{LOADERS[loader]}; dt = time.perf_counter() - t; "
-            "print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+            "hwm = [l for l in open('/proc/self/status') if l.startswith('VmHWM')][0]; "
+            "print(dt, hwm.split()[1])")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     dt, kb = out.stdout.split()
     return float(dt), int(kb) / 1024
