@@ -218,7 +218,7 @@ pub fn render<'py>(
 /// An image as an (H, W, 4) float32 array.
 fn image_array(py: Python<'_>, img: Image) -> PyResult<Bound<'_, PyArray3<f32>>> {
     let (w, h) = (img.width as usize, img.height as usize);
-    Ok(PyArray1::from_vec(py, img.pixels.into_flattened()).reshape([h, w, 4])?)
+    PyArray1::from_vec(py, img.pixels.into_flattened()).reshape([h, w, 4])
 }
 
 /// Validates a file against KHR_gaussian_splatting (and the formats' own rules): a list of
