@@ -11,7 +11,7 @@ use std::sync::OnceLock;
 use glow::HasContext;
 use khronos_egl as egl;
 
-use super::HeadlessError;
+use super::{GlApi, HeadlessError};
 
 /// `EGL_PLATFORM_SURFACELESS_MESA`.
 const PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
@@ -60,55 +60,29 @@ fn egl() -> Result<&'static Egl, HeadlessError> {
     .map_err(|e| HeadlessError::EglUnavailable(e.clone()))
 }
 
-/// Which client API a [`HeadlessContext`] speaks. More kinds of context may be added: match
-/// with a wildcard arm.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[non_exhaustive]
-pub enum GlApi {
-    /// OpenGL ES 3.0 or newer (shaders get `#version 300 es`). The default.
-    #[default]
-    Gles3,
-    /// Desktop OpenGL 3.3 (or newer) core profile (shaders get `#version 330 core`).
-    DesktopCore33,
-    /// Desktop OpenGL compatibility profile, 3.3 or newer (Mesa gives 4.5 on llvmpipe): the
-    /// fixed-function pipeline, immediate mode and client arrays of legacy hosts are all
-    /// there beside the shaders (which get `#version 330 core`).
-    DesktopCompat,
-}
-
-impl GlApi {
-    /// The `(major, minor)` version asked for by default.
-    fn default_version(self) -> (i32, i32) {
-        match self {
-            GlApi::Gles3 => (3, 0),
-            GlApi::DesktopCore33 | GlApi::DesktopCompat => (3, 3),
+/// What to ask EGL for: the `eglBindAPI` value, the `EGL_RENDERABLE_TYPE` bit a config
+/// needs, and the `eglCreateContext` attributes (`EGL_NONE`-terminated) for `version`.
+fn egl_request(api: GlApi, (major, minor): (i32, i32)) -> (egl::Enum, egl::Int, Vec<egl::Int>) {
+    let mut attribs = vec![
+        egl::CONTEXT_MAJOR_VERSION,
+        major,
+        egl::CONTEXT_MINOR_VERSION,
+        minor,
+    ];
+    let profile = |bit| [egl::CONTEXT_OPENGL_PROFILE_MASK, bit];
+    let (bind, renderable) = match api {
+        GlApi::Gles3 => (egl::OPENGL_ES_API, egl::OPENGL_ES3_BIT),
+        GlApi::DesktopCore33 => {
+            attribs.extend(profile(egl::CONTEXT_OPENGL_CORE_PROFILE_BIT));
+            (egl::OPENGL_API, egl::OPENGL_BIT)
         }
-    }
-
-    /// What to ask EGL for: the `eglBindAPI` value, the `EGL_RENDERABLE_TYPE` bit a config
-    /// needs, and the `eglCreateContext` attributes (`EGL_NONE`-terminated) for `version`.
-    fn egl_request(self, (major, minor): (i32, i32)) -> (egl::Enum, egl::Int, Vec<egl::Int>) {
-        let mut attribs = vec![
-            egl::CONTEXT_MAJOR_VERSION,
-            major,
-            egl::CONTEXT_MINOR_VERSION,
-            minor,
-        ];
-        let profile = |bit| [egl::CONTEXT_OPENGL_PROFILE_MASK, bit];
-        let (bind, renderable) = match self {
-            GlApi::Gles3 => (egl::OPENGL_ES_API, egl::OPENGL_ES3_BIT),
-            GlApi::DesktopCore33 => {
-                attribs.extend(profile(egl::CONTEXT_OPENGL_CORE_PROFILE_BIT));
-                (egl::OPENGL_API, egl::OPENGL_BIT)
-            }
-            GlApi::DesktopCompat => {
-                attribs.extend(profile(egl::CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT));
-                (egl::OPENGL_API, egl::OPENGL_BIT)
-            }
-        };
-        attribs.push(egl::NONE);
-        (bind, renderable, attribs)
-    }
+        GlApi::DesktopCompat => {
+            attribs.extend(profile(egl::CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT));
+            (egl::OPENGL_API, egl::OPENGL_BIT)
+        }
+    };
+    attribs.push(egl::NONE);
+    (bind, renderable, attribs)
 }
 
 /// An OpenGL ES 3, desktop core or desktop compatibility context ([`GlApi`]) on the surfaceless
@@ -148,7 +122,7 @@ impl HeadlessContext {
         let e = egl()?;
         let display = e.display();
         let err = |call| move |error| HeadlessError::Egl { call, error };
-        let (bind, renderable, attribs) = api.egl_request(version);
+        let (bind, renderable, attribs) = egl_request(api, version);
         e.instance.bind_api(bind).map_err(err("eglBindAPI"))?;
         // Surfaceless: no window surfaces, so don't let SURFACE_TYPE default to WINDOW_BIT.
         let config_attribs = [

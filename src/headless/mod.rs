@@ -1,4 +1,5 @@
-//! Headless rendering through EGL on Mesa's surfaceless platform (feature `gl`).
+//! Headless rendering (feature `gl`): through EGL on Mesa's surfaceless platform on Linux and
+//! the other Unixes, through WGL with a hidden window on Windows.
 //!
 //! * [`render`] — one call: cloud + camera + options → [`Image`]. This is what a CLI
 //!   `--backend gl` calls.
@@ -11,13 +12,22 @@
 //! be initialised the error is [`HeadlessError::EglUnavailable`], which callers (and the test
 //! suite) may treat as "no GL here". Every other failure is a real error.
 //!
+//! On Windows the context is made by WGL on a hidden window of its own (render into framebuffer
+//! objects as on EGL); a failure to make one is [`HeadlessError::WglUnavailable`].
+//!
 //! Contexts are current on the thread that created them and are not `Send`.
 
+#[cfg(not(windows))]
 mod egl;
 mod renderer;
+#[cfg(windows)]
+mod wgl;
 
-pub use egl::{GlApi, HeadlessContext};
+#[cfg(not(windows))]
+pub use egl::HeadlessContext;
 pub use renderer::{HeadlessOptions, HeadlessRenderer, TargetKind};
+#[cfg(windows)]
+pub use wgl::HeadlessContext;
 
 use crate::camera::Camera;
 use crate::cloud::SplatCloud;
@@ -38,9 +48,50 @@ pub enum HeadlessError {
         /// EGL's error.
         error: khronos_egl::Error,
     },
+    /// WGL could not give a context here (Windows: no window class, window, pixel format or
+    /// `wglCreateContextAttribsARB`). The Windows counterpart of
+    /// [`HeadlessError::EglUnavailable`].
+    #[error("WGL unavailable: {0}")]
+    WglUnavailable(String),
+    /// A WGL or Win32 call failed after a context could be made (`code`: `GetLastError()`).
+    #[error("WGL call {call} failed (error {code})")]
+    Wgl {
+        /// The failing call.
+        call: &'static str,
+        /// `GetLastError()` right after it.
+        code: u32,
+    },
     /// The GL layer failed.
     #[error(transparent)]
     Gl(#[from] GlError),
+}
+
+/// Which client API a [`HeadlessContext`] speaks. More kinds of context may be added: match
+/// with a wildcard arm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum GlApi {
+    /// OpenGL ES 3.0 or newer (shaders get `#version 300 es`). The default. On Windows, where
+    /// WGL offers ES contexts only through `WGL_EXT_create_context_es2_profile`, a desktop
+    /// 3.3 core context stands in when the driver has no ES (see [`HeadlessContext::describe`]).
+    #[default]
+    Gles3,
+    /// Desktop OpenGL 3.3 (or newer) core profile (shaders get `#version 330 core`).
+    DesktopCore33,
+    /// Desktop OpenGL compatibility profile, 3.3 or newer (Mesa gives 4.5 on llvmpipe): the
+    /// fixed-function pipeline, immediate mode and client arrays of legacy hosts are all
+    /// there beside the shaders (which get `#version 330 core`).
+    DesktopCompat,
+}
+
+impl GlApi {
+    /// The `(major, minor)` version asked for by default.
+    fn default_version(self) -> (i32, i32) {
+        match self {
+            GlApi::Gles3 => (3, 0),
+            GlApi::DesktopCore33 | GlApi::DesktopCompat => (3, 3),
+        }
+    }
 }
 
 /// Renders `cloud` seen by `camera` headlessly: creates an EGL context, uploads, sorts back to
