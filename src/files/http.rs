@@ -88,7 +88,15 @@ fn check(
 #[cfg(feature = "http")]
 pub fn fetch_bounded(url: &str, limit: u64, what: &str) -> io::Result<Vec<u8>> {
     use std::time::Duration;
-    let agent: ureq::Agent = ureq::Agent::config_builder()
+    let config = ureq::Agent::config_builder();
+    // macOS: the system's TLS (the only provider built there, see Cargo.toml).
+    #[cfg(target_os = "macos")]
+    let config = config.tls_config(
+        ureq::tls::TlsConfig::builder()
+            .provider(ureq::tls::TlsProvider::NativeTls)
+            .build(),
+    );
+    let agent: ureq::Agent = config
         .max_redirects(0)
         .http_status_as_error(false)
         .timeout_connect(Some(Duration::from_secs(10)))
