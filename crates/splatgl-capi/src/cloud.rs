@@ -77,7 +77,8 @@ pub unsafe extern "C" fn splatgl_load_options_default(out: *mut SplatglLoadOptio
     })
 }
 
-/// A path argument as a Rust path (UTF-8 or not: the bytes as given).
+/// A path argument as a Rust path: on Unix the bytes as given (UTF-8 or not), on Windows
+/// UTF-8 (converted to the UTF-16 Windows uses; other bytes are refused).
 ///
 /// # Safety
 /// `p` is `NULL` or a NUL-terminated string.
@@ -90,8 +91,16 @@ unsafe fn path_arg(p: *const c_char, what: &str) -> Result<PathBuf, CError> {
     if bytes.is_empty() {
         return Err(CError::invalid(format!("{what} is empty")));
     }
-    use std::os::unix::ffi::OsStrExt;
-    Ok(PathBuf::from(std::ffi::OsStr::from_bytes(bytes)))
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        Ok(PathBuf::from(std::ffi::OsStr::from_bytes(bytes)))
+    }
+    #[cfg(not(unix))]
+    match std::str::from_utf8(bytes) {
+        Ok(s) => Ok(PathBuf::from(s)),
+        Err(e) => Err(CError::invalid(format!("{what} is not UTF-8 ({e})"))),
+    }
 }
 
 /// Refuses `path` unless it lies inside `root` (both resolved).
