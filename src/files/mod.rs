@@ -150,8 +150,19 @@ fn contained_named(
     allow_outside: bool,
 ) -> Result<PathBuf, String> {
     let how = "files a document names must lie inside its folder (allow with --allow-outside-paths / LoadOptions::allow_outside_paths)";
-    if rel.is_absolute() && !allow_outside {
-        return Err(format!("URI {name:?} is an absolute path; {how}"));
+    if !allow_outside {
+        match lexical_escape(&rel.to_string_lossy()) {
+            Some(Escape::Absolute) => {
+                return Err(format!("URI {name:?} is an absolute path; {how}"));
+            }
+            Some(Escape::Up) => {
+                return Err(format!(
+                    "URI {name:?} resolves outside the asset's folder (its `..` climb above \
+                     it); {how}"
+                ));
+            }
+            None => {}
+        }
     }
     let joined = base.join(rel);
     let file = joined
@@ -171,6 +182,40 @@ fn contained_named(
         ));
     }
     Ok(file)
+}
+
+/// How a name escapes its folder before any file is looked at.
+#[derive(Debug, PartialEq, Eq)]
+enum Escape {
+    /// Absolute on some platform: `/x`, `\x`, `C:\x`, `C:/x`, `C:x`, `\\server\share`.
+    Absolute,
+    /// Its `..` components climb above the folder (`../x`, `a/../../x`, `..\x`).
+    Up,
+}
+
+/// The containment rule's platform-neutral half: `name` taken the way every platform would
+/// read it, with both `/` and `\` as separators and a drive letter as absolute, so a document
+/// written on one system is judged the same on every other (a glTF that names `..\..\secret`
+/// or `C:\x` is refused on Linux as on Windows). The file-system half (symlinks) follows in
+/// [`contained_path`].
+fn lexical_escape(name: &str) -> Option<Escape> {
+    let b = name.as_bytes();
+    let drive = b.len() >= 2 && b[0].is_ascii_alphabetic() && b[1] == b':';
+    if drive || name.starts_with(['/', '\\']) {
+        return Some(Escape::Absolute);
+    }
+    let mut depth = 0usize;
+    for part in name.split(['/', '\\']) {
+        match part {
+            "" | "." => {}
+            ".." => match depth.checked_sub(1) {
+                Some(d) => depth = d,
+                None => return Some(Escape::Up),
+            },
+            _ => depth += 1,
+        }
+    }
+    None
 }
 
 fn percent_decode(s: &str) -> String {
@@ -206,6 +251,34 @@ pub fn peak_memory() -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn names_that_escape_on_any_platform_are_escapes_on_every_platform() {
+        for name in [
+            "/etc/passwd",
+            "\\x",
+            "C:\\x",
+            "c:/x",
+            "C:x",
+            "\\\\server\\share\\x",
+        ] {
+            assert_eq!(lexical_escape(name), Some(Escape::Absolute), "{name}");
+        }
+        for name in ["../x", "..\\..\\secret", "a/../../x", "a\\..\\..\\x", ".."] {
+            assert_eq!(lexical_escape(name), Some(Escape::Up), "{name}");
+        }
+        for name in [
+            "x.bin",
+            "a/../x",
+            "a\\b\\..\\x",
+            "./x",
+            "a/./b",
+            "..x",
+            "x..",
+        ] {
+            assert_eq!(lexical_escape(name), None, "{name}");
+        }
+    }
 
     #[test]
     fn percent_decoding_keeps_invalid_escapes() {

@@ -113,6 +113,30 @@ fn escaping_uris_are_refused_by_info_render_and_validate() {
     std::fs::remove_dir_all(&root).ok();
 }
 
+/// A glTF written on Windows is judged as Windows would read it, on every platform:
+/// backslashes separate, a drive letter makes a path absolute.
+#[test]
+fn windows_style_escaping_uris_are_refused_on_every_platform() {
+    let (root, asset, _) = layout("escape-windows");
+    for (uri, says) in [
+        ("..\\outside.bin", "outside the asset's folder"),
+        ("..%5Coutside.bin", "outside the asset's folder"),
+        ("sub\\..\\..\\outside.bin", "outside the asset's folder"),
+        ("C:\\outside.bin", "absolute path"),
+        ("C:/outside.bin", "absolute path"),
+        ("\\\\server\\share\\outside.bin", "absolute path"),
+    ] {
+        let (scene, _) = scene_with_uri(&asset, uri);
+        let (code, out) = splatgl(&["info", scene.to_str().unwrap()]);
+        assert_eq!(code, 2, "{uri}: {out}");
+        assert!(
+            out.contains("buffers[0].uri") && out.contains(says),
+            "{uri}: {out}"
+        );
+    }
+    std::fs::remove_dir_all(&root).ok();
+}
+
 #[cfg(unix)]
 #[test]
 fn symlinks_are_followed_before_the_containment_check() {
