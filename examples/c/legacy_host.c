@@ -14,15 +14,25 @@
  *      -Ltarget/debug -lsplatgl_capi -lEGL -lGL -lm -Wl,-rpath,$PWD/target/debug -o legacy_host
  *   ./legacy_host wall.ply     (crates/splatgl-capi/tests/it/capi_hosts.rs writes the splat wall this expects)
  *
+ * On Windows (wgl_headless.h instead of egl_headless.h; scripts/windows/run.sh cross-builds it
+ * with mingw-w64 and runs it under Wine):
+ *   x86_64-w64-mingw32-gcc -std=c99 -Wall -Wextra -Werror -Icrates/splatgl-capi/include \
+ *      -Iexamples/c examples/c/legacy_host.c -L<dir of splatgl.dll> -lsplatgl -lopengl32 -lgdi32 \
+ *      -o legacy_host.exe
+ *
  * Exit status 0 when every check passes; each failure is printed.
  */
-#include <GL/gl.h>
-#include <GL/glext.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef _WIN32
+#include "wgl_headless.h" /* before GL/gl.h, which needs windows.h there */
+#else
 #include "egl_headless.h"
+#endif
+#include <GL/gl.h>
+#include <GL/glext.h>
 #include "host_math.h"
 #include "splatgl.h"
 
@@ -41,7 +51,7 @@ static PFNGLGENBUFFERSPROC p_glGenBuffers;
 static PFNGLBINDBUFFERPROC p_glBindBuffer;
 static PFNGLBUFFERDATAPROC p_glBufferData;
 
-#define LOAD(name) (*(void **)&p_##name = eglGetProcAddress(#name)) == NULL
+#define LOAD(name) (*(void **)&p_##name = headless_get_proc(#name, NULL)) == NULL
 
 static int load_gl(void) {
     if (LOAD(glGenFramebuffers) || LOAD(glBindFramebuffer) || LOAD(glFramebufferRenderbuffer) ||
@@ -55,7 +65,7 @@ static int load_gl(void) {
 }
 
 /* One piece of host state and how to read it. */
-enum kind { ENABLED, INTEGER, FLOAT };
+enum kind { READ_ENABLED, READ_INTEGER, READ_FLOAT };
 typedef struct {
     const char *name;
     GLenum pname;
@@ -64,52 +74,52 @@ typedef struct {
 } piece;
 
 static const piece PIECES[] = {
-    {"GL_LIGHTING", GL_LIGHTING, ENABLED, 1},
-    {"GL_LIGHT0", GL_LIGHT0, ENABLED, 1},
-    {"GL_COLOR_MATERIAL", GL_COLOR_MATERIAL, ENABLED, 1},
-    {"GL_NORMALIZE", GL_NORMALIZE, ENABLED, 1},
-    {"GL_DEPTH_TEST", GL_DEPTH_TEST, ENABLED, 1},
-    {"GL_BLEND", GL_BLEND, ENABLED, 1},
-    {"GL_CULL_FACE", GL_CULL_FACE, ENABLED, 1},
-    {"GL_SCISSOR_TEST", GL_SCISSOR_TEST, ENABLED, 1},
-    {"GL_TEXTURE_2D", GL_TEXTURE_2D, ENABLED, 1},
-    {"GL_ALPHA_TEST", GL_ALPHA_TEST, ENABLED, 1},
-    {"GL_VERTEX_ARRAY", GL_VERTEX_ARRAY, ENABLED, 1},
-    {"GL_NORMAL_ARRAY", GL_NORMAL_ARRAY, ENABLED, 1},
-    {"GL_DEPTH_FUNC", GL_DEPTH_FUNC, INTEGER, 1},
-    {"GL_DEPTH_WRITEMASK", GL_DEPTH_WRITEMASK, INTEGER, 1},
-    {"GL_BLEND_SRC_RGB", GL_BLEND_SRC_RGB, INTEGER, 1},
-    {"GL_BLEND_DST_RGB", GL_BLEND_DST_RGB, INTEGER, 1},
-    {"GL_BLEND_SRC_ALPHA", GL_BLEND_SRC_ALPHA, INTEGER, 1},
-    {"GL_BLEND_DST_ALPHA", GL_BLEND_DST_ALPHA, INTEGER, 1},
-    {"GL_BLEND_EQUATION_RGB", GL_BLEND_EQUATION_RGB, INTEGER, 1},
-    {"GL_CULL_FACE_MODE", GL_CULL_FACE_MODE, INTEGER, 1},
-    {"GL_FRONT_FACE", GL_FRONT_FACE, INTEGER, 1},
-    {"GL_SHADE_MODEL", GL_SHADE_MODEL, INTEGER, 1},
-    {"GL_MATRIX_MODE", GL_MATRIX_MODE, INTEGER, 1},
-    {"GL_VIEWPORT", GL_VIEWPORT, INTEGER, 4},
-    {"GL_SCISSOR_BOX", GL_SCISSOR_BOX, INTEGER, 4},
-    {"GL_COLOR_WRITEMASK", GL_COLOR_WRITEMASK, INTEGER, 4},
-    {"GL_POLYGON_MODE", GL_POLYGON_MODE, INTEGER, 2},
-    {"GL_CURRENT_PROGRAM", GL_CURRENT_PROGRAM, INTEGER, 1},
-    {"GL_ARRAY_BUFFER_BINDING", GL_ARRAY_BUFFER_BINDING, INTEGER, 1},
-    {"GL_ELEMENT_ARRAY_BUFFER_BINDING", GL_ELEMENT_ARRAY_BUFFER_BINDING, INTEGER, 1},
-    {"GL_VERTEX_ARRAY_BINDING", GL_VERTEX_ARRAY_BINDING, INTEGER, 1},
-    {"GL_ACTIVE_TEXTURE", GL_ACTIVE_TEXTURE, INTEGER, 1},
-    {"GL_TEXTURE_BINDING_2D", GL_TEXTURE_BINDING_2D, INTEGER, 1},
-    {"GL_DRAW_FRAMEBUFFER_BINDING", GL_DRAW_FRAMEBUFFER_BINDING, INTEGER, 1},
-    {"GL_RENDERBUFFER_BINDING", GL_RENDERBUFFER_BINDING, INTEGER, 1},
-    {"GL_UNPACK_ALIGNMENT", GL_UNPACK_ALIGNMENT, INTEGER, 1},
-    {"GL_PACK_ALIGNMENT", GL_PACK_ALIGNMENT, INTEGER, 1},
-    {"GL_VERTEX_ARRAY_SIZE", GL_VERTEX_ARRAY_SIZE, INTEGER, 1},
-    {"GL_VERTEX_ARRAY_STRIDE", GL_VERTEX_ARRAY_STRIDE, INTEGER, 1},
-    {"GL_CURRENT_COLOR", GL_CURRENT_COLOR, FLOAT, 4},
-    {"GL_CURRENT_NORMAL", GL_CURRENT_NORMAL, FLOAT, 3},
-    {"GL_COLOR_CLEAR_VALUE", GL_COLOR_CLEAR_VALUE, FLOAT, 4},
-    {"GL_DEPTH_CLEAR_VALUE", GL_DEPTH_CLEAR_VALUE, FLOAT, 1},
-    {"GL_MODELVIEW_MATRIX", GL_MODELVIEW_MATRIX, FLOAT, 16},
-    {"GL_PROJECTION_MATRIX", GL_PROJECTION_MATRIX, FLOAT, 16},
-    {"GL_LINE_WIDTH", GL_LINE_WIDTH, FLOAT, 1},
+    {"GL_LIGHTING", GL_LIGHTING, READ_ENABLED, 1},
+    {"GL_LIGHT0", GL_LIGHT0, READ_ENABLED, 1},
+    {"GL_COLOR_MATERIAL", GL_COLOR_MATERIAL, READ_ENABLED, 1},
+    {"GL_NORMALIZE", GL_NORMALIZE, READ_ENABLED, 1},
+    {"GL_DEPTH_TEST", GL_DEPTH_TEST, READ_ENABLED, 1},
+    {"GL_BLEND", GL_BLEND, READ_ENABLED, 1},
+    {"GL_CULL_FACE", GL_CULL_FACE, READ_ENABLED, 1},
+    {"GL_SCISSOR_TEST", GL_SCISSOR_TEST, READ_ENABLED, 1},
+    {"GL_TEXTURE_2D", GL_TEXTURE_2D, READ_ENABLED, 1},
+    {"GL_ALPHA_TEST", GL_ALPHA_TEST, READ_ENABLED, 1},
+    {"GL_VERTEX_ARRAY", GL_VERTEX_ARRAY, READ_ENABLED, 1},
+    {"GL_NORMAL_ARRAY", GL_NORMAL_ARRAY, READ_ENABLED, 1},
+    {"GL_DEPTH_FUNC", GL_DEPTH_FUNC, READ_INTEGER, 1},
+    {"GL_DEPTH_WRITEMASK", GL_DEPTH_WRITEMASK, READ_INTEGER, 1},
+    {"GL_BLEND_SRC_RGB", GL_BLEND_SRC_RGB, READ_INTEGER, 1},
+    {"GL_BLEND_DST_RGB", GL_BLEND_DST_RGB, READ_INTEGER, 1},
+    {"GL_BLEND_SRC_ALPHA", GL_BLEND_SRC_ALPHA, READ_INTEGER, 1},
+    {"GL_BLEND_DST_ALPHA", GL_BLEND_DST_ALPHA, READ_INTEGER, 1},
+    {"GL_BLEND_EQUATION_RGB", GL_BLEND_EQUATION_RGB, READ_INTEGER, 1},
+    {"GL_CULL_FACE_MODE", GL_CULL_FACE_MODE, READ_INTEGER, 1},
+    {"GL_FRONT_FACE", GL_FRONT_FACE, READ_INTEGER, 1},
+    {"GL_SHADE_MODEL", GL_SHADE_MODEL, READ_INTEGER, 1},
+    {"GL_MATRIX_MODE", GL_MATRIX_MODE, READ_INTEGER, 1},
+    {"GL_VIEWPORT", GL_VIEWPORT, READ_INTEGER, 4},
+    {"GL_SCISSOR_BOX", GL_SCISSOR_BOX, READ_INTEGER, 4},
+    {"GL_COLOR_WRITEMASK", GL_COLOR_WRITEMASK, READ_INTEGER, 4},
+    {"GL_POLYGON_MODE", GL_POLYGON_MODE, READ_INTEGER, 2},
+    {"GL_CURRENT_PROGRAM", GL_CURRENT_PROGRAM, READ_INTEGER, 1},
+    {"GL_ARRAY_BUFFER_BINDING", GL_ARRAY_BUFFER_BINDING, READ_INTEGER, 1},
+    {"GL_ELEMENT_ARRAY_BUFFER_BINDING", GL_ELEMENT_ARRAY_BUFFER_BINDING, READ_INTEGER, 1},
+    {"GL_VERTEX_ARRAY_BINDING", GL_VERTEX_ARRAY_BINDING, READ_INTEGER, 1},
+    {"GL_ACTIVE_TEXTURE", GL_ACTIVE_TEXTURE, READ_INTEGER, 1},
+    {"GL_TEXTURE_BINDING_2D", GL_TEXTURE_BINDING_2D, READ_INTEGER, 1},
+    {"GL_DRAW_FRAMEBUFFER_BINDING", GL_DRAW_FRAMEBUFFER_BINDING, READ_INTEGER, 1},
+    {"GL_RENDERBUFFER_BINDING", GL_RENDERBUFFER_BINDING, READ_INTEGER, 1},
+    {"GL_UNPACK_ALIGNMENT", GL_UNPACK_ALIGNMENT, READ_INTEGER, 1},
+    {"GL_PACK_ALIGNMENT", GL_PACK_ALIGNMENT, READ_INTEGER, 1},
+    {"GL_VERTEX_ARRAY_SIZE", GL_VERTEX_ARRAY_SIZE, READ_INTEGER, 1},
+    {"GL_VERTEX_ARRAY_STRIDE", GL_VERTEX_ARRAY_STRIDE, READ_INTEGER, 1},
+    {"GL_CURRENT_COLOR", GL_CURRENT_COLOR, READ_FLOAT, 4},
+    {"GL_CURRENT_NORMAL", GL_CURRENT_NORMAL, READ_FLOAT, 3},
+    {"GL_COLOR_CLEAR_VALUE", GL_COLOR_CLEAR_VALUE, READ_FLOAT, 4},
+    {"GL_DEPTH_CLEAR_VALUE", GL_DEPTH_CLEAR_VALUE, READ_FLOAT, 1},
+    {"GL_MODELVIEW_MATRIX", GL_MODELVIEW_MATRIX, READ_FLOAT, 16},
+    {"GL_PROJECTION_MATRIX", GL_PROJECTION_MATRIX, READ_FLOAT, 16},
+    {"GL_LINE_WIDTH", GL_LINE_WIDTH, READ_FLOAT, 1},
 };
 #define NPIECES (sizeof PIECES / sizeof PIECES[0])
 
@@ -125,14 +135,14 @@ static void read_state(snapshot *s) {
         GLint ints[16] = {0};
         int k;
         switch (p->kind) {
-        case ENABLED:
+        case READ_ENABLED:
             s->v[i][0] = (float)glIsEnabled(p->pname);
             break;
-        case INTEGER:
+        case READ_INTEGER:
             glGetIntegerv(p->pname, ints);
             for (k = 0; k < p->count; k++) s->v[i][k] = (float)ints[k];
             break;
-        case FLOAT:
+        case READ_FLOAT:
             glGetFloatv(p->pname, s->v[i]);
             break;
         }
