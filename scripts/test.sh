@@ -7,11 +7,15 @@
 #   python: the Python package (crates/splatgl-python) installed into a venv under the target
 #         folder with `pip install .` (maturin, the dev profile: the fast lane's dependencies
 #         are reused), then its pytest suite (python/tests) against the command;
-#   slow: the cross-checks that drive a browser or an X server: the engines graded in headless
-#         Chromium (GaussianSplats3D, Spark, CesiumJS, PlayCanvas, Babylon.js), splat-transform's
-#         streamed SOG and glTF, and the viewer under Xvfb.
-# `scripts/test.sh fast`, `python` or `slow` runs one lane (python after fast: it uses the
-# command fast builds). Tests that cannot run here (no
+#   platforms: the other platforms (docs/platforms.md): clippy with warnings as errors for
+#         Windows (x86_64-pc-windows-gnu) and both macOS targets (which can only be checked
+#         here), and the Windows build staged by scripts/windows/build.sh (mingw-w64);
+#   slow: the cross-checks that drive a browser, an X server or Wine: the engines graded in
+#         headless Chromium (GaussianSplats3D, Spark, CesiumJS, PlayCanvas, Babylon.js),
+#         splat-transform's streamed SOG and glTF, the viewer under Xvfb, and the Windows build
+#         under Wine (splatgl.exe render and view, the C legacy host against splatgl.dll).
+# `scripts/test.sh fast`, `python`, `platforms` or `slow` runs one lane (python after fast: it
+# uses the command fast builds; slow after platforms: it runs the Windows build). Tests that cannot run here (no
 # EGL, no real data, no npm tool) are listed at the end; with SPLATGL_REQUIRE=all (.ci/run sets
 # it) each of them fails instead.
 set -euo pipefail
@@ -24,7 +28,7 @@ skipped="$target/tmp/skipped-tests.txt"
 # the test harness, each a module path prefix.
 slow=(conformance_third_party:: conformance_cesium:: conformance_playcanvas:: conformance_babylon:: tiles_cesium::
   tiles_streamed_sog::
-  splat_transform_gltf:: viewer:: viewer_panel::)
+  splat_transform_gltf:: viewer:: viewer_panel:: windows::)
 skip_slow=()
 for m in "${slow[@]}"; do skip_slow+=(--skip "$m"); done
 
@@ -56,6 +60,15 @@ python() {
   SPLATGL_BIN="$target/debug/splatgl" "$venv/bin/python" -m pytest -q python/tests
 }
 
+platforms() {
+  # Library, CLI (with the viewer and http), C API.
+  local t
+  for t in x86_64-pc-windows-gnu aarch64-apple-darwin x86_64-apple-darwin; do
+    cargo clippy --locked --target "$t" -p splatgl-cli -p splatgl-capi -- -D warnings
+  done
+  ./scripts/windows/build.sh
+}
+
 slow() {
   # The fast lane's feature resolution (--workspace), so nothing is built again.
   cargo test --workspace --all-features --locked --test it -- "${slow[@]}"
@@ -75,8 +88,9 @@ case "$lane" in
   fast) run_lane fast ;;
   slow) run_lane slow ;;
   python) run_lane python ;;
-  all) run_lane fast; run_lane python; run_lane slow ;;
-  *) echo "usage: scripts/test.sh [fast|python|slow|all]" >&2; exit 2 ;;
+  platforms) run_lane platforms ;;
+  all) run_lane fast; run_lane python; run_lane platforms; run_lane slow ;;
+  *) echo "usage: scripts/test.sh [fast|python|platforms|slow|all]" >&2; exit 2 ;;
 esac
 if [ -s "$skipped" ]; then
   echo "skipped tests (what they need is missing here; SPLATGL_REQUIRE=all makes these failures):"

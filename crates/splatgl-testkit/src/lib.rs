@@ -179,3 +179,23 @@ pub fn fresh_dir(kind: &str, name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// The splat wall the C legacy host (`examples/c/legacy_host.c`) expects, as an INRIA PLY
+/// written to `path`: opaque splats at z = 0 over x ∈ [−1, 1], y ∈ [−0.6, 0.6].
+pub fn write_legacy_host_wall(path: &Path) {
+    let mut cloud = splatgl::SplatCloud::new(0);
+    for j in 0..16 {
+        for i in 0..24 {
+            let (x, y) = (-1.0 + 2.0 * i as f32 / 23.0, -0.6 + 1.2 * j as f32 / 15.0);
+            let dc = [1.2, -0.4, 0.8];
+            cloud.push(
+                [x, y, 0.0],
+                [0.05, 0.05, 0.01],
+                [0.0, 0.0, 0.0, 1.0],
+                0.95,
+                &[dc],
+            );
+        }
+    }
+    std::fs::write(path, splatgl::write::to_inria_ply(&cloud)).unwrap();
+}

@@ -12,8 +12,6 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use splatgl::SplatCloud;
-
 fn root() -> PathBuf {
     common::root()
 }
@@ -136,25 +134,10 @@ fn run(exe: &Path, args: &[&Path]) -> String {
     text
 }
 
-/// The splat wall `legacy_host.c` expects: opaque splats at z = 0 over x ∈ [−1, 1],
-/// y ∈ [−0.6, 0.6], written as an INRIA PLY.
+/// The splat wall `legacy_host.c` expects (`write_legacy_host_wall`).
 fn wall_ply() -> PathBuf {
-    let mut cloud = SplatCloud::new(0);
-    for j in 0..16 {
-        for i in 0..24 {
-            let (x, y) = (-1.0 + 2.0 * i as f32 / 23.0, -0.6 + 1.2 * j as f32 / 15.0);
-            let dc = [1.2, -0.4, 0.8];
-            cloud.push(
-                [x, y, 0.0],
-                [0.05, 0.05, 0.01],
-                [0.0, 0.0, 0.0, 1.0],
-                0.95,
-                &[dc],
-            );
-        }
-    }
     let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("capi-wall.ply");
-    std::fs::write(&path, splatgl::write::to_inria_ply(&cloud)).unwrap();
+    common::write_legacy_host_wall(&path);
     path
 }
 

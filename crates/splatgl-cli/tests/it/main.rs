@@ -40,4 +40,6 @@ mod tiles_streamed_sog;
 mod viewer;
 #[cfg(feature = "viewer")]
 mod viewer_panel;
+#[cfg(feature = "viewer")]
+mod windows;
 mod writers;

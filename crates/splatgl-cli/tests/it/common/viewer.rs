@@ -192,9 +192,14 @@ pub struct Viewer {
 impl Viewer {
     pub fn start(x: &X, cwd: &Path, args: &[&str]) -> Self {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_splatgl"));
-        cmd.arg("view")
-            .args(args)
-            .current_dir(cwd)
+        cmd.arg("view").args(args);
+        Self::start_command(x, cwd, cmd)
+    }
+
+    /// A viewer started by `cmd` (the `view` command and its options already given: e.g.
+    /// `splatgl.exe view` under Wine).
+    pub fn start_command(x: &X, cwd: &Path, mut cmd: Command) -> Self {
+        cmd.current_dir(cwd)
             .env("WINIT_X11_SCALE_FACTOR", "1")
             .env("SPLATGL_VIEWER_LAYOUT", "1")
             .stdout(Stdio::piped())
