@@ -65,6 +65,12 @@ fn big_endian_and_ascii_match_little_endian() {
         ascii += "\n";
     }
     assert!(load(ascii.as_bytes()) == want, "ASCII differs");
+    // Written on Windows: CRLF line ends in the header and the body.
+    let crlf = ascii.replace('\n', "\r\n");
+    assert!(
+        load(crlf.as_bytes()) == want,
+        "ASCII with CRLF line ends differs"
+    );
 }
 
 #[test]

@@ -198,3 +198,46 @@ fn windows_refuses_a_gltf_whose_uri_escapes_with_backslashes() {
         );
     }
 }
+
+/// Windows file semantics: a second render replaces the first output (the atomic write's
+/// rename onto an existing file), and `-o -` writes the PNG's bytes to standard output
+/// unchanged (no text-mode line-end translation).
+#[test]
+fn windows_output_replaces_an_existing_file_and_stdout_is_binary() {
+    let Some(dir) = staged() else { return };
+    let tmp = common::fresh_dir("windows", "output");
+    let out = tmp.join("out.png");
+    let _x_lock = viewer::X_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let x = viewer::x_server();
+    let exe = dir.join("splatgl.exe");
+    let out_w = win(&out);
+    let render = |width: &str, o: &str| {
+        let args = [
+            "render",
+            "--backend",
+            "reference",
+            "--width",
+            width,
+            "--height",
+            "24",
+            "-f",
+            "-o",
+            o,
+        ];
+        run(&mut wine_command(&x, &exe, &args))
+    };
+    std::fs::write(&out, b"an older file").unwrap();
+    for width in ["32", "40"] {
+        let (o, text) = render(width, &out_w);
+        assert!(o.status.success(), "{text}");
+        let img = Image::read(&out).unwrap_or_else(|e| panic!("{e}: {text}"));
+        assert_eq!(img.width.to_string(), width, "the output was not replaced");
+    }
+    let (o, text) = render("40", "-");
+    assert!(o.status.success(), "{text}");
+    assert_eq!(
+        o.stdout,
+        std::fs::read(&out).unwrap(),
+        "-o - differs from the file"
+    );
+}
