@@ -67,6 +67,8 @@ platforms() {
     cargo clippy --locked --target "$t" -p splatgl-cli -p splatgl-capi -- -D warnings
   done
   ./scripts/windows/build.sh
+  # The release archives' layout, from the dev builds above (scripts/dist.sh checks them).
+  ./scripts/dist.sh --dev
 }
 
 slow() {
