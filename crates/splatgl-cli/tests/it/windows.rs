@@ -241,3 +241,26 @@ fn windows_output_replaces_an_existing_file_and_stdout_is_binary() {
         "-o - differs from the file"
     );
 }
+
+/// `O` in the viewer opens Windows' common Open dialog; a path typed there is loaded.
+#[test]
+fn windows_viewer_opens_the_file_chosen_in_the_open_dialog() {
+    let Some(dir) = staged() else { return };
+    let Some(scene) = common::real("jsplat_unitCube-ascii.ply") else {
+        return;
+    };
+    let _x_lock = viewer::X_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let cwd = viewer::dir("windows-dialog");
+    let x = viewer::x_server();
+    let args = [&["view", "--no-ui"][..], &CAMERA].concat();
+    let mut v = Viewer::start_command(&x, &cwd, wine_command(&x, &dir.join("splatgl.exe"), &args));
+    v.key("o");
+    let ids = v.xdo(&["search", "--sync", "--name", "^Open a splat file"]);
+    let dialog = ids.lines().next().expect("the Open dialog").to_owned();
+    v.xdo(&["windowfocus", "--sync", &dialog]);
+    v.xdo(&["type", "--delay", "20", &win(&scene)]);
+    v.xdo(&["key", "Return"]);
+    let line = v.expect(|l| l.starts_with("loaded: jsplat_unitCube-ascii.ply"));
+    assert!(line.contains("20 splats"), "{line}");
+    v.quit();
+}

@@ -200,8 +200,9 @@ impl App {
         }
     }
 
-    /// `O`: asks for a file with zenity or kdialog when installed, else reads a path typed on
-    /// stdin; the answer arrives as [`UserEvent::Open`]. One question at a time.
+    /// `O`: asks for a file (the platform's dialog: on Linux zenity or kdialog when installed,
+    /// else a path typed on stdin; the common Open dialog on Windows; `choose file` on macOS);
+    /// the answer arrives as [`UserEvent::Open`]. One question at a time.
     pub(super) fn open_dialog(&self) {
         if self.dialog_open.swap(true, Ordering::SeqCst) {
             return;
@@ -225,12 +226,14 @@ impl App {
 }
 
 /// Whether `name` is an executable on `PATH`.
+#[cfg(all(unix, not(target_os = "macos")))]
 fn on_path(name: &str) -> bool {
     std::env::var_os("PATH")
         .is_some_and(|paths| std::env::split_paths(&paths).any(|d| d.join(name).is_file()))
 }
 
-/// The file dialog: zenity, kdialog, or a line typed on stdin.
+/// The file dialog on Linux and the other Unixes: zenity, kdialog, or a line typed on stdin.
+#[cfg(all(unix, not(target_os = "macos")))]
 fn ask_for_file() -> Option<PathBuf> {
     let dialog = [
         (
@@ -241,18 +244,69 @@ fn ask_for_file() -> Option<PathBuf> {
     ]
     .into_iter()
     .find(|(exe, _)| on_path(exe));
-    let answer = match dialog {
-        Some((exe, args)) => {
-            let out = std::process::Command::new(exe).args(args).output().ok()?;
-            String::from_utf8_lossy(&out.stdout).into_owned()
-        }
+    match dialog {
+        Some((exe, args)) => answer_of(exe, args),
         None => {
             println!("open: type a file path and press Enter");
             let mut line = String::new();
             std::io::stdin().read_line(&mut line).ok()?;
-            line
+            non_empty(&line)
         }
+    }
+}
+
+/// The file dialog on macOS: the system's own, through AppleScript's `choose file`.
+#[cfg(target_os = "macos")]
+fn ask_for_file() -> Option<PathBuf> {
+    answer_of(
+        "osascript",
+        &[
+            "-e",
+            "POSIX path of (choose file with prompt \"Open a splat file\")",
+        ],
+    )
+}
+
+/// The file dialog on Windows: the common Open dialog (`GetOpenFileNameW`).
+#[cfg(windows)]
+fn ask_for_file() -> Option<PathBuf> {
+    use std::os::windows::ffi::OsStringExt;
+    use windows_sys::Win32::UI::Controls::Dialogs::{
+        GetOpenFileNameW, OFN_FILEMUSTEXIST, OFN_NOCHANGEDIR, OFN_PATHMUSTEXIST, OPENFILENAMEW,
     };
+    let wide = |s: &str| s.encode_utf16().collect::<Vec<u16>>();
+    // Pairs of (label, patterns), each NUL-terminated, the list ending in a second NUL.
+    let filter = wide(
+        "Splat files\0*.glb;*.gltf;*.ply;*.spz;*.splat;*.ksplat;*.sog;*.json\0All files\0*.*\0\0",
+    );
+    let title = wide("Open a splat file\0");
+    let mut file = vec![0u16; 32 * 1024];
+    // SAFETY: every pointer in the struct points at a live buffer of the stated size; the
+    // rest is zero (no owner window, no hook).
+    let chosen = unsafe {
+        let mut ofn: OPENFILENAMEW = std::mem::zeroed();
+        ofn.lStructSize = size_of::<OPENFILENAMEW>() as u32;
+        ofn.lpstrFilter = filter.as_ptr();
+        ofn.lpstrFile = file.as_mut_ptr();
+        ofn.nMaxFile = file.len() as u32;
+        ofn.lpstrTitle = title.as_ptr();
+        ofn.Flags = OFN_FILEMUSTEXIST | OFN_PATHMUSTEXIST | OFN_NOCHANGEDIR;
+        GetOpenFileNameW(&mut ofn) != 0
+    };
+    let len = file.iter().position(|&c| c == 0).unwrap_or(file.len());
+    (chosen && len > 0).then(|| PathBuf::from(std::ffi::OsString::from_wide(&file[..len])))
+}
+
+/// What a dialog program printed on stdout (the chosen path), if anything.
+#[cfg(unix)]
+fn answer_of(exe: &str, args: &[&str]) -> Option<PathBuf> {
+    let out = std::process::Command::new(exe).args(args).output().ok()?;
+    non_empty(&String::from_utf8_lossy(&out.stdout))
+}
+
+/// A path typed or printed, trimmed; `None` when empty (the question was cancelled).
+#[cfg(unix)]
+fn non_empty(answer: &str) -> Option<PathBuf> {
     let p = answer.trim();
     (!p.is_empty()).then(|| PathBuf::from(p))
 }
