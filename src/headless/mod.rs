@@ -1,29 +1,35 @@
 //! Headless rendering (feature `gl`): through EGL on Mesa's surfaceless platform on Linux and
-//! the other Unixes, through WGL with a hidden window on Windows.
+//! the other Unixes, through WGL with a hidden window on Windows, through CGL on macOS.
 //!
 //! * [`render`] — one call: cloud + camera + options → [`Image`]. This is what a CLI
 //!   `--backend gl` calls.
 //! * [`HeadlessRenderer`] — the same, keeping the context, the uploaded cloud and the
 //!   framebuffers between renders (tests, benchmarks, many views of one cloud).
-//! * [`HeadlessContext`] — just the EGL context and its [`glow::Context`], for driving
+//! * [`HeadlessContext`] — just the context (EGL, WGL or CGL) and its [`glow::Context`], for driving
 //!   [`crate::gl`] yourself (e.g. with a [`ReadbackTarget`](crate::gl::ReadbackTarget)).
 //!
 //! The EGL library is loaded at run time (`libEGL.so.1`); when it is missing or no display can
 //! be initialised the error is [`HeadlessError::EglUnavailable`], which callers (and the test
 //! suite) may treat as "no GL here". Every other failure is a real error.
 //!
+//! On macOS it is made by CGL with no drawable (desktop core profiles only: a GLES 3 request
+//! gets 4.1 core); a failure is [`HeadlessError::CglUnavailable`].
 //! On Windows the context is made by WGL on a hidden window of its own (render into framebuffer
 //! objects as on EGL); a failure to make one is [`HeadlessError::WglUnavailable`].
 //!
 //! Contexts are current on the thread that created them and are not `Send`.
 
-#[cfg(not(windows))]
+#[cfg(target_os = "macos")]
+mod cgl;
+#[cfg(not(any(windows, target_os = "macos")))]
 mod egl;
 mod renderer;
 #[cfg(windows)]
 mod wgl;
 
-#[cfg(not(windows))]
+#[cfg(target_os = "macos")]
+pub use cgl::HeadlessContext;
+#[cfg(not(any(windows, target_os = "macos")))]
 pub use egl::HeadlessContext;
 pub use renderer::{HeadlessOptions, HeadlessRenderer, TargetKind};
 #[cfg(windows)]
@@ -60,6 +66,18 @@ pub enum HeadlessError {
         call: &'static str,
         /// `GetLastError()` right after it.
         code: u32,
+    },
+    /// CGL could not give a context here (macOS: OpenGL.framework missing, or a profile macOS
+    /// does not offer). The macOS counterpart of [`HeadlessError::EglUnavailable`].
+    #[error("CGL unavailable: {0}")]
+    CglUnavailable(String),
+    /// A CGL call failed (`code`: its `CGLError`).
+    #[error("CGL call {call} failed (error {code})")]
+    Cgl {
+        /// The failing call.
+        call: &'static str,
+        /// The `CGLError` it returned.
+        code: i32,
     },
     /// The GL layer failed.
     #[error(transparent)]
