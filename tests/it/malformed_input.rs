@@ -586,6 +586,7 @@ fn repeated_scene_roots_and_instance_bombs_are_errors() {
     assert!(e.contains("budget") || e.contains("justify"), "{e}");
 }
 
+#[cfg(unix)] // a Unix device
 #[test]
 fn external_buffer_must_be_a_regular_file() {
     let dir = std::env::temp_dir().join(format!("splatgl-hostile-{}", std::process::id()));
@@ -978,6 +979,7 @@ fn sog_corpus() {
     );
 }
 
+#[cfg(unix)] // the symlink case
 #[test]
 fn unbundled_sog_rejects_paths_outside_its_folder() {
     let root = std::env::temp_dir().join(format!("splatgl-sogbad-{}", std::process::id()));
