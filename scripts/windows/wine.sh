@@ -21,7 +21,8 @@ if [ ! -f "$sys32/bcryptprimitives.dll" ]; then
   exec 9>"$target_dir/wineprefix.lock"
   flock 9
   if [ ! -f "$sys32/bcryptprimitives.dll" ]; then
-    wine64 wineboot -i >/dev/null 2>&1
+    # No Mono or Gecko: their install prompts would wait for a click.
+    WINEDLLOVERRIDES="mscoree=;mshtml=" wine64 wineboot -i >/dev/null 2>&1
     wineserver -w
     cp "$stub" "$sys32/bcryptprimitives.dll"
   fi
