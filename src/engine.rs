@@ -33,7 +33,7 @@ pub enum Engine {
     Reference,
     /// Headless GL: its context and renderer, with the cloud last uploaded, drawing into
     /// `target`.
-    #[cfg(feature = "gl")]
+    #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
     Gl {
         /// The context and renderer.
         renderer: Box<crate::headless::HeadlessRenderer>,
@@ -56,10 +56,12 @@ impl Engine {
     pub fn new(backend: Backend) -> Result<Self, String> {
         match backend {
             Backend::Reference => Ok(Engine::Reference),
-            #[cfg(feature = "gl")]
+            #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Backend::Gl => Self::gl(None),
             #[cfg(not(feature = "gl"))]
             Backend::Gl => Err("this splatgl was built without the `gl` feature".into()),
+            #[cfg(all(feature = "gl", target_arch = "wasm32"))]
+            Backend::Gl => Err("no headless GL in the browser: draw on a WebGL2 canvas".into()),
         }
     }
 
@@ -67,7 +69,7 @@ impl Engine {
     /// RGBA16F (floating-point blending, resolved to 8 bits) where the context can render to
     /// it (desktop GL; ES with `EXT_color_buffer_half_float` or `_float`), else RGBA8 with a
     /// warning ([`Engine::fallback`]).
-    #[cfg(feature = "gl")]
+    #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
     pub fn gl(target: Option<crate::headless::TargetKind>) -> Result<Self, String> {
         use crate::headless::TargetKind;
         let renderer = crate::headless::HeadlessRenderer::new().map_err(|e| e.to_string())?;
@@ -92,7 +94,7 @@ impl Engine {
     }
 
     /// The framebuffer a GL engine blends in (`None` for the reference).
-    #[cfg(feature = "gl")]
+    #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
     pub fn target(&self) -> Option<crate::headless::TargetKind> {
         match self {
             Engine::Reference => None,
@@ -105,7 +107,7 @@ impl Engine {
     pub fn fallback(&self) -> Option<&str> {
         match self {
             Engine::Reference => None,
-            #[cfg(feature = "gl")]
+            #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Engine::Gl { fallback, .. } => fallback.as_deref(),
         }
     }
@@ -114,7 +116,7 @@ impl Engine {
     pub fn backend(&self) -> Backend {
         match self {
             Engine::Reference => Backend::Reference,
-            #[cfg(feature = "gl")]
+            #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Engine::Gl { .. } => Backend::Gl,
         }
     }
@@ -131,7 +133,7 @@ impl Engine {
     pub fn describe(&self) -> Option<String> {
         match self {
             Engine::Reference => None,
-            #[cfg(feature = "gl")]
+            #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Engine::Gl { renderer, .. } => Some(renderer.context().describe()),
         }
     }
@@ -144,7 +146,7 @@ impl Engine {
                 let _ = cloud;
                 Ok(())
             }
-            #[cfg(feature = "gl")]
+            #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Engine::Gl { renderer, .. } => renderer.upload(cloud).map_err(|e| format!("GL: {e}")),
         }
     }
@@ -164,7 +166,7 @@ impl Engine {
                 let (img, stats) = crate::reference::render_display(cloud, camera, opts, space);
                 Ok((img, Some(stats.visible)))
             }
-            #[cfg(feature = "gl")]
+            #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Engine::Gl {
                 renderer, target, ..
             } => {

@@ -32,7 +32,7 @@ pub mod engine;
 pub mod files;
 #[cfg(feature = "gl")]
 pub mod gl;
-#[cfg(feature = "gl")]
+#[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
 pub mod headless;
 pub mod image;
 pub mod load;

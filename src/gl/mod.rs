@@ -39,6 +39,7 @@
 //! limits ([`GlError::Capacity`]; below them clouds larger than one texture are spread over
 //! array-texture layers), `GL_OUT_OF_MEMORY` ([`GlError::Gl`]).
 
+mod bound;
 mod caps;
 mod context;
 pub(crate) mod data;
@@ -72,7 +73,7 @@ pub(crate) use error::check_error;
 #[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use glsl::Errata;
-#[cfg(not(feature = "testing"))]
+#[cfg(all(not(feature = "testing"), not(target_arch = "wasm32")))]
 pub(crate) use glsl::Errata;
 pub use prepass::PREPASS_MIN_SPLATS;
 // Test and benchmark hooks (feature `testing`): host programs for the state tests, the draw
