@@ -163,11 +163,19 @@ impl FrameTargets {
             gl.clear_color(bg[0], bg[1], bg[2], alpha);
             gl.clear(glow::COLOR_BUFFER_BIT);
         }
+        // Where the float target resolves into: the staging target, else the window.
+        let into = self
+            .staging
+            .as_ref()
+            .filter(|_| staged)
+            .map(ReadbackTarget::framebuffer);
         let drawn = match self.float.as_mut().filter(|_| float) {
-            Some(t) => t.begin(gl, [bg[0], bg[1], bg[2], 0.0]).and_then(|()| {
-                renderer.draw_current_with(gl, camera, settings)?;
-                t.resolve(gl, linear)
-            }),
+            Some(t) => t
+                .begin_into(gl, [bg[0], bg[1], bg[2], 0.0], into)
+                .and_then(|()| {
+                    renderer.draw_current_with(gl, camera, settings)?;
+                    t.resolve(gl, linear)
+                }),
             None => renderer.draw_current_with(gl, camera, settings),
         };
         if switch {

@@ -12,6 +12,7 @@
 //! The records buffer holds as many records as splats were uploaded (68 bytes each), sized
 //! at upload; nothing is allocated per frame.
 
+use crate::gl::bound::Bound;
 use glow::HasContext;
 
 use super::GlError;
@@ -94,10 +95,10 @@ impl PrePass {
         // array, array buffer, transform-feedback object and generic transform-feedback
         // buffer back (queried first).
         unsafe {
-            let host_vao = gl.get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING);
-            let host_array = gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING);
-            let host_tf = gl.get_parameter_transform_feedback(glow::TRANSFORM_FEEDBACK_BINDING);
-            let host_tf_buffer = gl.get_parameter_buffer(glow::TRANSFORM_FEEDBACK_BUFFER_BINDING);
+            let host_vao = gl.bound_vertex_array(glow::VERTEX_ARRAY_BINDING);
+            let host_array = gl.bound_buffer(glow::ARRAY_BUFFER_BINDING);
+            let host_tf = gl.bound_transform_feedback(glow::TRANSFORM_FEEDBACK_BINDING);
+            let host_tf_buffer = gl.bound_buffer(glow::TRANSFORM_FEEDBACK_BUFFER_BINDING);
             gl.bind_vertex_array(Some(prep_vao));
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(order));
             gl.enable_vertex_attrib_array(0);
@@ -155,7 +156,7 @@ impl PrePass {
         let errors = super::error::ErrorScope::begin(gl)?;
         // SAFETY: (re)allocates the pre-pass's own buffer; rebinds the host's array buffer.
         unsafe {
-            let host = gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING);
+            let host = gl.bound_buffer(glow::ARRAY_BUFFER_BINDING);
             gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.records));
             gl.buffer_data_size(glow::ARRAY_BUFFER, bytes as i32, glow::DYNAMIC_COPY);
             gl.bind_buffer(glow::ARRAY_BUFFER, host);

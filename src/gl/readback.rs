@@ -5,6 +5,7 @@
 //! Used by the headless renderer, the benchmarks, the GL tests and `examples/embed.rs` (a
 //! host-owned context), and under [`super::OffscreenTarget`] (its `RGBA16F` accumulation).
 
+use crate::gl::bound::Bound;
 use glow::HasContext;
 
 use super::GlError;
@@ -113,7 +114,7 @@ impl ReadbackTarget {
                 gl.renderbuffer_storage(glow::RENDERBUFFER, internal, w, h);
                 gl.bind_renderbuffer(glow::RENDERBUFFER, None);
             }
-            let prev = gl.get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING);
+            let prev = gl.bound_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING);
             gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(fbo));
             let (target, attach) = (glow::DRAW_FRAMEBUFFER, glow::COLOR_ATTACHMENT0);
             gl.framebuffer_texture_2d(target, attach, glow::TEXTURE_2D, Some(color), 0);
@@ -216,7 +217,7 @@ impl ReadbackTarget {
         // `out`, which the callers size to exactly that (tight rows: PACK_ALIGNMENT 4 divides
         // the 4- and 16-byte pixels, row length and skips 0, no pack buffer bound).
         unsafe {
-            let prev = gl.get_parameter_framebuffer(glow::READ_FRAMEBUFFER_BINDING);
+            let prev = gl.bound_framebuffer(glow::READ_FRAMEBUFFER_BINDING);
             gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
             gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);

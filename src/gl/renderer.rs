@@ -1,6 +1,7 @@
 //! [`SplatRenderer`]: uploads clouds and draws them into the host's framebuffer. Its
 //! [`DrawSettings`] are in `settings.rs`, the draw calls themselves in `draw.rs`.
 
+use crate::gl::bound::Bound;
 use std::cell::Cell;
 
 use glam::Mat4;
@@ -471,7 +472,7 @@ impl SplatRenderer {
         // host's array buffer back (restore mode) or none.
         unsafe {
             let host = if self.settings.restore_state {
-                gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING)
+                gl.bound_buffer(glow::ARRAY_BUFFER_BINDING)
             } else {
                 None
             };

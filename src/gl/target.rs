@@ -8,6 +8,7 @@
 //! The resolve **replaces** the pixels of the viewport it restores (blending off): clear the
 //! target with the scene's background (`begin`), so the resolved image is final.
 
+use crate::gl::bound::Bound;
 use glow::HasContext;
 
 use super::GlError;
@@ -91,11 +92,25 @@ impl OffscreenTarget {
     /// the whole target and clears it to `clear` (premultiplied; use `(background, 0)`). Leaves
     /// the clear colour set to `clear`.
     pub fn begin(&mut self, gl: &glow::Context, clear: [f32; 4]) -> Result<(), GlError> {
+        // SAFETY: a state query.
+        let bound = unsafe { gl.bound_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING) };
+        self.begin_into(gl, clear, bound)
+    }
+
+    /// [`OffscreenTarget::begin`] with the framebuffer to resolve into given (`None`: the
+    /// default one) instead of queried: on the web, where bindings cannot be queried
+    /// ([`Bound`]), the frame knows it.
+    pub(crate) fn begin_into(
+        &mut self,
+        gl: &glow::Context,
+        clear: [f32; 4],
+        into: Option<glow::Framebuffer>,
+    ) -> Result<(), GlError> {
         self.pass.owned.check()?;
         let (w, h) = self.target.size();
-        // SAFETY: state queries and binding the target's own framebuffer.
+        // SAFETY: a state query and binding the target's own framebuffer.
         unsafe {
-            self.saved_fbo = gl.get_parameter_framebuffer(glow::DRAW_FRAMEBUFFER_BINDING);
+            self.saved_fbo = into;
             gl.get_parameter_i32_slice(glow::VIEWPORT, &mut self.saved_viewport);
             gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(self.target.framebuffer()));
             gl.viewport(0, 0, w as i32, h as i32);

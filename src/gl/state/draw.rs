@@ -1,6 +1,7 @@
 //! The state of one draw: set what the draw needs, and in restore mode query the host's values
 //! first and put back exactly what was changed (see the tables in [`super`]).
 
+use crate::gl::bound::Bound;
 use glow::HasContext;
 
 use super::{ALPHA_TEST, Contexts};
@@ -199,8 +200,8 @@ fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved 
     // the per-unit bindings (put back by `leave`).
     unsafe {
         let mut s = Saved {
-            program: c.q().get_parameter_program(glow::CURRENT_PROGRAM),
-            vao: c.q().get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING),
+            program: c.q().bound_program(glow::CURRENT_PROGRAM),
+            vao: c.q().bound_vertex_array(glow::VERTEX_ARRAY_BINDING),
             active_texture: c.int(glow::ACTIVE_TEXTURE),
             units: [(None, None); 2],
             caps: [None; CAPS.len()],
@@ -215,7 +216,7 @@ fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved 
         if ctx.tf_objects {
             s.transform_feedback = c
                 .q()
-                .get_parameter_transform_feedback(glow::TRANSFORM_FEEDBACK_BINDING);
+                .bound_transform_feedback(glow::TRANSFORM_FEEDBACK_BINDING);
         }
         for (k, (cap, contexts)) in CAPS.into_iter().enumerate() {
             if exists(contexts, ctx) {
@@ -245,8 +246,8 @@ fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved 
         }
         for unit in 0..2 {
             c.s().active_texture(glow::TEXTURE0 + unit as u32);
-            let tex = c.q().get_parameter_texture(glow::TEXTURE_BINDING_2D_ARRAY);
-            s.units[unit] = (tex, c.q().get_parameter_sampler(glow::SAMPLER_BINDING));
+            let tex = c.q().bound_texture(glow::TEXTURE_BINDING_2D_ARRAY);
+            s.units[unit] = (tex, c.q().bound_sampler(glow::SAMPLER_BINDING));
         }
         s
     }

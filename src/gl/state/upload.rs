@@ -1,6 +1,7 @@
 //! The bindings and pixel-unpack state `new` and `upload` change, captured first and put
 //! back when the guard drops (on every return path).
 
+use crate::gl::bound::Bound;
 use glow::HasContext;
 
 use crate::gl::context::ContextInfo;
@@ -31,7 +32,7 @@ pub(crate) struct Bindings<'gl> {
 impl<'gl> Bindings<'gl> {
     fn empty(gl: &'gl glow::Context) -> Self {
         // SAFETY: a binding query.
-        let array_buffer = unsafe { gl.get_parameter_buffer(glow::ARRAY_BUFFER_BINDING) };
+        let array_buffer = unsafe { gl.bound_buffer(glow::ARRAY_BUFFER_BINDING) };
         Bindings {
             gl,
             vertex_array: None,
@@ -46,7 +47,7 @@ impl<'gl> Bindings<'gl> {
     pub(crate) fn for_new(gl: &'gl glow::Context) -> Self {
         let mut b = Self::empty(gl);
         // SAFETY: a binding query.
-        b.vertex_array = Some(unsafe { gl.get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING) });
+        b.vertex_array = Some(unsafe { gl.bound_vertex_array(glow::VERTEX_ARRAY_BINDING) });
         b
     }
 
@@ -57,8 +58,8 @@ impl<'gl> Bindings<'gl> {
         let mut b = Self::empty(gl);
         // SAFETY: state queries, and unpack state set to valid values.
         unsafe {
-            b.texture_2d_array = Some(gl.get_parameter_texture(glow::TEXTURE_BINDING_2D_ARRAY));
-            let unpack_buffer = gl.get_parameter_buffer(glow::PIXEL_UNPACK_BUFFER_BINDING);
+            b.texture_2d_array = Some(gl.bound_texture(glow::TEXTURE_BINDING_2D_ARRAY));
+            let unpack_buffer = gl.bound_buffer(glow::PIXEL_UNPACK_BUFFER_BINDING);
             if unpack_buffer.is_some() {
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
                 b.unpack_buffer = Some(unpack_buffer);
