@@ -19,7 +19,9 @@ pub(crate) use injected;
 pub(crate) fn has_extension(gl: &glow::Context, name: &str) -> bool {
     use glow::HasContext;
     let missing = injected!((), |f| f.missing_extensions.contains(&name).then_some(())).is_some();
-    !missing && gl.supported_extensions().contains(name)
+    // WebGL names its extensions without the `GL_` prefix (`EXT_color_buffer_float`).
+    let set = gl.supported_extensions();
+    !missing && (set.contains(name) || name.strip_prefix("GL_").is_some_and(|n| set.contains(n)))
 }
 
 /// An integer limit (`GL_MAX_TEXTURE_SIZE`, `GL_MAX_ARRAY_TEXTURE_LAYERS`), as the GL layer

@@ -87,6 +87,11 @@ impl ContextInfo {
 /// `(is ES, major, minor)` of a `GL_VERSION` string: `"OpenGL ES 3.2 Mesa …"`,
 /// `"OpenGL ES-CM 1.1"`, `"4.5 (Core Profile) Mesa …"`, `"2.1 Mesa …"`.
 fn parse_version(s: &str) -> Option<(bool, u32, u32)> {
+    // WebGL N.m is OpenGL ES N+1.m (WebGL 2.0 = ES 3.0), as the WebGL spec defines it.
+    if let Some(r) = s.strip_prefix("WebGL ") {
+        let (_, major, minor) = parse_version(r)?;
+        return Some((true, major + 1, minor));
+    }
     let (es, rest) = match s.strip_prefix("OpenGL ES") {
         Some(r) => (true, r.trim_start_matches(|c| c != ' ').trim_start()),
         None => (false, s.trim_start()),
@@ -111,6 +116,8 @@ mod tests {
         let p = parse_version;
         assert_eq!(p("OpenGL ES 3.2 Mesa 22.3.6"), Some((true, 3, 2)));
         assert_eq!(p("OpenGL ES 3.0"), Some((true, 3, 0)));
+        assert_eq!(p("WebGL 2.0 (OpenGL ES 3.0 Chromium)"), Some((true, 3, 0)));
+        assert_eq!(p("WebGL 1.0 (OpenGL ES 2.0 Chromium)"), Some((true, 2, 0)));
         assert_eq!(p("OpenGL ES-CM 1.1 Mesa"), Some((true, 1, 1)));
         assert_eq!(
             p("4.5 (Compatibility Profile) Mesa 22.3.6"),

@@ -99,8 +99,9 @@ impl TextureLayout {
     /// The most splats of `per_splat` texels that fit (the shader's texel indices are `int`s:
     /// at most 2³¹ − 1 texels).
     pub(crate) fn capacity(&self, per_splat: usize) -> usize {
-        let texels = self.width() * self.layer_rows() * self.max_layers;
-        texels.min(i32::MAX as usize) / per_splat
+        // In u64: on 32-bit targets (wasm32) the product overflows usize.
+        let texels = self.width() as u64 * self.layer_rows() as u64 * self.max_layers as u64;
+        (texels.min(i32::MAX as u64) / per_splat.max(1) as u64) as usize
     }
 
     /// `(rows per layer, layers)` of a texture holding `n` splats of `per_splat` texels.
