@@ -104,9 +104,12 @@ impl SplatRenderer {
 
     /// Sorts the uploaded cloud back to front for `camera` drawn into a viewport of its own
     /// size — only the splats its frustum may see when `cull` (the same image) — and uploads
-    /// the order: what the headless renderer draws. Uses the positions and cull radii kept by
-    /// [`SplatRenderer::upload`].
-    pub(crate) fn sort_for_camera(
+    /// the order: what the headless renderer draws (and the web build's exact renders). Uses
+    /// the positions and cull radii kept by [`SplatRenderer::upload`].
+    ///
+    /// Errors: [`GlError::NotUploaded`] before an upload, and whatever uploading the order
+    /// reports.
+    pub fn sort_for_camera(
         &mut self,
         gl: &glow::Context,
         camera: &crate::camera::Camera,

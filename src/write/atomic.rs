@@ -112,9 +112,10 @@ pub fn write_atomic(
         }
         let mut w = BufWriter::new(file);
         fill(&mut w)?;
-        let file: File = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        drop(file);
+        {
+            let file: File = w.into_inner().map_err(|e| e.into_error())?;
+            file.sync_all()?;
+        } // closed before the rename (Windows cannot rename a file that is open)
         std::fs::rename(&tmp, path)
     })();
     result?;
