@@ -1,0 +1,370 @@
+//! splatgl in the browser: the library's loaders, cull, sort and GL backend over a WebGL2
+//! canvas, exported to JavaScript with `wasm-bindgen` (`web/splatgl.js` wraps it as
+//! `splatgl.create(canvas)`; `docs/web.md`).
+//!
+//! Everything here is `wasm32` only; natively the crate is empty. The sort runs on the page's
+//! thread: rayon's pool has no threads on `wasm32-unknown-unknown`, so the same radix sort
+//! runs single-threaded behind the same API (`FrameSort::Sync`, the default).
+#![cfg(target_arch = "wasm32")]
+
+use glam::{Mat4, Vec3};
+use glow::HasContext;
+use splatgl::SplatCloud;
+use splatgl::camera::{Camera, GltfPerspective, SceneView, ViewOptions};
+use splatgl::files::Format;
+use splatgl::gl::frame::{Blend, FrameTargets, Output};
+use splatgl::gl::{DrawSettings, SplatRenderer};
+use splatgl::image::PngDepth;
+use splatgl::load::{LoadOptions, load_bytes};
+use wasm_bindgen::JsCast;
+use wasm_bindgen::prelude::*;
+use web_sys::{HtmlCanvasElement, WebGl2RenderingContext};
+
+/// What the renderer holds of the loaded file besides the GPU copy: the cloud (for framing
+/// and the info), its glTF cameras and its format.
+struct Loaded {
+    cloud: SplatCloud,
+    cameras: Vec<GltfPerspective>,
+    format: Option<Format>,
+    name: String,
+}
+
+/// A splat renderer on a WebGL2 canvas.
+#[wasm_bindgen]
+pub struct Renderer {
+    gl: glow::Context,
+    renderer: SplatRenderer,
+    targets: FrameTargets,
+    loaded: Option<Loaded>,
+    view: Mat4,
+    projection: Mat4,
+    sh_degree: Option<u8>,
+    canvas: HtmlCanvasElement,
+}
+
+fn js_error(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+/// A column-major 4×4 matrix from 16 finite numbers.
+fn matrix(what: &str, m: &[f32]) -> Result<Mat4, JsError> {
+    if m.len() != 16 || m.iter().any(|v| !v.is_finite()) {
+        return Err(JsError::new(&format!(
+            "{what}: expected 16 finite numbers (column-major), got {}",
+            m.len()
+        )));
+    }
+    Ok(Mat4::from_cols_slice(m))
+}
+
+#[wasm_bindgen]
+impl Renderer {
+    /// A renderer drawing on `canvas` (a WebGL2 context is created on it: no antialiasing,
+    /// premultiplied alpha, the drawing buffer kept for `toDataURL`).
+    #[wasm_bindgen(constructor)]
+    pub fn new(canvas: HtmlCanvasElement) -> Result<Renderer, JsError> {
+        // A panic (a bug: every input error is a JsError) says where on the console before
+        // the module traps.
+        static HOOK: std::sync::Once = std::sync::Once::new();
+        HOOK.call_once(|| {
+            std::panic::set_hook(Box::new(|info| {
+                web_sys::console::error_1(&format!("splatgl: {info}").into());
+            }))
+        });
+        let attrs = js_sys::Object::new();
+        for (k, v) in [
+            ("antialias", false),
+            ("premultipliedAlpha", true),
+            ("preserveDrawingBuffer", true),
+            ("depth", true),
+        ] {
+            js_sys::Reflect::set(&attrs, &k.into(), &v.into())
+                .map_err(|_| JsError::new("cannot build the context attributes"))?;
+        }
+        let context = canvas
+            .get_context_with_context_options("webgl2", &attrs)
+            .map_err(|_| JsError::new("getContext('webgl2') threw"))?
+            .ok_or_else(|| JsError::new("this browser gives no WebGL2 context"))?
+            .dyn_into::<WebGl2RenderingContext>()
+            .map_err(|_| JsError::new("getContext('webgl2') returned something else"))?;
+        let gl = glow::Context::from_webgl2_context(context);
+        let canvas = canvas.clone();
+        let renderer = SplatRenderer::new(&gl).map_err(js_error)?;
+        Ok(Renderer {
+            gl,
+            renderer,
+            targets: FrameTargets::default(),
+            loaded: None,
+            view: Mat4::IDENTITY,
+            projection: Mat4::IDENTITY,
+            sh_degree: None,
+            canvas,
+        })
+    }
+
+    /// Loads a splat file from its bytes (`name`'s extension helps detect the format: any
+    /// format splatgl reads; a glTF must be self-contained: `.glb`, or `.gltf` with data URIs)
+    /// and uploads it, replacing what was loaded. Returns a JSON object: `name`, `format`,
+    /// `splats`, `sh_degree`, `cameras` (glTF camera nodes), `warnings` (the loader's
+    /// findings). A file that cannot be loaded is an error with the loader's message, and
+    /// the previous cloud stays.
+    pub fn load(&mut self, bytes: &[u8], name: &str) -> Result<String, JsError> {
+        let scene = load_bytes(
+            bytes,
+            Some(std::path::Path::new(name)),
+            &LoadOptions::default(),
+        )
+        .map_err(js_error)?;
+        let warnings: Vec<String> = scene
+            .report
+            .findings
+            .iter()
+            .map(|f| f.to_string())
+            .collect();
+        let format = scene.report.format;
+        self.upload(Loaded {
+            cloud: scene.cloud,
+            cameras: scene.cameras,
+            format: Some(format),
+            name: name.to_string(),
+        })?;
+        Ok(self.info(&warnings))
+    }
+
+    /// Loads the bundled default scene (what `splatgl render` draws without a file).
+    pub fn load_default(&mut self) -> Result<String, JsError> {
+        self.upload(Loaded {
+            cloud: splatgl::synthetic::default_scene(),
+            cameras: Vec::new(),
+            format: None,
+            name: "default scene".into(),
+        })?;
+        Ok(self.info(&[]))
+    }
+
+    fn upload(&mut self, loaded: Loaded) -> Result<(), JsError> {
+        self.renderer
+            .upload(&self.gl, &loaded.cloud)
+            .map_err(js_error)?;
+        self.loaded = Some(loaded);
+        Ok(())
+    }
+
+    fn info(&self, warnings: &[String]) -> String {
+        let Some(l) = &self.loaded else {
+            return "{}".into();
+        };
+        serde_json::json!({
+            "name": l.name,
+            "format": l.format.map(|f| format!("{f:?}").to_lowercase()),
+            "splats": l.cloud.len(),
+            "sh_degree": l.cloud.sh_degree,
+            "cameras": l.cameras.len(),
+            "warnings": warnings,
+        })
+        .to_string()
+    }
+
+    /// The number of splats loaded (0 before a load).
+    pub fn splat_count(&self) -> usize {
+        self.loaded.as_ref().map_or(0, |l| l.cloud.len())
+    }
+
+    /// The SH degree drawn: `undefined` = the cloud's own, else at most the cloud's.
+    pub fn set_sh_degree(&mut self, degree: Option<u8>) {
+        self.sh_degree = degree;
+    }
+
+    /// The view (world → GL eye space, looking down −z) and projection matrices, each 16
+    /// numbers, column-major (as WebGL's `uniformMatrix4fv` takes them).
+    pub fn set_camera(&mut self, view: &[f32], projection: &[f32]) -> Result<(), JsError> {
+        self.view = matrix("view", view)?;
+        self.projection = matrix("projection", projection)?;
+        Ok(())
+    }
+
+    /// Clears the canvas to `background` (RGB, 0–1) and draws the loaded cloud for the camera
+    /// of [`Renderer::set_camera`]: culled, sorted back to front and blended into the canvas.
+    /// Returns the milliseconds it took on the CPU (sort and GL calls; the GPU may still be
+    /// drawing).
+    pub fn draw(&mut self, r: f32, g: f32, b: f32) -> Result<f64, JsError> {
+        let started = now_ms();
+        let (w, h) = self.size();
+        // SAFETY: state calls on the canvas's context, current by construction on the web.
+        unsafe {
+            self.gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            self.gl.viewport(0, 0, w, h);
+            self.gl.clear_color(r, g, b, 1.0);
+            self.gl.clear_depth_f32(1.0);
+            self.gl
+                .clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+        }
+        if self.loaded.is_some() && w > 0 && h > 0 {
+            self.renderer.settings_mut().sh_degree = self.sh_degree;
+            self.renderer
+                .draw_frame(&self.gl, self.view, self.projection, [0, 0, w, h])
+                .map_err(js_error)?;
+        }
+        Ok(now_ms() - started)
+    }
+
+    /// The default view of what is loaded at `width` × `height` (what `splatgl render` picks
+    /// without camera options: the default scene's own view, else the cloud framed), as 10
+    /// numbers: eye (3), target (3), up (3), vertical field of view in degrees.
+    pub fn default_view(&self, width: u32, height: u32) -> Result<Vec<f32>, JsError> {
+        let cam = self.default_camera(width, height)?;
+        let eye = cam.eye();
+        let inv = cam.world_to_camera.inverse();
+        // OpenCV axes: +z forward, −y up.
+        let forward = inv.transform_vector3(Vec3::Z);
+        let up = -inv.transform_vector3(Vec3::Y);
+        let fov = 2.0 * (0.5 * cam.height as f32 / cam.fy).atan();
+        let target = eye + forward;
+        Ok([eye, target, up]
+            .iter()
+            .flat_map(|v| v.to_array())
+            .chain([fov.to_degrees()])
+            .collect())
+    }
+
+    fn default_camera(&self, width: u32, height: u32) -> Result<Camera, JsError> {
+        let l = self
+            .loaded
+            .as_ref()
+            .ok_or_else(|| JsError::new("nothing is loaded"))?;
+        let opts = ViewOptions {
+            width: Some(width),
+            height: Some(height),
+            ..ViewOptions::default()
+        };
+        let scene = SceneView {
+            cloud: &l.cloud,
+            format: l.format,
+            cameras: &l.cameras,
+        };
+        opts.camera(scene, (width, height)).map_err(js_error)
+    }
+
+    /// Renders what is loaded as `splatgl render --backend gl` does (blending in RGBA16F, the
+    /// framebuffer the RC recommends) and returns an 8-bit RGB PNG: seen by glTF camera node
+    /// `gltf_camera` of the file, or with `gltf_camera` < 0 by the default view
+    /// ([`Renderer::default_view`]), at `width` × `height`, over `background` (RGB, 0–1).
+    /// The canvas is left as it was (the image is drawn off screen).
+    pub fn render_png(
+        &mut self,
+        gltf_camera: i32,
+        width: u32,
+        height: u32,
+        r: f32,
+        g: f32,
+        b: f32,
+    ) -> Result<Vec<u8>, JsError> {
+        if width == 0 || height == 0 || width > 8192 || height > 8192 {
+            return Err(JsError::new(&format!(
+                "image size {width}×{height}: each side must be 1–8192"
+            )));
+        }
+        let camera = if gltf_camera < 0 {
+            self.default_camera(width, height)?
+        } else {
+            let l = self
+                .loaded
+                .as_ref()
+                .ok_or_else(|| JsError::new("nothing is loaded"))?;
+            let g = l.cameras.get(gltf_camera as usize).ok_or_else(|| {
+                JsError::new(&format!(
+                    "{}: no glTF camera {gltf_camera} (it has {})",
+                    l.name,
+                    l.cameras.len()
+                ))
+            })?;
+            Camera::from_gltf(g, width, height).map_err(js_error)?
+        };
+        self.renderer
+            .sort_for_camera(&self.gl, &camera, true)
+            .map_err(js_error)?;
+        let settings = DrawSettings {
+            sh_degree: self.sh_degree,
+            depth_test: false,
+            color_space: Some(self.renderer.color_space()),
+            ..DrawSettings::default()
+        };
+        let image = self
+            .targets
+            .draw(
+                &self.gl,
+                &self.renderer,
+                &camera,
+                &settings,
+                [r, g, b],
+                Blend::Rgba16f,
+                Output::Image,
+                "rendering",
+            )
+            .map_err(js_error)?
+            .ok_or_else(|| JsError::new("no image came back"))?;
+        image.encode_png(PngDepth::Eight, false).map_err(js_error)
+    }
+
+    /// Waits until the GL has drawn everything asked of it (reads one pixel back: WebGL has
+    /// no blocking finish), for timing frames.
+    pub fn finish(&self) {
+        let mut px = [0u8; 4];
+        // SAFETY: a 1×1 read of the bound framebuffer into a 4-byte buffer.
+        unsafe {
+            self.gl.read_pixels(
+                0,
+                0,
+                1,
+                1,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelPackData::Slice(Some(&mut px)),
+            );
+        }
+    }
+
+    /// `GL_VERSION / GL_RENDERER` and whether RGBA16F blending is available.
+    pub fn gl_info(&self) -> String {
+        // SAFETY: string queries on the canvas's context.
+        let (v, r) = unsafe {
+            (
+                self.gl.get_parameter_string(glow::VERSION),
+                self.gl.get_parameter_string(glow::RENDERER),
+            )
+        };
+        format!(
+            "{v} / {r}; RGBA16F blending: {}",
+            splatgl::gl::can_render_rgba16f(&self.gl)
+        )
+    }
+
+    fn size(&self) -> (i32, i32) {
+        (
+            self.canvas.width().min(16384) as i32,
+            self.canvas.height().min(16384) as i32,
+        )
+    }
+}
+
+/// Milliseconds per sort of `n` random splats by camera distance (the renderer's radix sort,
+/// on this thread: wasm has no rayon threads), averaged over `reps` sorts after one warm-up.
+/// `examples/sort_time.rs` measures the same natively.
+#[wasm_bindgen]
+pub fn sort_ms(n: usize, reps: u32) -> f64 {
+    let cloud = splatgl::synthetic::random_cloud(n, 0, 5.0, 7);
+    let mut sorter = splatgl::sort::Sorter::new();
+    sorter.sort_by_distance(&cloud.positions, [0.0, 0.0, -20.0]);
+    let started = now_ms();
+    for i in 0..reps {
+        sorter.sort_by_distance(&cloud.positions, [0.01 * i as f32, 0.0, -20.0]);
+    }
+    (now_ms() - started) / f64::from(reps.max(1))
+}
+
+/// Milliseconds since the page started (`performance.now()`).
+fn now_ms() -> f64 {
+    web_sys::window()
+        .and_then(|w| w.performance())
+        .map_or(0.0, |p| p.now())
+}
