@@ -125,6 +125,7 @@ export function renderSuite({ name, page, required, prefix, viewExtra = {}, bann
       const j = cams[c.cameras_json_index];
       if (onlyView && c.image !== onlyView) continue;
       views.push({ image: c.image, ...fields, width: c.width, height: c.height,
+                   gltfCamera: c.gltf_camera,
                    fy: j.fy, position: j.position, rotation: j.rotation,
                    ...viewExtra,
                    znear: gltfCameras[c.gltf_camera]?.perspective?.znear ?? 0.05 });
@@ -180,7 +181,7 @@ export function renderViews({ name, page, prefix, views, tmp, out, mounts = {}, 
       return;
     }
     let file = null;
-    if (url === '/' || url === '/page') file = path.join(here, page);
+    if (url === '/' || url === '/page') file = path.resolve(here, page); // relative to this folder, or absolute
     else if (url === '/page.mjs') file = path.join(here, 'page.mjs');
     else if (url === '/views.json') return send(res, 200, 'application/json', JSON.stringify(views));
     else {

@@ -1,0 +1,82 @@
+// splatgl in the browser: the JavaScript API over the wasm module (crates/splatgl-web).
+//
+//   import * as splatgl from './splatgl.js';
+//   const r = await splatgl.create(canvas);           // a WebGL2 context on the canvas
+//   await r.load(bytes, 'scene.ply');                 // any format splatgl reads
+//   r.setCamera(view, proj);                          // column-major 4×4 matrices (16 numbers)
+//   r.draw();                                         // cull, sort back to front, blend
+//
+// Errors (no WebGL2, a file that cannot be loaded, bad matrices) are thrown as Error with
+// splatgl's message; after a failed load the renderer keeps what it had.
+import init, { Renderer } from './pkg/splatgl_web.js';
+
+let ready = null;
+
+/** A renderer on `canvas` (loads the wasm module on first use). */
+export async function create(canvas) {
+  ready ??= init({ module_or_path: new URL('./pkg/splatgl_web_bg.wasm', import.meta.url) });
+  await ready;
+  return new SplatglRenderer(new Renderer(canvas));
+}
+
+class SplatglRenderer {
+  constructor(inner) { this.inner = inner; }
+
+  /** Loads a file from its bytes (ArrayBuffer or Uint8Array); `name` gives its format. Returns
+   * { name, format, splats, sh_degree, cameras, warnings }. */
+  async load(bytes, name) {
+    const data = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
+    return JSON.parse(this.inner.load(data, name));
+  }
+
+  /** Loads the bundled default scene. */
+  loadDefault() { return JSON.parse(this.inner.load_default()); }
+
+  /** The view (world → eye, looking down −z) and projection matrices, column-major. */
+  setCamera(view, proj) { this.inner.set_camera(Float32Array.from(view), Float32Array.from(proj)); }
+
+  /** Clears to `background` ([r, g, b], 0–1) and draws; returns the CPU milliseconds spent. */
+  draw(background = [0, 0, 0]) { return this.inner.draw(background[0], background[1], background[2]); }
+
+  /** SH degree to draw (`undefined`: the file's). */
+  setShDegree(degree) { this.inner.set_sh_degree(degree); }
+
+  /** The default view at width × height: { eye, target, up, fovDeg }. */
+  defaultView(width, height) {
+    const v = this.inner.default_view(width, height);
+    return { eye: [v[0], v[1], v[2]], target: [v[3], v[4], v[5]], up: [v[6], v[7], v[8]], fovDeg: v[9] };
+  }
+
+  /** An 8-bit RGB PNG (Uint8Array) as `splatgl render --backend gl` renders it: glTF camera
+   * `gltfCamera`, or the default view when it is negative. */
+  renderPng(gltfCamera, width, height, background = [0, 0, 0]) {
+    return this.inner.render_png(gltfCamera, width, height, background[0], background[1], background[2]);
+  }
+
+  /** The number of splats loaded. */
+  get splatCount() { return this.inner.splat_count(); }
+
+  /** GL_VERSION / GL_RENDERER and whether RGBA16F blending is available. */
+  glInfo() { return this.inner.gl_info(); }
+}
+
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const unit = (a) => { const l = Math.hypot(a[0], a[1], a[2]) || 1; return [a[0] / l, a[1] / l, a[2] / l]; };
+
+/** A view matrix looking from `eye` at `target` with `up` up (column-major). */
+export function lookAt(eye, target, up) {
+  const f = unit(sub(target, eye));
+  const s = unit(cross(f, up));
+  const u = cross(s, f);
+  return [s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0,
+          -dot(s, eye), -dot(u, eye), dot(f, eye), 1];
+}
+
+/** A perspective projection (vertical field of view in degrees; column-major, GL depth). */
+export function perspective(fovDeg, aspect, near, far) {
+  const t = 1 / Math.tan(fovDeg * Math.PI / 360);
+  return [t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, (far + near) / (near - far), -1,
+          0, 0, 2 * far * near / (near - far), 0];
+}
