@@ -8,12 +8,14 @@
 #         folder with `pip install .` (maturin, the dev profile: the fast lane's dependencies
 #         are reused), then its pytest suite (python/tests) against the command;
 #   platforms: the other platforms (docs/platforms.md): clippy with warnings as errors for
-#         Windows (x86_64-pc-windows-gnu) and both macOS targets (which can only be checked
-#         here), and the Windows build staged by scripts/windows/build.sh (mingw-w64);
+#         Windows (x86_64-pc-windows-gnu), both macOS targets (which can only be checked
+#         here) and the browser (wasm32-unknown-unknown), the Windows build staged by
+#         scripts/windows/build.sh (mingw-w64) and the web build (scripts/web.sh build);
 #   slow: the cross-checks that drive a browser, an X server or Wine: the engines graded in
 #         headless Chromium (GaussianSplats3D, Spark, CesiumJS, PlayCanvas, Babylon.js),
-#         splat-transform's streamed SOG and glTF, the viewer under Xvfb, and the Windows build
-#         under Wine (splatgl.exe render and view, the C legacy host against splatgl.dll).
+#         splat-transform's streamed SOG and glTF, the viewer under Xvfb, the Windows build
+#         under Wine (splatgl.exe render and view, the C legacy host against splatgl.dll), and
+#         the web build in headless Chromium (scenes, the conformance suite, the viewer page).
 # `scripts/test.sh fast`, `python`, `platforms` or `slow` runs one lane (python after fast: it
 # uses the command fast builds; slow after platforms: it runs the Windows build). Tests that cannot run here (no
 # EGL, no real data, no npm tool) are listed at the end; with SPLATGL_REQUIRE=all (.ci/run sets
@@ -28,7 +30,7 @@ skipped="$target/tmp/skipped-tests.txt"
 # the test harness, each a module path prefix.
 slow=(conformance_third_party:: conformance_cesium:: conformance_playcanvas:: conformance_babylon:: tiles_cesium::
   tiles_streamed_sog::
-  splat_transform_gltf:: viewer:: viewer_panel:: windows::)
+  splat_transform_gltf:: viewer:: viewer_panel:: windows:: web::)
 skip_slow=()
 for m in "${slow[@]}"; do skip_slow+=(--skip "$m"); done
 
@@ -66,6 +68,9 @@ platforms() {
   for t in x86_64-pc-windows-gnu aarch64-apple-darwin x86_64-apple-darwin; do
     cargo clippy --locked --target "$t" -p splatgl-cli -p splatgl-capi -- -D warnings
   done
+  # The browser: the library and the web crate for wasm32, then web/dist (release).
+  cargo clippy --locked --target wasm32-unknown-unknown -p splatgl-web -- -D warnings
+  ./scripts/web.sh build
   ./scripts/windows/build.sh
   # The library's unit and integration tests built for Windows and run under Wine (headless
   # GL through WGL), all but the two modules that run host tools the Wine prefix lacks

@@ -40,6 +40,7 @@ mod tiles_streamed_sog;
 mod viewer;
 #[cfg(feature = "viewer")]
 mod viewer_panel;
+mod web;
 #[cfg(feature = "viewer")]
 mod windows;
 mod writers;
