@@ -8,7 +8,7 @@
 //
 // Errors (no WebGL2, a file that cannot be loaded, bad matrices) are thrown as Error with
 // splatgl's message; after a failed load the renderer keeps what it had.
-import init, { Renderer } from './pkg/splatgl_web.js';
+import init, { Renderer, sort_ms } from './pkg/splatgl_web.js';
 
 let ready = null;
 
@@ -18,6 +18,10 @@ export async function create(canvas) {
   await ready;
   return new SplatglRenderer(new Renderer(canvas));
 }
+
+/** Milliseconds per sort of `n` random splats by camera distance in wasm (one thread),
+ * averaged over `reps` (after `create`). */
+export function sortMs(n, reps = 10) { return sort_ms(n, reps); }
 
 class SplatglRenderer {
   constructor(inner) { this.inner = inner; }
@@ -37,6 +41,9 @@ class SplatglRenderer {
 
   /** Clears to `background` ([r, g, b], 0–1) and draws; returns the CPU milliseconds spent. */
   draw(background = [0, 0, 0]) { return this.inner.draw(background[0], background[1], background[2]); }
+
+  /** Returns once the GL has drawn everything asked of it (a 1-pixel read). */
+  finish() { this.inner.finish(); }
 
   /** SH degree to draw (`undefined`: the file's). */
   setShDegree(degree) { this.inner.set_sh_degree(degree); }
