@@ -63,8 +63,12 @@ python() {
 }
 
 platforms() {
-  # Library, CLI (with the viewer and http), C API.
+  # The targets' standard libraries (a no-op where .ci/run or an earlier run added them).
   local t
+  for t in x86_64-pc-windows-gnu aarch64-apple-darwin x86_64-apple-darwin wasm32-unknown-unknown; do
+    rustup target list --installed | grep -qx "$t" || rustup target add "$t"
+  done
+  # Library, CLI (with the viewer and http), C API.
   for t in x86_64-pc-windows-gnu aarch64-apple-darwin x86_64-apple-darwin; do
     cargo clippy --locked --target "$t" -p splatgl-cli -p splatgl-capi -- -D warnings
   done

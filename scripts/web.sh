@@ -25,6 +25,10 @@ cmd=${1:-}
 build() {
   local profile=${SPLATGL_WEB_PROFILE:-release} dir
   [ "$profile" = dev ] && dir=debug || dir=$profile
+  if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+    echo "== rustup target add wasm32-unknown-unknown"
+    rustup target add wasm32-unknown-unknown
+  fi
   local version
   version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3; exit }' Cargo.lock)
   if [ "$(wasm-bindgen --version 2>/dev/null | awk '{ print $2 }')" != "$version" ]; then
