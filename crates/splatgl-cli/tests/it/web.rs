@@ -12,7 +12,7 @@ use std::process::Command;
 use splatgl::image::Image;
 
 use crate::common;
-use common::third_party::{clean, generate, grade, rc_assets, tmp};
+use common::third_party::{clean, generate, grade, missing_node_or_browser, rc_assets, tmp};
 
 /// Why the web build cannot run here, if it cannot.
 fn missing() -> Option<String> {
@@ -23,13 +23,7 @@ fn missing() -> Option<String> {
             wasm.display()
         ));
     }
-    if Command::new("node").arg("--version").output().is_err() {
-        return Some("node not runnable".into());
-    }
-    let browser = ["chromium", "chromium-browser"]
-        .iter()
-        .any(|b| Command::new(b).arg("--version").output().is_ok());
-    (!browser).then(|| "chromium (or chromium-browser) not runnable".into())
+    missing_node_or_browser()
 }
 
 /// `node scripts/web/NAME args…`: its stderr, after checking it succeeded.

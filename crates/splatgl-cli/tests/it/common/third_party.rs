@@ -22,6 +22,11 @@ pub fn missing_tools(file: &str) -> Option<String> {
     if !npm.exists() {
         return Some(format!("{} not installed", npm.display()));
     }
+    missing_node_or_browser()
+}
+
+/// Why node or chromium cannot run here (what every page-driving test needs), if they cannot.
+pub fn missing_node_or_browser() -> Option<String> {
     if Command::new("node").arg("--version").output().is_err() {
         return Some("node not runnable".into());
     }
