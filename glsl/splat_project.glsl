@@ -48,12 +48,7 @@ struct Splat {
     vec2 center_px; // window pixels (gl_FragCoord's frame: y up)
 };
 
-// Linear texel index -> (x, y, layer) in the data textures.
-ivec3 texel_coord(int linear_index) {
-    return ivec3(linear_index & (TEX_WIDTH - 1),
-                 (linear_index >> TEX_WIDTH_LOG2) & (LAYER_ROWS - 1),
-                 linear_index >> (TEX_WIDTH_LOG2 + LAYER_ROWS_LOG2));
-}
+//@include texel.glsl
 
 //@include sh.glsl
 

@@ -133,6 +133,14 @@ pub const GEOM_TEXEL_POSITION_OPACITY: usize = 0;
 pub const GEOM_TEXEL_ROTATION: usize = 1;
 /// Geometry texel holding (scale.xyz, 0).
 pub const GEOM_TEXEL_SCALE: usize = 2;
+/// `RGBA32F` texels of one pre-pass record in the records texture: (clip-space centre),
+/// (clip-space corner offsets), (colour, opacity), (conic, unused).
+pub const RECORD_TEXELS: usize = 4;
+/// Quads (splats) per instance of the quad draw after the pre-pass: one instance of this many
+/// quads instead of one per splat, so a renderer that pays per instance (SwiftShader runs
+/// each instance as a draw of its own; llvmpipe sets up each one) pays it once per batch.
+/// Their indices (`6 ·` this many, u16) must stay below 65 536.
+pub const QUADS_PER_INSTANCE: usize = 256;
 
 /// `RGBA16F` texels per splat holding the SH coefficients of degrees `0..=degree`: the
 /// (d+1)² RGB triples packed tightly, coefficient k's channel c at float `3k + c`, so

@@ -88,11 +88,11 @@ impl TextureLayout {
         Self::for_limits(size, layers)
     }
 
-    fn width(&self) -> usize {
+    pub(crate) fn width(&self) -> usize {
         1 << self.width_log2
     }
 
-    fn layer_rows(&self) -> usize {
+    pub(crate) fn layer_rows(&self) -> usize {
         1 << self.layer_rows_log2
     }
 
@@ -105,7 +105,7 @@ impl TextureLayout {
     }
 
     /// `(rows per layer, layers)` of a texture holding `n` splats of `per_splat` texels.
-    fn shape(&self, n: usize, per_splat: usize) -> (usize, usize) {
+    pub(crate) fn shape(&self, n: usize, per_splat: usize) -> (usize, usize) {
         let rows = (n * per_splat).div_ceil(self.width()).max(1);
         if rows <= self.layer_rows() {
             (rows, 1)
@@ -115,7 +115,7 @@ impl TextureLayout {
     }
 
     /// [`GlError::Capacity`] unless `n` splats of `per_splat` texels fit.
-    fn check(&self, n: usize, per_splat: usize) -> Result<(), GlError> {
+    pub(crate) fn check(&self, n: usize, per_splat: usize) -> Result<(), GlError> {
         let fits = self.capacity(per_splat);
         if n <= fits {
             return Ok(());

@@ -133,22 +133,28 @@ impl SplatRenderer {
         let (saved, entered) = state::draw::enter(gl, self.ctx, &want, settings.restore_state);
         match prepass {
             Some(p) if self.instances > 0 => {
-                // Per-splat maths once per splat into the records, then the quads read them.
+                // Per-splat maths once per splat into the records, then the quads read them,
+                // in batches of QUADS_PER_INSTANCE.
                 p.bind(gl);
                 self.set_uniforms(gl, &p.prep_uniforms, view, settings);
-                p.capture(gl, self.instances);
+                p.capture(gl, self.instances, view.viewport);
+                p.draw_quads(gl, self.instances);
             }
-            _ => self.set_uniforms(gl, &self.uniforms, view, settings),
+            Some(_) => {}
+            None => {
+                self.set_uniforms(gl, &self.uniforms, view, settings);
+                if self.instances > 0 {
+                    // SAFETY: draws `instances` instances of the direct VAO, which reads the
+                    // order buffer that `set_order` bounded by its size (the shader culls any
+                    // index past the uploaded splats).
+                    unsafe {
+                        gl.draw_arrays_instanced(glow::TRIANGLE_STRIP, 0, 4, self.instances as i32)
+                    };
+                }
+            }
         }
         self.used_prepass
             .set(prepass.is_some() && self.instances > 0);
-        if self.instances > 0 {
-            // SAFETY: draws `instances` instances of the bound VAO: the direct one reads the
-            // order buffer, which `set_order` bounded by its size (the shader culls any index
-            // past the uploaded splats); the quad one reads as many records, captured just
-            // above (`instances ≤ capacity`).
-            unsafe { gl.draw_arrays_instanced(glow::TRIANGLE_STRIP, 0, 4, self.instances as i32) };
-        }
         let left = state::draw::leave(gl, self.ctx, saved);
         self.state_calls.set(state::StateCalls {
             queries: entered.queries + left.queries,

@@ -20,6 +20,8 @@ pub(crate) const SPLAT_PREP_VERT: &str = include_str!("../../glsl/splat_prep.ver
 pub(crate) const SPLAT_QUAD_VERT: &str = include_str!("../../glsl/splat_quad.vert");
 /// Fragment stage of the pre-pass (never runs: the rasterizer is discarded).
 pub(crate) const DISCARD_FRAG: &str = include_str!("../../glsl/discard.frag");
+/// Texel addressing of the array textures, spliced in at `//@include texel.glsl`.
+pub(crate) const TEXEL_GLSL: &str = include_str!("../../glsl/texel.glsl");
 /// Spherical-harmonics colour, spliced into the per-splat maths at `//@include sh.glsl`.
 pub(crate) const SH_GLSL: &str = include_str!("../../glsl/sh.glsl");
 /// Fragment stage of the splat program.
@@ -186,11 +188,17 @@ pub(crate) fn defines(layout: &TextureLayout) -> String {
     def("GEOM_TEXEL_SCALE", profile::GEOM_TEXEL_SCALE.to_string());
     let max_sh = profile::sh_texels(crate::cloud::MAX_SH_DEGREE);
     def("MAX_SH_TEXELS", max_sh.to_string());
+    def("RECORD_TEXELS", profile::RECORD_TEXELS.to_string());
+    def(
+        "QUADS_PER_INSTANCE",
+        profile::QUADS_PER_INSTANCE.to_string(),
+    );
     s
 }
 
 /// Assembles one stage: version line, precision, defines (see [`defines`]), then the file (with
-/// `//@include splat_project.glsl` and `//@include sh.glsl` replaced by those files).
+/// `//@include splat_project.glsl`, `//@include texel.glsl` and `//@include sh.glsl` replaced by
+/// those files).
 pub(crate) fn assemble(
     version: GlslVersion,
     errata: &Errata,
@@ -211,6 +219,7 @@ pub(crate) fn assemble(
         defines(layout),
         errata.defines(),
         body.replace("//@include splat_project.glsl", SPLAT_PROJECT_GLSL)
+            .replace("//@include texel.glsl", TEXEL_GLSL)
             .replace("//@include sh.glsl", SH_GLSL)
     )
 }
@@ -231,8 +240,9 @@ mod tests {
     use std::collections::BTreeMap;
 
     /// The GLSL sources, by file name.
-    const SOURCES: [(&str, &str); 9] = [
+    const SOURCES: [(&str, &str); 10] = [
         ("splat.vert", SPLAT_VERT),
+        ("texel.glsl", TEXEL_GLSL),
         ("splat_project.glsl", SPLAT_PROJECT_GLSL),
         ("splat_prep.vert", SPLAT_PREP_VERT),
         ("splat_quad.vert", SPLAT_QUAD_VERT),
@@ -294,6 +304,11 @@ mod tests {
             ),
             ("GEOM_TEXEL_SCALE".into(), profile::GEOM_TEXEL_SCALE as f64),
             ("MAX_SH_TEXELS".into(), profile::sh_texels(3) as f64),
+            ("RECORD_TEXELS".into(), profile::RECORD_TEXELS as f64),
+            (
+                "QUADS_PER_INSTANCE".into(),
+                profile::QUADS_PER_INSTANCE as f64,
+            ),
             ("TEX_WIDTH".into(), 2048.0),
             ("TEX_WIDTH_LOG2".into(), 11.0),
             ("LAYER_ROWS".into(), 2048.0),

@@ -188,7 +188,14 @@ impl SplatRenderer {
             quad_vert: asm(glsl::SPLAT_QUAD_VERT),
             splat_frag: asm(glsl::SPLAT_FRAG),
         };
-        self.prepass = Some(PrePass::new(gl, &src, self.order_buffer, capacity, true)?);
+        self.prepass = Some(PrePass::new(
+            gl,
+            &src,
+            self.order_buffer,
+            self.layout,
+            capacity,
+            true,
+        )?);
         Ok(())
     }
 

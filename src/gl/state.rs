@@ -31,6 +31,8 @@
 //! | `GL_FRAMEBUFFER_SRGB` (desktop; ES with `GL_EXT_sRGB_write_control`) | enabled iff the colour space drawn is `lin_rec709_display` (blending on linear values, encoded by an sRGB framebuffer) |
 //! | `GL_ALPHA_TEST` (compatibility profile) | disabled |
 //! | `GL_TRANSFORM_FEEDBACK_BINDING` (where transform-feedback objects exist: ES 3.x, desktop ≥ 4.0 or `GL_ARB_transform_feedback2`) | 0 |
+//! | `GL_PIXEL_UNPACK_BUFFER_BINDING` | 0 |
+//! | `GL_UNPACK_ROW_LENGTH`, `GL_UNPACK_SKIP_ROWS`, `GL_UNPACK_SKIP_PIXELS`, `GL_UNPACK_SKIP_IMAGES`; `GL_UNPACK_SWAP_BYTES` (desktop) | 0 (false) |
 //!
 //! `set_order` binds the order buffer as `GL_ARRAY_BUFFER` to write it.
 //!
@@ -39,7 +41,10 @@
 //! transform-feedback object (whose buffer binding was made at creation: the generic
 //! `GL_TRANSFORM_FEEDBACK_BUFFER` binding is never touched by a draw), enables
 //! `GL_RASTERIZER_DISCARD` for one `GL_POINTS` draw inside `glBegin/EndTransformFeedback`,
-//! and sets all three back to the values above before the quad draw. So the state left (or
+//! and sets all three back to the values above before the quad draw. It then copies the
+//! records into its records texture (binding the records buffer as `GL_PIXEL_UNPACK_BUFFER`
+//! for the copy and 0 again after it, with the unpack parameters above) and binds that texture
+//! on unit 0, in place of the geometry texture, for the quad draw. So the state left (or
 //! restored) is the same whichever path drew. The host must not have transform feedback
 //! active during a draw (it would capture the splats' quads on any path).
 //!
@@ -87,6 +92,12 @@
 //! | `GL_FRAMEBUFFER_SRGB` | sRGB switch | enabled iff `lin_rec709_display` |
 //! | `GL_ALPHA_TEST` | compatibility | disabled |
 //! | `GL_TRANSFORM_FEEDBACK_BINDING` | TF objects | 0 |
+//! | `GL_PIXEL_UNPACK_BUFFER_BINDING` | all | 0 |
+//! | `GL_UNPACK_ROW_LENGTH` | all | 0 |
+//! | `GL_UNPACK_SKIP_ROWS` | all | 0 |
+//! | `GL_UNPACK_SKIP_PIXELS` | all | 0 |
+//! | `GL_UNPACK_SKIP_IMAGES` | all | 0 |
+//! | `GL_UNPACK_SWAP_BYTES` | desktop | false |
 //!
 //! ("sRGB switch": desktop GL, or ES with `GL_EXT_sRGB_write_control`; "TF objects": ES 3.x,
 //! desktop GL ≥ 4.0 or `GL_ARB_transform_feedback2`.) `tests/it/gl_embedding.rs`
@@ -164,7 +175,7 @@ pub enum Contexts {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum LeftValue {
-    /// Binding 0 (no object).
+    /// 0: no object bound, or the integer 0.
     Zero,
     /// An enum value (e.g. `GL_TEXTURE0`, `GL_ONE`), with its name.
     Enum(u32, &'static str),
@@ -343,6 +354,22 @@ pub const LEFT_WITHOUT_RESTORE: &[Left] = &[
         glow::TRANSFORM_FEEDBACK_BINDING,
         TransformFeedbackObjects,
         Zero,
+    ),
+    left(
+        "GL_PIXEL_UNPACK_BUFFER_BINDING",
+        glow::PIXEL_UNPACK_BUFFER_BINDING,
+        All,
+        Zero,
+    ),
+    left("GL_UNPACK_ROW_LENGTH", glow::UNPACK_ROW_LENGTH, All, Zero),
+    left("GL_UNPACK_SKIP_ROWS", glow::UNPACK_SKIP_ROWS, All, Zero),
+    left("GL_UNPACK_SKIP_PIXELS", glow::UNPACK_SKIP_PIXELS, All, Zero),
+    left("GL_UNPACK_SKIP_IMAGES", glow::UNPACK_SKIP_IMAGES, All, Zero),
+    left(
+        "GL_UNPACK_SWAP_BYTES",
+        glow::UNPACK_SWAP_BYTES,
+        Desktop,
+        Bool(false),
     ),
 ];
 

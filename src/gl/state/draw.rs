@@ -45,6 +45,18 @@ const CAPS: [(u32, Contexts); 10] = [
     (ALPHA_TEST, Contexts::Compatibility),
 ];
 
+/// Pixel-unpack parameters a draw needs at 0, and where they exist: the pre-pass copies its
+/// records from a buffer into a texture, and each of these would offset or byte-swap that copy
+/// (`GL_UNPACK_ALIGNMENT` and `GL_UNPACK_IMAGE_HEIGHT` cannot matter: rows of whole 16-byte
+/// texels, one layer per copy).
+const UNPACK: [(u32, Contexts); 5] = [
+    (glow::UNPACK_ROW_LENGTH, Contexts::All),
+    (glow::UNPACK_SKIP_ROWS, Contexts::All),
+    (glow::UNPACK_SKIP_PIXELS, Contexts::All),
+    (glow::UNPACK_SKIP_IMAGES, Contexts::All),
+    (glow::UNPACK_SWAP_BYTES, Contexts::Desktop),
+];
+
 /// Whether a piece of state of `contexts` exists in `ctx`.
 pub(crate) fn exists(contexts: Contexts, ctx: ContextInfo) -> bool {
     match contexts {
@@ -86,6 +98,9 @@ pub(crate) struct Saved {
     color_mask: Option<[bool; 4]>,
     polygon_mode: Option<[u32; 2]>,
     transform_feedback: Option<glow::TransformFeedback>,
+    /// The host's `GL_PIXEL_UNPACK_BUFFER` binding, where one was bound (then unbound).
+    unpack_buffer: Option<glow::Buffer>,
+    unpack: [Option<i32>; UNPACK.len()],
 }
 
 /// The context with a count of the calls made through it.
@@ -175,6 +190,15 @@ fn enter_plain(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) {
             c.set_cap(cap, want.cap(cap));
         }
     }
+    // SAFETY: unbinds the pixel-unpack buffer and zeroes unpack parameters of this context.
+    unsafe {
+        c.s().bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
+        for (pname, contexts) in UNPACK {
+            if exists(contexts, ctx) {
+                c.s().pixel_store_i32(pname, 0);
+            }
+        }
+    }
     let [sr, dr, sa, da] = want.blend_func();
     // SAFETY: plain state setters with valid enums for this context.
     unsafe {
@@ -212,7 +236,14 @@ fn query_host(c: &mut Counted<'_>, ctx: ContextInfo, depth_test: bool) -> Saved 
             color_mask: None,
             polygon_mode: None,
             transform_feedback: None,
+            unpack_buffer: c.q().bound_buffer(glow::PIXEL_UNPACK_BUFFER_BINDING),
+            unpack: [None; UNPACK.len()],
         };
+        for (k, (pname, contexts)) in UNPACK.into_iter().enumerate() {
+            if exists(contexts, ctx) {
+                s.unpack[k] = Some(c.int(pname) as i32);
+            }
+        }
         if ctx.tf_objects {
             s.transform_feedback = c
                 .q()
@@ -269,6 +300,19 @@ fn enter_restoring(c: &mut Counted<'_>, ctx: ContextInfo, want: &DrawState) -> S
         match s.caps[k] {
             Some(host) if host != want.cap(cap) => c.set_cap(cap, want.cap(cap)),
             _ => s.caps[k] = None,
+        }
+    }
+    // SAFETY: unbinds the host's pixel-unpack buffer and zeroes the unpack parameters it set
+    // (kept in `s` to put back).
+    unsafe {
+        if s.unpack_buffer.is_some() {
+            c.s().bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
+        }
+        for (k, (pname, _)) in UNPACK.into_iter().enumerate() {
+            match s.unpack[k] {
+                Some(host) if host != 0 => c.s().pixel_store_i32(pname, 0),
+                _ => s.unpack[k] = None,
+            }
         }
     }
     /// Keeps `saved` only if it differs from `want`, calling `set` then.
@@ -352,6 +396,15 @@ pub(crate) fn leave(gl: &glow::Context, ctx: ContextInfo, saved: Option<Saved>) 
         for (k, (cap, _)) in CAPS.into_iter().enumerate() {
             if let Some(on) = s.caps[k] {
                 c.set_cap(cap, on);
+            }
+        }
+        if s.unpack_buffer.is_some() {
+            c.s()
+                .bind_buffer(glow::PIXEL_UNPACK_BUFFER, s.unpack_buffer);
+        }
+        for (k, (pname, _)) in UNPACK.into_iter().enumerate() {
+            if let Some(v) = s.unpack[k] {
+                c.s().pixel_store_i32(pname, v);
             }
         }
         if let Some([sr, dr, sa, da]) = s.blend_func {
