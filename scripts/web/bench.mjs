@@ -3,6 +3,11 @@
 // browser (headless Chromium, SwiftShader WebGL2), on the same scene, cameras and canvas size:
 //
 //   node scripts/web/bench.mjs SCENE [OUT.json] [--width 1280] [--height 720] [--frames 10]
+//        [--engines splatgl,gs3d,spark,playcanvas] [--splatgl PATH]
+//
+// --splatgl: the `splatgl` command used to convert the scene (default: target/release/splatgl,
+// else target/debug/splatgl, else built with `cargo build --release -p splatgl-cli`); web/dist
+// is built (`scripts/web.sh build`) when it is missing.
 //
 // SCENE is converted to INRIA PLY (`splatgl convert`), which every engine reads. The cameras:
 // splatgl's default view of the scene (what `splatgl render` picks) and the same view orbited
@@ -22,7 +27,24 @@ const here = path.dirname(fileURLToPath(import.meta.url));
 const root = process.env.SPLATGL_ROOT || path.resolve(here, '../..');
 const args = process.argv.slice(2);
 const opt = (flag, dflt) => { const i = args.indexOf(flag); return i >= 0 ? args.splice(i, 2)[1] : dflt; };
-const engines = ['splatgl', 'gs3d', 'spark', 'playcanvas'];
+const allEngines = ['splatgl', 'gs3d', 'spark', 'playcanvas'];
+const engines = opt('--engines', allEngines.join(',')).split(',');
+for (const e of engines) {
+  if (!allEngines.includes(e)) { console.error(`bench.mjs: unknown engine ${e} (${allEngines.join(', ')})`); process.exit(2); }
+}
+
+/** The `splatgl` command: --splatgl, else a release or debug build, else one built now. */
+function findSplatgl(given) {
+  if (given) return given;
+  const exe = process.platform === 'win32' ? 'splatgl.exe' : 'splatgl';
+  for (const profile of ['release', 'debug']) {
+    const p = path.join(root, 'target', profile, exe);
+    if (fs.existsSync(p)) return p;
+  }
+  process.stderr.write('== no splatgl build found: cargo build --release -p splatgl-cli\n');
+  execFileSync('cargo', ['build', '--release', '-p', 'splatgl-cli'], { cwd: root, stdio: 'inherit' });
+  return path.join(root, 'target', 'release', exe);
+}
 
 if (args[0] === '--child') {
   // One engine's page: serve it, the views and the PLY; chromium; exit when it says done.
@@ -41,9 +63,14 @@ if (args[0] === '--child') {
   const width = Number(opt('--width', '1280'));
   const height = Number(opt('--height', '720'));
   const frames = Number(opt('--frames', '10'));
-  const splatgl = opt('--splatgl', path.join(root, 'target/debug/splatgl'));
+  const given = opt('--splatgl', null);
   const [scene, outJson] = args;
-  if (!scene) { console.error('usage: bench.mjs SCENE [OUT.json] [--width W] [--height H] [--frames N]'); process.exit(2); }
+  if (!scene) { console.error('usage: bench.mjs SCENE [OUT.json] [--width W] [--height H] [--frames N] [--engines E,..] [--splatgl PATH]'); process.exit(2); }
+  const splatgl = findSplatgl(given);
+  if (engines.includes('splatgl') && !fs.existsSync(path.join(root, 'web/dist/pkg/splatgl_web_bg.wasm'))) {
+    process.stderr.write('== web/dist missing: scripts/web.sh build\n');
+    execFileSync(path.join(root, 'scripts/web.sh'), ['build'], { cwd: root, stdio: 'inherit' });
+  }
   const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'splatgl-web-bench-'));
   execFileSync(splatgl, ['convert', scene, path.join(tmp, 'scene.ply'), '-f'], { stdio: 'pipe' });
   // The default view as `splatgl render` prints it: --look-at eye,target,up --fov F.
