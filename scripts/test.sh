@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The project's test command (README), in two lanes, each timed:
+# The project's test command (README), in four lanes, each timed:
 #   fast: format check, clippy with warnings as errors for every feature set users build
 #         (default, --no-default-features, --all-features), docs without broken links, an
 #         independent Python re-implementation of the reference's math, and every unit and
@@ -8,8 +8,8 @@
 #         folder with `pip install .` (maturin, the dev profile: the fast lane's dependencies
 #         are reused), then its pytest suite (python/tests) against the command;
 #   platforms: the other platforms (docs/platforms.md): clippy with warnings as errors for
-#         Windows (x86_64-pc-windows-gnu), both macOS targets (which can only be checked
-#         here) and the browser (wasm32-unknown-unknown), the Windows build staged by
+#         Windows (x86_64-pc-windows-gnu), macOS (aarch64-apple-darwin, which can only be
+#         checked here) and the browser (wasm32-unknown-unknown), the Windows build staged by
 #         scripts/windows/build.sh (mingw-w64) and the web build (scripts/web.sh build);
 #   slow: the cross-checks that drive a browser, an X server or Wine: the engines graded in
 #         headless Chromium (GaussianSplats3D, Spark, CesiumJS, PlayCanvas, Babylon.js),
@@ -65,11 +65,12 @@ python() {
 platforms() {
   # The targets' standard libraries (a no-op where .ci/run or an earlier run added them).
   local t
-  for t in x86_64-pc-windows-gnu aarch64-apple-darwin x86_64-apple-darwin wasm32-unknown-unknown; do
+  for t in x86_64-pc-windows-gnu aarch64-apple-darwin wasm32-unknown-unknown; do
     rustup target list --installed | grep -qx "$t" || rustup target add "$t"
   done
-  # Library, CLI (with the viewer and http), C API.
-  for t in x86_64-pc-windows-gnu aarch64-apple-darwin x86_64-apple-darwin; do
+  # Library, CLI (with the viewer and http), C API. macOS: one target (both take the same cfg
+  # paths; docs/platforms.md).
+  for t in x86_64-pc-windows-gnu aarch64-apple-darwin; do
     cargo clippy --locked --target "$t" -p splatgl-cli -p splatgl-capi -- -D warnings
   done
   # The browser: the library and the web crate for wasm32, then web/dist (release).
