@@ -16,7 +16,9 @@ npm_tools=(@playcanvas/splat-transform@3.7.0 @mkkellogg/gaussian-splats-3d@0.4.7
   # PlayCanvas 2.23 reads KHR_gaussian_splatting glTF itself (scripts/conformance/playcanvas.mjs).
   playcanvas@2.23.3
   # Babylon.js 9 reads KHR_gaussian_splatting glTF itself (scripts/conformance/babylon.mjs).
-  @babylonjs/core@9.28.0 @babylonjs/loaders@9.28.0)
+  @babylonjs/core@9.28.0 @babylonjs/loaders@9.28.0
+  # The web package's declarations are checked with tsc --noEmit (scripts/web/pack-check.mjs).
+  typescript@5.9.3)
 if [ "$(cat .npm-tools/ci-installed 2>/dev/null)" = "${npm_tools[*]}" ]; then
   exit 0
 fi

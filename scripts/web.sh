@@ -11,6 +11,10 @@
 #   ./scripts/web.sh bench SCENE [OUT.json] frame times of splatgl-web in headless Chromium
 #                                          (scripts/web/bench.mjs)
 #   ./scripts/web.sh serve [PORT]          serves web/dist on 127.0.0.1 (default port 8080)
+#   ./scripts/web.sh pack                  the npm package `splatgl` (web/dist is its root) as
+#                                          target/web-pack/splatgl-VERSION.tgz, then checked:
+#                                          installed beside web/example, type-checked with
+#                                          tsc --noEmit, the example rendered in headless Chromium
 #
 # build needs the wasm32-unknown-unknown target (rustup target add wasm32-unknown-unknown) and
 # wasm-bindgen-cli of the version Cargo.lock pins (installed with cargo install when missing);
@@ -42,7 +46,7 @@ build() {
   mkdir -p web/dist/pkg
   wasm-bindgen --target web --no-typescript --out-dir web/dist/pkg \
     "$target_dir/wasm32-unknown-unknown/$dir/splatgl_web.wasm"
-  cp web/index.html web/viewer.js web/splatgl.js web/dist/
+  cp web/index.html web/viewer.js web/splatgl.js web/splatgl.d.ts web/package.json web/dist/
   local wasm=web/dist/pkg/splatgl_web_bg.wasm
   echo "web/dist: $(stat -c %s "$wasm") bytes of wasm, $(gzip -9 -c "$wasm" | wc -c) gzipped"
 }
@@ -58,11 +62,14 @@ case "$cmd" in
   bench)
     [ $# -ge 1 ] || { echo "usage: scripts/web.sh bench SCENE [OUT.json]" >&2; exit 2; }
     node scripts/web/bench.mjs "$@" ;;
+  pack)
+    [ -f web/dist/pkg/splatgl_web_bg.wasm ] || build
+    node scripts/web/pack-check.mjs ;;
   serve)
     port=${1:-8080}
     echo "http://127.0.0.1:$port/ (web/dist; Ctrl-C stops)"
     exec python3 -m http.server "$port" --bind 127.0.0.1 --directory web/dist ;;
   *)
-    sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2 ;;
 esac

@@ -5,7 +5,9 @@
 //   await r.load(bytes, 'scene.ply');                 // any format splatgl reads
 //   r.setCamera(view, proj);                          // column-major 4×4 matrices (16 numbers)
 //   r.draw();                                         // cull, sort back to front, blend
+//   r.dispose();                                      // frees its GPU objects
 //
+// Types: splatgl.d.ts (checked with tsc --noEmit against example/example.ts).
 // Errors (no WebGL2, a file that cannot be loaded, bad matrices) are thrown as Error with
 // splatgl's message; after a failed load the renderer keeps what it had.
 import init, { Renderer, sort_ms } from './pkg/splatgl_web.js';
@@ -27,14 +29,26 @@ class SplatglRenderer {
   constructor(inner) { this.inner = inner; }
 
   /** Loads a file from its bytes (ArrayBuffer or Uint8Array); `name` gives its format. Returns
-   * { name, format, splats, sh_degree, cameras, warnings }. */
+   * { name, format, splats, sh_degree, cameras, warnings } (`format` undefined for none). */
   async load(bytes, name) {
     const data = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
-    return JSON.parse(this.inner.load(data, name));
+    return info(this.inner.load(data, name));
   }
 
   /** Loads the bundled default scene. */
-  loadDefault() { return JSON.parse(this.inner.load_default()); }
+  loadDefault() { return info(this.inner.load_default()); }
+
+  /** Where `draw` blends: 'rgba16f' (the default: floating-point blending, resolved into the
+   * canvas) or 'rgba8' (in the canvas's 8 bits: colours above 1 clamped per splat). */
+  setTarget(target) { this.inner.set_target(target); }
+
+  /** Frees the renderer's GPU objects and its memory in the module; any later call throws. */
+  dispose() {
+    if (!this.inner) return;
+    this.inner.dispose();
+    this.inner.free();
+    this.inner = null;
+  }
 
   /** The view (world → eye, looking down −z) and projection matrices, column-major. */
   setCamera(view, proj) { this.inner.set_camera(Float32Array.from(view), Float32Array.from(proj)); }
@@ -65,6 +79,13 @@ class SplatglRenderer {
 
   /** GL_VERSION / GL_RENDERER and whether RGBA16F blending is available. */
   glInfo() { return this.inner.gl_info(); }
+}
+
+/** The loader's JSON answer, with `undefined` (not null) for what is absent. */
+function info(json) {
+  const o = JSON.parse(json);
+  for (const k of Object.keys(o)) if (o[k] === null) o[k] = undefined;
+  return o;
 }
 
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];

@@ -11,9 +11,10 @@ use glam::{Mat4, Vec3};
 use glow::HasContext;
 use splatgl::SplatCloud;
 use splatgl::camera::{Camera, GltfPerspective, SceneView, ViewOptions};
+use splatgl::cloud::ColorSpace;
 use splatgl::files::Format;
 use splatgl::gl::frame::{Blend, FrameTargets, Output};
-use splatgl::gl::{DrawSettings, SplatRenderer};
+use splatgl::gl::{DrawSettings, OffscreenTarget, SplatRenderer};
 use splatgl::image::PngDepth;
 use splatgl::load::{LoadOptions, load_bytes};
 use wasm_bindgen::JsCast;
@@ -40,6 +41,13 @@ pub struct Renderer {
     projection: Mat4,
     sh_degree: Option<u8>,
     canvas: HtmlCanvasElement,
+    /// `draw` blends in an RGBA16F target resolved into the canvas (the default, as the RC
+    /// recommends), else directly in the canvas's 8 bits ([`Renderer::set_target`]).
+    float_blending: bool,
+    /// The RGBA16F target of `draw` (made at the canvas's size on first use).
+    float: Option<OffscreenTarget>,
+    /// [`Renderer::dispose`] ran: every GPU object is gone.
+    disposed: bool,
 }
 
 fn js_error(e: impl std::fmt::Display) -> JsError {
@@ -99,6 +107,9 @@ impl Renderer {
             projection: Mat4::IDENTITY,
             sh_degree: None,
             canvas,
+            float_blending: true,
+            float: None,
+            disposed: false,
         })
     }
 
@@ -109,6 +120,7 @@ impl Renderer {
     /// findings). A file that cannot be loaded is an error with the loader's message, and
     /// the previous cloud stays.
     pub fn load(&mut self, bytes: &[u8], name: &str) -> Result<String, JsError> {
+        self.live()?;
         let scene = load_bytes(
             bytes,
             Some(std::path::Path::new(name)),
@@ -133,6 +145,7 @@ impl Renderer {
 
     /// Loads the bundled default scene (what `splatgl render` draws without a file).
     pub fn load_default(&mut self) -> Result<String, JsError> {
+        self.live()?;
         self.upload(Loaded {
             cloud: splatgl::synthetic::default_scene(),
             cameras: Vec::new(),
@@ -184,12 +197,20 @@ impl Renderer {
     }
 
     /// Clears the canvas to `background` (RGB, 0–1) and draws the loaded cloud for the camera
-    /// of [`Renderer::set_camera`]: culled, sorted back to front and blended into the canvas.
-    /// Returns the milliseconds it took on the CPU (sort and GL calls; the GPU may still be
-    /// drawing).
+    /// of [`Renderer::set_camera`]: culled, sorted back to front and blended — by default in
+    /// an RGBA16F target resolved into the canvas (sRGB-encoding `lin_rec709_display`
+    /// clouds), with `set_target("rgba8")` directly in the canvas. Returns the milliseconds it
+    /// took on the CPU (sort and GL calls; the GPU may still be drawing).
     pub fn draw(&mut self, r: f32, g: f32, b: f32) -> Result<f64, JsError> {
+        self.live()?;
         let started = now_ms();
         let (w, h) = self.size();
+        let linear = self.renderer.color_space() == ColorSpace::LinRec709Display;
+        let bg = if linear {
+            [r, g, b].map(|c| splatgl::profile::srgb_decode(c as f64) as f32)
+        } else {
+            [r, g, b]
+        };
         // SAFETY: state calls on the canvas's context, current by construction on the web.
         unsafe {
             self.gl.bind_framebuffer(glow::FRAMEBUFFER, None);
@@ -199,13 +220,81 @@ impl Renderer {
             self.gl
                 .clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
         }
-        if self.loaded.is_some() && w > 0 && h > 0 {
-            self.renderer.settings_mut().sh_degree = self.sh_degree;
-            self.renderer
-                .draw_frame(&self.gl, self.view, self.projection, [0, 0, w, h])
-                .map_err(js_error)?;
+        if self.loaded.is_none() || w <= 0 || h <= 0 {
+            return Ok(now_ms() - started);
         }
+        self.renderer.settings_mut().sh_degree = self.sh_degree;
+        let (view, projection) = (self.view, self.projection);
+        let viewport = [0, 0, w, h];
+        if !self.float_blending {
+            self.renderer
+                .draw_frame(&self.gl, view, projection, viewport)
+                .map_err(js_error)?;
+            return Ok(now_ms() - started);
+        }
+        let size = (w as u32, h as u32);
+        if self.float.as_ref().is_none_or(|t| t.size() != size) {
+            if let Some(mut t) = self.float.take() {
+                t.destroy(&self.gl);
+            }
+            let t = OffscreenTarget::new(&self.gl, size.0, size.1).map_err(|e| {
+                JsError::new(&format!(
+                    "no RGBA16F target for float blending ({e}); set_target(\"rgba8\") blends \
+                     in the canvas's 8 bits"
+                ))
+            })?;
+            self.float = Some(t);
+        }
+        let target = self.float.as_mut().expect("made above");
+        // The canvas (the default framebuffer, bound above) is where it resolves.
+        target
+            .begin(&self.gl, [bg[0], bg[1], bg[2], 1.0])
+            .map_err(js_error)?;
+        let drawn = self
+            .renderer
+            .draw_frame(&self.gl, view, projection, viewport);
+        target.resolve(&self.gl, linear).map_err(js_error)?;
+        drawn.map_err(js_error)?;
         Ok(now_ms() - started)
+    }
+
+    /// Where `draw` blends: `"rgba16f"` (the default: floating-point blending resolved into
+    /// the canvas, as the RC recommends) or `"rgba8"` (directly in the canvas: faster where
+    /// fill is the cost, colours above 1 clamped per splat — the kit's `overbright_blending`
+    /// asset fails it).
+    pub fn set_target(&mut self, target: &str) -> Result<(), JsError> {
+        self.float_blending = match target {
+            "rgba16f" => true,
+            "rgba8" => false,
+            other => {
+                return Err(JsError::new(&format!(
+                    "target {other:?}: expected \"rgba16f\" or \"rgba8\""
+                )));
+            }
+        };
+        Ok(())
+    }
+
+    /// Frees every GPU object the renderer made (textures, buffers, programs, targets; the
+    /// canvas's context stays the page's). Afterwards every call but `dispose` is an error.
+    pub fn dispose(&mut self) {
+        if self.disposed {
+            return;
+        }
+        self.renderer.destroy(&self.gl);
+        self.targets.destroy(&self.gl);
+        if let Some(mut t) = self.float.take() {
+            t.destroy(&self.gl);
+        }
+        self.loaded = None;
+        self.disposed = true;
+    }
+
+    fn live(&self) -> Result<(), JsError> {
+        if self.disposed {
+            return Err(JsError::new("this renderer was disposed"));
+        }
+        Ok(())
     }
 
     /// The default view of what is loaded at `width` × `height` (what `splatgl render` picks
@@ -259,6 +348,7 @@ impl Renderer {
         g: f32,
         b: f32,
     ) -> Result<Vec<u8>, JsError> {
+        self.live()?;
         if width == 0 || height == 0 || width > 8192 || height > 8192 {
             return Err(JsError::new(&format!(
                 "image size {width}×{height}: each side must be 1–8192"

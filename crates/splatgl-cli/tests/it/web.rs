@@ -1,7 +1,8 @@
 //! splatgl's web build (`crates/splatgl-web`, `web/dist` from `./scripts/web.sh build`) in
 //! headless Chromium (SwiftShader WebGL2): the same renderer compiled to wasm32 renders the
 //! default, fruit and biker scenes like the native reference, passes the generated
-//! conformance suite, and its viewer page shows a malformed file's error and keeps working.
+//! conformance suite, its viewer page shows a malformed file's error and keeps working, and
+//! the npm package packs, type-checks and draws its example.
 //!
 //! Needs `web/dist`, node and chromium; without them the tests skip, which fails under
 //! `SPLATGL_REQUIRE=all` (the slow lane of `scripts/test.sh` builds `web/dist` first).
@@ -160,4 +161,33 @@ fn web_viewer_shows_a_malformed_files_error_and_keeps_working() {
     assert_eq!(r["errorAfterGood"], "", "{r}");
     assert_eq!(r["splats"], 4721, "{r}");
     assert!(r["litPixels"].as_u64().unwrap() > 1000, "{r}");
+}
+
+#[test]
+fn web_package_packs_type_checks_and_its_example_renders() {
+    if let Some(why) = missing() {
+        common::skip(&why);
+        return;
+    }
+    let tsc = common::root().join(".npm-tools/node_modules/typescript/bin/tsc");
+    if !tsc.is_file() {
+        common::skip(&format!("{} (scripts/npm-tools.sh)", tsc.display()));
+        return;
+    }
+    // npm pack, install beside web/example, tsc --noEmit --checkJs --strict, the page drawn.
+    let err = node("pack-check.mjs", &[]);
+    let field = |prefix: &str| {
+        err.lines()
+            .find_map(|l| l.strip_prefix(prefix))
+            .unwrap_or_else(|| panic!("no {prefix:?} line: {err}"))
+    };
+    let files: Vec<String> = serde_json::from_str(field("page: FILES ")).unwrap();
+    assert!(files.contains(&"splatgl.d.ts".to_string()), "{files:?}");
+    let r: serde_json::Value = serde_json::from_str(field("page: RESULT ")).unwrap();
+    assert!(r.get("failure").is_none(), "{r}");
+    // The default scene, loaded through the installed package: `format` is absent
+    // (undefined), not null, and the splats are on the canvas.
+    assert_eq!(r["splats"], 6527, "{r}");
+    assert!(r.get("format").is_none(), "{r}");
+    assert!(r["litPixels"].as_u64().unwrap() > 10_000, "{r}");
 }
