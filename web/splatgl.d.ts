@@ -29,8 +29,9 @@ export interface View {
   fovDeg: number;
 }
 
-/** Where `draw` blends: floating point resolved into the canvas (default), or 8 bits. */
-export type Target = 'rgba16f' | 'rgba8';
+/** Where `draw` blends: floating point (RGBA32F where the browser can blend it, else RGBA16F)
+ * resolved into the canvas (the default), or the canvas's 8 bits. */
+export type Target = 'float' | 'rgba8';
 
 /** A splat renderer on one WebGL2 canvas. */
 export interface Renderer {
@@ -45,7 +46,7 @@ export interface Renderer {
   /** Clears to `background` and draws (cull, sort back to front, blend); returns the CPU
    * milliseconds spent. */
   draw(background?: Vec3): number;
-  /** Where `draw` blends (default 'rgba16f'). */
+  /** Where `draw` blends (default 'float'). */
   setTarget(target: Target): void;
   /** Returns once the GL has drawn everything asked of it. */
   finish(): void;

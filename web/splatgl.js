@@ -38,8 +38,9 @@ class SplatglRenderer {
   /** Loads the bundled default scene. */
   loadDefault() { return info(this.inner.load_default()); }
 
-  /** Where `draw` blends: 'rgba16f' (the default: floating-point blending, resolved into the
-   * canvas) or 'rgba8' (in the canvas's 8 bits: colours above 1 clamped per splat). */
+  /** Where `draw` blends: 'float' (the default: RGBA32F where the browser blends it, else
+   * RGBA16F, resolved into the canvas) or 'rgba8' (in the canvas's 8 bits: colours above 1
+   * clamped per splat). */
   setTarget(target) { this.inner.set_target(target); }
 
   /** Frees the renderer's GPU objects and its memory in the module; any later call throws. */

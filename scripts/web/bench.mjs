@@ -3,8 +3,9 @@
 // browser (headless Chromium, SwiftShader WebGL2), on the same scene, cameras and canvas size:
 //
 //   node scripts/web/bench.mjs SCENE [OUT.json] [--width 1280] [--height 720] [--frames 10]
-//        [--engines splatgl,gs3d,spark,playcanvas] [--splatgl PATH]
+//        [--engines splatgl,gs3d,spark,playcanvas] [--splatgl PATH] [--target float|rgba8]
 //
+// --target: where splatgl-web blends (`setTarget`; default its own default, float).
 // --splatgl: the `splatgl` command used to convert the scene (default: target/release/splatgl,
 // else target/debug/splatgl, else built with `cargo build --release -p splatgl-cli`); web/dist
 // is built (`scripts/web.sh build`) when it is missing.
@@ -63,6 +64,7 @@ if (args[0] === '--child') {
   const width = Number(opt('--width', '1280'));
   const height = Number(opt('--height', '720'));
   const frames = Number(opt('--frames', '10'));
+  const splatglTarget = opt('--target', undefined);
   const given = opt('--splatgl', null);
   const [scene, outJson] = args;
   if (!scene) { console.error('usage: bench.mjs SCENE [OUT.json] [--width W] [--height H] [--frames N] [--engines E,..] [--splatgl PATH]'); process.exit(2); }
@@ -88,7 +90,7 @@ if (args[0] === '--child') {
     return v.map((x, i) => target[i] + x * Math.cos(a) + c[i] * Math.sin(a) + u[i] * d * (1 - Math.cos(a)));
   };
   const views = [eye, orbit(40), orbit(-40)].map((e, camera) => ({
-    file: '/files/scene.ply', width, height, eye: e, target, up, fovDeg, camera, frames,
+    file: '/files/scene.ply', width, height, eye: e, target, up, fovDeg, camera, frames, splatglTarget,
   }));
   fs.writeFileSync(path.join(tmp, 'views.json'), JSON.stringify(views));
   const results = [];

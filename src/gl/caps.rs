@@ -37,6 +37,15 @@ pub(crate) fn limit(gl: &glow::Context, pname: u32) -> i32 {
     injected.unwrap_or_else(|| unsafe { gl.get_parameter_i32(pname) })
 }
 
+/// Whether `gl` can render to and blend in an RGBA32F framebuffer: desktop GL, or ES with
+/// `GL_EXT_color_buffer_float` and `GL_EXT_float_blend`.
+pub fn can_blend_rgba32f(gl: &glow::Context) -> bool {
+    use glow::HasContext;
+    !gl.version().is_embedded
+        || (has_extension(gl, "GL_EXT_color_buffer_float")
+            && has_extension(gl, "GL_EXT_float_blend"))
+}
+
 /// Whether `gl` can render to (and blend in) an RGBA16F framebuffer: desktop GL, or ES with
 /// `GL_EXT_color_buffer_half_float` or `GL_EXT_color_buffer_float`.
 pub fn can_render_rgba16f(gl: &glow::Context) -> bool {

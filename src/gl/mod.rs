@@ -66,7 +66,7 @@ mod target;
 mod uniforms;
 mod view;
 
-pub use caps::can_render_rgba16f;
+pub use caps::{can_blend_rgba32f, can_render_rgba16f};
 pub use error::GlError;
 pub(crate) use error::check_error;
 // The review draft's errata as shader switches: for the erratum proof (feature `testing`).

@@ -26,6 +26,9 @@ pub enum ColorFormat {
     /// `RGBA16F`: half float, unclamped. On OpenGL ES needs `EXT_color_buffer_float` or
     /// `EXT_color_buffer_half_float`.
     Rgba16f,
+    /// `RGBA32F`: single float, unclamped. On OpenGL ES needs `EXT_color_buffer_float`, and
+    /// `EXT_float_blend` to blend in it.
+    Rgba32f,
 }
 
 impl ColorFormat {
@@ -34,6 +37,7 @@ impl ColorFormat {
             ColorFormat::Rgba8 => glow::RGBA8,
             ColorFormat::Srgb8Alpha8 => glow::SRGB8_ALPHA8,
             ColorFormat::Rgba16f => glow::RGBA16F,
+            ColorFormat::Rgba32f => glow::RGBA32F,
         }
     }
 }
@@ -196,7 +200,7 @@ impl ReadbackTarget {
                 flip_rows(&mut bytes, w * 4);
                 Image::from_rgba8(self.width, self.height, &bytes)
             }
-            ColorFormat::Rgba16f => {
+            ColorFormat::Rgba16f | ColorFormat::Rgba32f => {
                 let mut pixels = vec![[0.0f32; 4]; w * h];
                 self.read_into(gl, glow::FLOAT, bytemuck::cast_slice_mut(&mut pixels));
                 flip_rows(&mut pixels, w);

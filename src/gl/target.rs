@@ -65,10 +65,26 @@ impl ResolvePass {
 }
 
 impl OffscreenTarget {
-    /// Creates a `width × height` target. On OpenGL ES it needs `EXT_color_buffer_float` or
-    /// `EXT_color_buffer_half_float` (rendering to `RGBA16F`).
+    /// Creates a `width × height` `RGBA16F` target. On OpenGL ES it needs
+    /// `EXT_color_buffer_float` or `EXT_color_buffer_half_float` (rendering to `RGBA16F`).
     pub fn new(gl: &glow::Context, width: u32, height: u32) -> Result<Self, GlError> {
-        let mut target = ReadbackTarget::new(gl, width, height, ColorFormat::Rgba16f, None)?;
+        Self::with_format(gl, width, height, ColorFormat::Rgba16f)
+    }
+
+    /// [`OffscreenTarget::new`] blending in `format`: `Rgba32f` needs, on OpenGL ES,
+    /// `EXT_color_buffer_float` and `EXT_float_blend` ([`super::can_blend_rgba32f`]). Single
+    /// floats are the cheaper float where blending is done in software: SwiftShader (the
+    /// browser's WebGL2 without a GPU) blends half floats 1.7× slower than bytes and single
+    /// floats as fast as bytes (`docs/performance.md`); they also round less (llvmpipe, biker
+    /// at 1280×720 against the CPU reference: 76.0 dB, max 1/255, where `RGBA16F` gives
+    /// 64.1 dB, max 3/255).
+    pub fn with_format(
+        gl: &glow::Context,
+        width: u32,
+        height: u32,
+        format: ColorFormat,
+    ) -> Result<Self, GlError> {
+        let mut target = ReadbackTarget::new(gl, width, height, format, None)?;
         match ResolvePass::new(gl) {
             Ok(pass) => Ok(OffscreenTarget {
                 target,

@@ -14,7 +14,7 @@ use splatgl::camera::{Camera, GltfPerspective, SceneView, ViewOptions};
 use splatgl::cloud::ColorSpace;
 use splatgl::files::Format;
 use splatgl::gl::frame::{Blend, FrameTargets, Output};
-use splatgl::gl::{DrawSettings, OffscreenTarget, SplatRenderer};
+use splatgl::gl::{ColorFormat, DrawSettings, OffscreenTarget, SplatRenderer};
 use splatgl::image::PngDepth;
 use splatgl::load::{LoadOptions, load_bytes};
 use wasm_bindgen::JsCast;
@@ -198,7 +198,8 @@ impl Renderer {
 
     /// Clears the canvas to `background` (RGB, 0–1) and draws the loaded cloud for the camera
     /// of [`Renderer::set_camera`]: culled, sorted back to front and blended — by default in
-    /// an RGBA16F target resolved into the canvas (sRGB-encoding `lin_rec709_display`
+    /// a float target (RGBA32F where the browser can blend it, else RGBA16F) resolved into the
+    /// canvas (sRGB-encoding `lin_rec709_display`
     /// clouds), with `set_target("rgba8")` directly in the canvas. Returns the milliseconds it
     /// took on the CPU (sort and GL calls; the GPU may still be drawing).
     pub fn draw(&mut self, r: f32, g: f32, b: f32) -> Result<f64, JsError> {
@@ -237,12 +238,20 @@ impl Renderer {
             if let Some(mut t) = self.float.take() {
                 t.destroy(&self.gl);
             }
-            let t = OffscreenTarget::new(&self.gl, size.0, size.1).map_err(|e| {
-                JsError::new(&format!(
-                    "no RGBA16F target for float blending ({e}); set_target(\"rgba8\") blends \
+            // Single floats where the browser blends them (EXT_float_blend): SwiftShader blends
+            // them as fast as bytes, half floats 1.7× slower (docs/performance.md).
+            let format = if splatgl::gl::can_blend_rgba32f(&self.gl) {
+                ColorFormat::Rgba32f
+            } else {
+                ColorFormat::Rgba16f
+            };
+            let t =
+                OffscreenTarget::with_format(&self.gl, size.0, size.1, format).map_err(|e| {
+                    JsError::new(&format!(
+                        "no RGBA16F target for float blending ({e}); set_target(\"rgba8\") blends \
                      in the canvas's 8 bits"
-                ))
-            })?;
+                    ))
+                })?;
             self.float = Some(t);
         }
         let target = self.float.as_mut().expect("made above");
@@ -258,17 +267,17 @@ impl Renderer {
         Ok(now_ms() - started)
     }
 
-    /// Where `draw` blends: `"rgba16f"` (the default: floating-point blending resolved into
-    /// the canvas, as the RC recommends) or `"rgba8"` (directly in the canvas: faster where
-    /// fill is the cost, colours above 1 clamped per splat — the kit's `overbright_blending`
-    /// asset fails it).
+    /// Where `draw` blends: `"float"` (the default: floating-point blending — RGBA32F where
+    /// the browser can blend it, else RGBA16F — resolved into the canvas, as the RC
+    /// recommends) or `"rgba8"` (directly in the canvas: no target to resolve, but colours
+    /// above 1 are clamped per splat — the kit's `overbright_blending` asset fails it).
     pub fn set_target(&mut self, target: &str) -> Result<(), JsError> {
         self.float_blending = match target {
-            "rgba16f" => true,
+            "float" => true,
             "rgba8" => false,
             other => {
                 return Err(JsError::new(&format!(
-                    "target {other:?}: expected \"rgba16f\" or \"rgba8\""
+                    "target {other:?}: expected \"float\" or \"rgba8\""
                 )));
             }
         };
