@@ -3,8 +3,9 @@
 // browser (headless Chromium, SwiftShader WebGL2), on the same scene, cameras and canvas size:
 //
 //   node scripts/web/bench.mjs SCENE [OUT.json] [--width 1280] [--height 720] [--frames 10]
-//        [--engines splatgl,gs3d,spark,playcanvas] [--splatgl PATH] [--target float|rgba8]
+//        [--engines splatgl,gs3d,spark,playcanvas] [--splatgl PATH] [--target float|rgba8] [--warm 5]
 //
+// --warm: untimed frames per camera before the timed ones (fewer for large scenes).
 // --target: where splatgl-web blends (`setTarget`; default its own default, float).
 // --splatgl: the `splatgl` command used to convert the scene (default: target/release/splatgl,
 // else target/debug/splatgl, else built with `cargo build --release -p splatgl-cli`); web/dist
@@ -65,6 +66,7 @@ if (args[0] === '--child') {
   const height = Number(opt('--height', '720'));
   const frames = Number(opt('--frames', '10'));
   const splatglTarget = opt('--target', undefined);
+  const warm = Number(opt('--warm', '5'));
   const given = opt('--splatgl', null);
   const [scene, outJson] = args;
   if (!scene) { console.error('usage: bench.mjs SCENE [OUT.json] [--width W] [--height H] [--frames N] [--engines E,..] [--splatgl PATH]'); process.exit(2); }
@@ -90,7 +92,7 @@ if (args[0] === '--child') {
     return v.map((x, i) => target[i] + x * Math.cos(a) + c[i] * Math.sin(a) + u[i] * d * (1 - Math.cos(a)));
   };
   const views = [eye, orbit(40), orbit(-40)].map((e, camera) => ({
-    file: '/files/scene.ply', width, height, eye: e, target, up, fovDeg, camera, frames, splatglTarget,
+    file: '/files/scene.ply', width, height, eye: e, target, up, fovDeg, camera, frames, warm, splatglTarget,
   }));
   fs.writeFileSync(path.join(tmp, 'views.json'), JSON.stringify(views));
   const results = [];
