@@ -33,6 +33,16 @@ export interface View {
  * resolved into the canvas (the default), or the canvas's 8 bits. */
 export type Target = 'float' | 'rgba8';
 
+/** GPU milliseconds of the stages of one draw (undefined: the stage did not run). */
+export interface StageTimes {
+  /** The pre-pass: the per-splat maths, once per splat (transform feedback). */
+  prepassMs?: number;
+  /** The copy of the pre-pass's records into the records texture. */
+  copyMs?: number;
+  /** The quads: vertices, rasterisation, fragments, blending. */
+  quadsMs?: number;
+}
+
 /** A splat renderer on one WebGL2 canvas. */
 export interface Renderer {
   /** Loads a file from its bytes; `name`'s extension helps detect the format. Throws with the
@@ -61,6 +71,12 @@ export interface Renderer {
   readonly splatCount: number;
   /** GL_VERSION / GL_RENDERER and whether RGBA16F blending is available. */
   glInfo(): string;
+  /** Times each GPU stage of every draw from now on (or stops); throws where the browser has
+   * no EXT_disjoint_timer_query_webgl2. */
+  setStageTiming(on: boolean): void;
+  /** GPU milliseconds of the last draw's stages (undefined until the page has returned to its
+   * event loop after the draw: ask a frame later). */
+  stageTimes(): StageTimes;
   /** Frees the renderer's GPU objects and its module memory; any later call throws. */
   dispose(): void;
 }

@@ -43,6 +43,18 @@ class SplatglRenderer {
    * clamped per splat). */
   setTarget(target) { this.inner.set_target(target); }
 
+  /** Times each GPU stage of every draw from now on (or stops): throws where the browser has
+   * no EXT_disjoint_timer_query_webgl2. */
+  setStageTiming(on) { this.inner.set_stage_timing(on); }
+
+  /** GPU milliseconds of the last draw's stages: { prepassMs, copyMs, quadsMs }, each
+   * undefined when it did not run, timing is off, or the result is not there yet (WebGL
+   * gives results only after the page returned to its event loop: ask a frame later). */
+  stageTimes() {
+    const t = JSON.parse(this.inner.stage_times());
+    return { prepassMs: t.prepass_ms ?? undefined, copyMs: t.copy_ms ?? undefined, quadsMs: t.quads_ms ?? undefined };
+  }
+
   /** Frees the renderer's GPU objects and its memory in the module; any later call throws. */
   dispose() {
     if (!this.inner) return;

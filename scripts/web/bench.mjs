@@ -118,6 +118,10 @@ if (args[0] === '--child') {
     const mu = mean(e);
     console.log(`${e.padEnd(18)} ${per} ms${mu && base ? `  mean ${mu.toFixed(1)} ms = ${(mu / base).toFixed(2)}× splatgl-web` : ''}`);
   }
+  for (const r of results.filter((x) => x.stages)) {
+    const s = r.stages, f = (x) => (x === undefined ? '—' : x.toFixed(1));
+    console.log(`splatgl-web camera ${r.camera + 1} GPU stages: pre-pass ${f(s.prepassMs)} ms, copy ${f(s.copyMs)} ms, quads ${f(s.quadsMs)} ms${s.error ? ` (${s.error})` : ''}`);
+  }
   const sort = results.find((r) => r.sortMs1M !== undefined);
   if (sort) console.log(`splatgl sort of 1M splats in wasm: ${sort.sortMs1M.toFixed(1)} ms`);
   const missing = engines.length - names.length;

@@ -9,6 +9,7 @@ use super::GlError;
 use super::prepass::PREPASS_MIN_SPLATS;
 use super::renderer::SplatRenderer;
 use super::settings::{DrawSettings, Pipeline};
+use super::stages::Stage;
 use super::state::{self, DrawState};
 use super::view::ViewParams;
 use crate::camera::Camera;
@@ -131,25 +132,32 @@ impl SplatRenderer {
             srgb: space == ColorSpace::LinRec709Display,
         };
         let (saved, entered) = state::draw::enter(gl, self.ctx, &want, settings.restore_state);
+        if let Some(q) = &self.stages {
+            q.reset();
+        }
         match prepass {
             Some(p) if self.instances > 0 => {
                 // Per-splat maths once per splat into the records, then the quads read them,
                 // in batches of QUADS_PER_INSTANCE.
+                let n = self.instances;
                 p.bind(gl);
                 self.set_uniforms(gl, &p.prep_uniforms, view, settings);
-                p.capture(gl, self.instances, view.viewport);
-                p.draw_quads(gl, self.instances);
+                self.timed(gl, Stage::PrePass, || p.capture(gl, n));
+                self.timed(gl, Stage::Copy, || p.copy_records(gl, n));
+                p.bind_quads(gl, n, view.viewport);
+                self.timed(gl, Stage::Quads, || p.draw_quads(gl, n));
             }
             Some(_) => {}
             None => {
                 self.set_uniforms(gl, &self.uniforms, view, settings);
                 if self.instances > 0 {
+                    let n = self.instances as i32;
                     // SAFETY: draws `instances` instances of the direct VAO, which reads the
                     // order buffer that `set_order` bounded by its size (the shader culls any
                     // index past the uploaded splats).
-                    unsafe {
-                        gl.draw_arrays_instanced(glow::TRIANGLE_STRIP, 0, 4, self.instances as i32)
-                    };
+                    self.timed(gl, Stage::Quads, || unsafe {
+                        gl.draw_arrays_instanced(glow::TRIANGLE_STRIP, 0, 4, n)
+                    });
                 }
             }
         }
@@ -161,5 +169,13 @@ impl SplatRenderer {
             sets: entered.sets + left.sets,
         });
         Ok(())
+    }
+
+    /// Runs `f` inside the timer query of `stage` when stage timing is on.
+    fn timed<T>(&self, gl: &glow::Context, stage: Stage, f: impl FnOnce() -> T) -> T {
+        match &self.stages {
+            Some(q) => q.time(gl, stage, f),
+            None => f(),
+        }
     }
 }

@@ -46,6 +46,7 @@ pub(crate) mod data;
 mod draw;
 mod error;
 pub mod frame;
+mod stages;
 // Fault injection for the GL tests: only with the `testing` feature (hidden); without it every
 // lookup (`caps`) is the driver's answer and nothing thread-local is read on a production path.
 #[cfg(feature = "testing")]
@@ -91,6 +92,7 @@ pub use settings::{DepthFunc, DrawSettings, FrameSort};
 pub use settings::{DrawPath, Pipeline};
 #[allow(deprecated)]
 pub use sort::{DistanceSorter, sort_back_to_front};
+pub use stages::StageTimes;
 #[cfg(feature = "testing")]
 #[doc(hidden)]
 pub use state::StateCalls;

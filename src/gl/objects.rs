@@ -75,6 +75,7 @@ pub(crate) enum GlObject {
     Buffer(glow::Buffer),
     VertexArray(glow::VertexArray),
     TransformFeedback(glow::TransformFeedback),
+    Query(glow::Query),
 }
 
 impl GlObject {
@@ -92,6 +93,7 @@ impl GlObject {
                 GlObject::Buffer(o) => gl.delete_buffer(o),
                 GlObject::VertexArray(o) => gl.delete_vertex_array(o),
                 GlObject::TransformFeedback(o) => gl.delete_transform_feedback(o),
+                GlObject::Query(o) => gl.delete_query(o),
             }
         }
     }
@@ -190,6 +192,8 @@ creators! {
     vertex_array: VertexArray = create_vertex_array, "vertex array";
     /// A new transform-feedback object.
     transform_feedback: TransformFeedback = create_transform_feedback, "transform feedback";
+    /// A new query object.
+    query: Query = create_query, "query";
 }
 
 impl Drop for Creating<'_> {

@@ -255,20 +255,14 @@ impl PrePass {
         }
     }
 
-    /// Captures the records of the first `n` splats of the order (≤ the capacity), copies
-    /// them into the records texture, then binds the quad program (its uniforms set for `n`
-    /// splats in `viewport`), its vertex array, and the records texture on unit 0. Leaves the
-    /// default transform-feedback object bound, `GL_RASTERIZER_DISCARD` disabled, no
-    /// pixel-unpack buffer and unit 1 active (as a draw sets them, see [`super::state`]; the
-    /// draw set the unpack parameters the copy needs).
-    pub(super) fn capture(&self, gl: &glow::Context, n: usize, viewport: [i32; 4]) {
+    /// Captures the records of the first `n` splats of the order (≤ the capacity). Leaves the
+    /// default transform-feedback object bound and `GL_RASTERIZER_DISCARD` disabled (as a
+    /// draw sets them, see [`super::state`]).
+    pub(super) fn capture(&self, gl: &glow::Context, n: usize) {
         let n = n.min(self.capacity);
-        let width = self.layout.width();
-        let layer_rows = self.layout.layer_rows();
         // SAFETY: one POINTS draw of `n ≤ capacity` vertices into the records buffer (bound
         // to the transform-feedback object's binding 0 at creation), which holds `capacity`
-        // records; then copies of whole rows of it, inside both the buffer and the texture
-        // (sized for `capacity` records in whole rows); then the quad program and objects.
+        // records.
         unsafe {
             gl.bind_transform_feedback(glow::TRANSFORM_FEEDBACK, Some(self.tf));
             gl.enable(glow::RASTERIZER_DISCARD);
@@ -277,6 +271,19 @@ impl PrePass {
             gl.end_transform_feedback();
             gl.disable(glow::RASTERIZER_DISCARD);
             gl.bind_transform_feedback(glow::TRANSFORM_FEEDBACK, None);
+        }
+    }
+
+    /// Copies the first `n` captured records into the records texture and binds it on unit 0;
+    /// leaves no pixel-unpack buffer bound and unit 1 active (the draw set the unpack
+    /// parameters the copy needs, see [`super::state`]).
+    pub(super) fn copy_records(&self, gl: &glow::Context, n: usize) {
+        let n = n.min(self.capacity);
+        let width = self.layout.width();
+        let layer_rows = self.layout.layer_rows();
+        // SAFETY: copies of whole rows of the records buffer, inside both the buffer and the
+        // texture (sized for `capacity` records in whole rows).
+        unsafe {
             gl.active_texture(glow::TEXTURE0);
             gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.records_texture));
             gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, Some(self.records));
@@ -303,6 +310,16 @@ impl PrePass {
             }
             gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, None);
             gl.active_texture(glow::TEXTURE1);
+        }
+    }
+
+    /// Binds the quad program (its uniforms set for `n` splats in `viewport`) and its vertex
+    /// array.
+    pub(super) fn bind_quads(&self, gl: &glow::Context, n: usize, viewport: [i32; 4]) {
+        let n = n.min(self.capacity);
+        // SAFETY: binds the pre-pass's own quad program and vertex array and sets its
+        // uniforms with values of the declared types.
+        unsafe {
             gl.use_program(Some(self.quad));
             gl.bind_vertex_array(Some(self.quad_vao));
             let u = &self.quad_uniforms;
@@ -314,7 +331,7 @@ impl PrePass {
     }
 
     /// Draws the quads of the first `n` records captured: `⌈n / QUADS_PER_INSTANCE⌉`
-    /// instances of one batch (bound by [`PrePass::capture`]).
+    /// instances of one batch (bound by [`PrePass::bind_quads`]).
     pub(super) fn draw_quads(&self, gl: &glow::Context, n: usize) {
         let n = n.min(self.capacity);
         let instances = n.div_ceil(QUADS_PER_INSTANCE) as i32;

@@ -74,6 +74,8 @@ pub struct SplatRenderer {
     pub(super) host_sort: Option<super::host_sort::HostSort>,
     /// Whether the storage is pages ([`SplatRenderer::allocate_pages`]).
     paged: bool,
+    /// The timer queries of [`SplatRenderer::set_stage_timing`] (off: `None`).
+    pub(super) stages: Option<super::stages::StageQueries>,
 }
 
 impl SplatRenderer {
@@ -153,6 +155,7 @@ impl SplatRenderer {
             owned: objects.keep("SplatRenderer"),
             host_sort: None,
             paged: false,
+            stages: None,
         })
     }
 
@@ -501,6 +504,9 @@ impl SplatRenderer {
         if let Some(mut p) = self.prepass.take() {
             p.destroy(gl);
         }
+        if let Some(mut q) = self.stages.take() {
+            q.destroy(gl);
+        }
         self.owned.destroy(gl);
         self.host_sort = None;
         self.order_capacity = 0;
@@ -514,6 +520,9 @@ impl SplatRenderer {
         }
         if let Some(mut p) = self.prepass.take() {
             p.abandon();
+        }
+        if let Some(mut q) = self.stages.take() {
+            q.abandon();
         }
         self.owned.abandon();
     }

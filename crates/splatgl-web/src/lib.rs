@@ -284,6 +284,31 @@ impl Renderer {
         Ok(())
     }
 
+    /// Times each GPU stage of every draw from now on (`true`) or stops (`false`): an error
+    /// where the browser has no `EXT_disjoint_timer_query_webgl2`.
+    pub fn set_stage_timing(&mut self, on: bool) -> Result<(), JsError> {
+        self.live()?;
+        self.renderer
+            .set_stage_timing(&self.gl, on)
+            .map_err(js_error)
+    }
+
+    /// The GPU milliseconds of each stage of the last draw as JSON: `prepass_ms`, `copy_ms`,
+    /// `quads_ms` (each absent when that stage did not run, the timer was disturbed, or the
+    /// result is not available yet: WebGL gives results only after the page returned to its
+    /// event loop — ask a frame later); `{}` when stage timing is off.
+    pub fn stage_times(&self) -> String {
+        let Some(t) = self.renderer.stage_times(&self.gl) else {
+            return "{}".into();
+        };
+        serde_json::json!({
+            "prepass_ms": t.prepass_ms,
+            "copy_ms": t.copy_ms,
+            "quads_ms": t.quads_ms,
+        })
+        .to_string()
+    }
+
     /// Frees every GPU object the renderer made (textures, buffers, programs, targets; the
     /// canvas's context stays the page's). Afterwards every call but `dispose` is an error.
     pub fn dispose(&mut self) {
