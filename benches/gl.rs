@@ -150,6 +150,9 @@ struct Row {
     draw: f64,
     draw_cpu: f64,
     prepass: bool,
+    /// GPU time of each stage of one more frame (timer queries; `None` where the context has
+    /// none).
+    stages: Option<splatgl::gl::StageTimes>,
 }
 
 impl Row {
@@ -243,9 +246,17 @@ impl Bench<'_> {
                     draw: ms(t2 - t1),
                     draw_cpu: ms(c2 - c1),
                     prepass: renderer.last_draw_used_prepass(),
+                    stages: None,
                 });
             }
         }
+        // One more frame, timed per stage on the GPU (not part of the medians).
+        let stages = renderer.set_stage_timing(gl, true).ok().and_then(|()| {
+            renderer.draw_current(gl, cam).unwrap();
+            let t = renderer.stage_times(gl);
+            renderer.set_stage_timing(gl, false).unwrap();
+            t
+        });
         let pick = |f: fn(&Row) -> f64| median(&mut rows.iter().map(f).collect::<Vec<_>>());
         Row {
             drawn: pick(|r| r.drawn as f64) as usize,
@@ -261,8 +272,18 @@ impl Bench<'_> {
             draw: pick(|r| r.draw),
             draw_cpu: pick(|r| r.draw_cpu),
             prepass: rows[0].prepass,
+            stages,
         }
     }
+}
+
+/// The GPU stage times as `pre-pass / copy / quads` ms (`-` for a stage that did not run).
+fn stage_cells(t: Option<splatgl::gl::StageTimes>) -> String {
+    let Some(t) = t else {
+        return "no timer queries".into();
+    };
+    let f = |v: Option<f64>| v.map_or("-".into(), |ms| format!("{ms:.1}"));
+    format!("{} / {} / {}", f(t.prepass_ms), f(t.copy_ms), f(t.quads_ms))
 }
 
 /// `cam` moved by `angle` radians on a circle about the vertical through `target`, turned
@@ -426,7 +447,7 @@ fn main() {
         size: (w, h),
     };
     println!(
-        "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8} | {:>9} | {:>11} | {:>9} | {:>7} | pre-pass",
+        "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8} | {:>9} | {:>11} | {:>9} | {:>7} | pre-pass | GPU ms: pre-pass / copy / quads",
         "scene",
         "view",
         "path",
@@ -456,7 +477,7 @@ fn main() {
                 }
                 let r = b.run(&cloud, &bounds, &c, target, path);
                 println!(
-                    "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8.2} | {:>9.1} | {:>11.1} | {:>9.1} | {:>7.2} | {}",
+                    "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8.2} | {:>9.1} | {:>11.1} | {:>9.1} | {:>7.2} | {:>8} | {}",
                     name,
                     view,
                     path.name(),
@@ -467,7 +488,8 @@ fn main() {
                     r.draw_cpu,
                     r.frame(),
                     1e3 / r.frame(),
-                    if r.prepass { "yes" } else { "no" }
+                    if r.prepass { "yes" } else { "no" },
+                    stage_cells(r.stages)
                 );
                 rows.push(r);
             }

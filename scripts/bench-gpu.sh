@@ -22,11 +22,12 @@ SPLATGL_BENCH_PREDICT=0 \
 grep -m1 '^context:' "$log"
 grep -m1 '^framebuffer' "$log"
 echo
-printf '%-7s %-5s %-7s %10s %10s %9s\n' scene view path drawn "frame ms" "frames/s"
+printf '%-7s %-5s %-7s %10s %10s %9s  %s\n' scene view path drawn "frame ms" "frames/s" "GPU ms: pre-pass / copy / quads"
 # Rows of the main table: scene | view | path | drawn | fragments | sort | draw | CPU | frame | fps | pre-pass
+# | GPU stages (timer queries: where the frame goes on the GPU)
 awk -F'|' 'NF >= 11 && $2 ~ /full|half/ && $3 ~ /former|cull|extent|new/ {
     gsub(/ /, "", $1); gsub(/ /, "", $2); gsub(/ /, "", $3)
-    printf "%-7s %-5s %-7s %10d %10.1f %9.2f\n", $1, $2, $3, $4, $9, $10
+    printf "%-7s %-5s %-7s %10d %10.1f %9.2f  %s\n", $1, $2, $3, $4, $9, $10, $12
 }' "$log"
 echo
 # The speed-up summary and, if asked for, the crossover table.

@@ -130,7 +130,9 @@ impl StageQueries {
 impl SplatRenderer {
     /// Times each stage of every draw on the GPU from now on (`true`), or stops (`false`),
     /// for [`SplatRenderer::stage_times`]. Errors where the context has no `GL_TIME_ELAPSED`
-    /// queries. Costs a query per stage per draw; nothing when off (the default).
+    /// queries. Costs a query per stage per draw; nothing when off (the default). While it is
+    /// on, the host must not have a `GL_TIME_ELAPSED` query of its own active during a draw
+    /// (GL allows one at a time).
     pub fn set_stage_timing(&mut self, gl: &glow::Context, on: bool) -> Result<(), GlError> {
         self.owned.check()?;
         match (on, self.stages.take()) {

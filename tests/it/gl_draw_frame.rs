@@ -160,3 +160,38 @@ fn draw_frame_refuses_what_it_cannot_draw() {
     s.draw_with_matrices(gl, view, proj, VIEWPORT).unwrap();
     s.destroy(gl);
 }
+
+#[test]
+fn stage_timing_reports_the_stages_each_path_ran_and_changes_no_pixel() {
+    use splatgl::gl::StageTimes;
+    let Some(ctx) = or_skip(HeadlessContext::with_api(GlApi::DesktopCore33), "context") else {
+        return;
+    };
+    ctx.make_current().unwrap();
+    let gl = ctx.gl();
+    let (cloud, cam) = scene();
+    let mut r = uploaded(gl, &cloud);
+    let (view, proj) = (cam.gl_view(), cam.gl_projection());
+    assert_eq!(r.stage_times(gl), None, "off by default");
+    let untimed = image(gl, &mut r, |r| r.draw_frame(gl, view, proj, VIEWPORT));
+    r.set_stage_timing(gl, true).unwrap();
+    let timed = image(gl, &mut r, |r| r.draw_frame(gl, view, proj, VIEWPORT));
+    assert_eq!(timed.pixels, untimed.pixels, "timing changed the image");
+    // 3000 splats: the pre-pass path, all three stages.
+    let t = r.stage_times(gl).unwrap();
+    let ok = |v: Option<f64>| v.is_some_and(|ms| ms.is_finite() && ms >= 0.0);
+    assert!(ok(t.prepass_ms) && ok(t.copy_ms) && ok(t.quads_ms), "{t:?}");
+    assert!(t.quads_ms.unwrap() > 0.0, "{t:?}");
+    // A few splats: the direct path, quads only.
+    let few = synthetic::random_cloud(10, 1, 0.7, 3);
+    r.upload(gl, &few).unwrap();
+    image(gl, &mut r, |r| r.draw_frame(gl, view, proj, VIEWPORT));
+    let t = r.stage_times(gl).unwrap();
+    assert!(
+        t.prepass_ms.is_none() && t.copy_ms.is_none() && ok(t.quads_ms),
+        "{t:?}"
+    );
+    r.set_stage_timing(gl, false).unwrap();
+    assert_eq!(r.stage_times(gl), None::<StageTimes>);
+    r.destroy(gl);
+}
