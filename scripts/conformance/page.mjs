@@ -5,6 +5,18 @@
 /** Sends a line to the adapter's stderr. */
 export const log = (m) => fetch('/log', { method: 'POST', body: String(m) });
 
+/** Pixels of `canvas` (any canvas the page may read) brighter than near-black (R+G+B > 30). */
+export function litPixels(canvas) {
+  const probe = document.createElement('canvas');
+  probe.width = canvas.width; probe.height = canvas.height;
+  const ctx = probe.getContext('2d');
+  ctx.drawImage(canvas, 0, 0);
+  const px = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
+  let lit = 0;
+  for (let i = 0; i < px.length; i += 4) if (px[i] + px[i + 1] + px[i + 2] > 30) lit++;
+  return lit;
+}
+
 /** Resolves at the next animation frame. */
 export const frame = () => new Promise((r) => requestAnimationFrame(r));
 

@@ -233,20 +233,27 @@ fn allocate_texture(
         gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(tex));
         let (w, h, d) = (layout.width() as i32, height as i32, layers as i32);
         gl.tex_storage_3d(glow::TEXTURE_2D_ARRAY, 1, internal_format, w, h, d);
-        for (pname, v) in [
-            (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
-            (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
-            (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
-            (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
-        ] {
-            gl.tex_parameter_i32(glow::TEXTURE_2D_ARRAY, pname, v as i32);
-        }
+        nearest_texel_reads(gl);
     }
     Ok((tex, RowTarget { height, rows_total }))
 }
 
 /// Where a write goes: the texture bound to `TEXTURE_2D_ARRAY`, `height` rows a layer, of
 /// which it may touch rows below `rows_total`.
+/// The bound `TEXTURE_2D_ARRAY` read texel by texel: `NEAREST`, clamped to its edges (the
+/// data and records textures are read with `texelFetch`; RGBA32F is not filterable on ES 3.0).
+pub(crate) fn nearest_texel_reads(gl: &glow::Context) {
+    for (pname, v) in [
+        (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+        (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+        (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+        (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+    ] {
+        // SAFETY: a texture parameter of the bound 2D array texture, valid enums.
+        unsafe { gl.tex_parameter_i32(glow::TEXTURE_2D_ARRAY, pname, v as i32) };
+    }
+}
+
 #[derive(Debug, Clone, Copy)]
 struct RowTarget {
     height: usize,

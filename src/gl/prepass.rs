@@ -225,14 +225,7 @@ impl PrePass {
                 glow::FLOAT,
                 glow::PixelUnpackData::Slice(None),
             );
-            for (pname, v) in [
-                (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
-                (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
-                (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
-                (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
-            ] {
-                gl.tex_parameter_i32(glow::TEXTURE_2D_ARRAY, pname, v as i32);
-            }
+            super::data::nearest_texel_reads(gl);
             gl.bind_texture(glow::TEXTURE_2D_ARRAY, host_tex);
             if host_unpack.is_some() {
                 gl.bind_buffer(glow::PIXEL_UNPACK_BUFFER, host_unpack);
