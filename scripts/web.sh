@@ -70,6 +70,6 @@ case "$cmd" in
     echo "http://127.0.0.1:$port/ (web/dist; Ctrl-C stops)"
     exec python3 -m http.server "$port" --bind 127.0.0.1 --directory web/dist ;;
   *)
-    sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2 ;;
 esac
