@@ -118,6 +118,11 @@ if (args[0] === '--child') {
     const mu = mean(e);
     console.log(`${e.padEnd(18)} ${per} ms${mu && base ? `  mean ${mu.toFixed(1)} ms = ${(mu / base).toFixed(2)}× splatgl-web` : ''}`);
   }
+  // What each engine asked of WebGL (common.mjs wraps the context's methods), camera 1.
+  for (const r of results.filter((x) => x.camera === 0 && x.gl)) {
+    const g = r.gl, mb = (b) => (b / 1048576).toFixed(1);
+    console.log(`${r.engine.padEnd(18)} per frame: ${g.draws} draw calls, ${g.instances} instances, ${g.vertices} vertices; allocated: textures ${mb(g.textureBytes)} MiB, buffers ${mb(g.bufferBytes)} MiB`);
+  }
   for (const r of results.filter((x) => x.stages)) {
     const s = r.stages, f = (x) => (x === undefined ? '—' : x.toFixed(1));
     console.log(`splatgl-web camera ${r.camera + 1} GPU stages: pre-pass ${f(s.prepassMs)} ms, copy ${f(s.copyMs)} ms, quads ${f(s.quadsMs)} ms${s.error ? ` (${s.error})` : ''}`);

@@ -5,6 +5,43 @@ import { log } from '/page.mjs';
 
 export const frame = () => new Promise((r) => requestAnimationFrame(r));
 
+// What each engine asks of WebGL, counted by wrapping WebGL2RenderingContext's methods before
+// any page makes a context (this module is imported first): draw calls, instances and vertices
+// per frame (in `time`), and the bytes of every texture and buffer allocated (resident: what
+// the engine uploaded; the canvas itself not counted).
+const counts = { draws: 0, instances: 0, vertices: 0, textureBytes: 0, bufferBytes: 0 };
+{
+  const G = WebGL2RenderingContext;
+  const P = G.prototype;
+  // Bytes per texel of the sized formats the engines use (others counted as 4).
+  const texel = new Map([[G.RGBA8, 4], [G.RGBA16F, 8], [G.RGBA32F, 16], [G.RGBA32UI, 16],
+    [G.RGBA16UI, 8], [G.RG32UI, 8], [G.RG32F, 8], [G.R32UI, 4], [G.R32F, 4], [G.RGB32F, 12],
+    [G.RGBA8UI, 4], [G.RG16F, 4], [G.R16F, 2], [G.RGB8, 3], [G.R8, 1], [G.RG8, 2],
+    [G.SRGB8_ALPHA8, 4], [G.RGB16F, 6], [G.RGBA16I, 8], [G.RGBA32I, 16], [G.RG16UI, 4]]);
+  const wrap = (name, f) => {
+    const orig = P[name];
+    P[name] = function (...a) { f(a); return orig.apply(this, a); };
+  };
+  wrap('drawArrays', (a) => { counts.draws++; counts.instances++; counts.vertices += a[2]; });
+  wrap('drawElements', (a) => { counts.draws++; counts.instances++; counts.vertices += a[1]; });
+  wrap('drawArraysInstanced', (a) => { counts.draws++; counts.instances += a[3]; counts.vertices += a[2] * a[3]; });
+  wrap('drawElementsInstanced', (a) => { counts.draws++; counts.instances += a[4]; counts.vertices += a[1] * a[4]; });
+  const bytes = (fmt, w, h, d) => (texel.get(fmt) ?? 4) * w * h * d;
+  wrap('texStorage2D', (a) => { counts.textureBytes += bytes(a[2], a[3], a[4], 1); });
+  wrap('texStorage3D', (a) => { counts.textureBytes += bytes(a[2], a[3], a[4], a[5]); });
+  wrap('texImage2D', (a) => { if (a.length >= 8 && typeof a[3] === 'number') counts.textureBytes += bytes(a[2], a[3], a[4], 1); });
+  wrap('texImage3D', (a) => { counts.textureBytes += bytes(a[2], a[3], a[4], a[5]); });
+  wrap('bufferData', (a) => {
+    const v = a[1];
+    counts.bufferBytes += typeof v === 'number' ? v : (v && v.byteLength) || 0;
+  });
+}
+
+/** Draw calls, instances and vertices per frame of the last `time`, and the bytes of every
+ * texture and buffer allocated so far. */
+export const glCounts = () => ({ ...lastFrame, textureBytes: counts.textureBytes, bufferBytes: counts.bufferBytes });
+let lastFrame = {};
+
 /** The views (views.json): one per camera, each { file, width, height, eye, target, up, fovDeg, camera, frames }. */
 export async function views() {
   return (await fetch('/views.json')).json();
@@ -16,6 +53,7 @@ export async function time(draw, sync, { warm = 5, frames = 10 } = {}, lit = () 
   for (let i = 0; i < warm; i++) { await draw(); sync(); await frame(); }
   let total = 0;
   let shown = null;
+  const before = { ...counts };
   for (let i = 0; i < frames; i++) {
     const t0 = performance.now();
     await draw();
@@ -25,6 +63,8 @@ export async function time(draw, sync, { warm = 5, frames = 10 } = {}, lit = () 
     if (i === frames - 1) shown = lit();
     await frame();
   }
+  const per = (k) => Math.round((counts[k] - before[k]) / frames);
+  lastFrame = { draws: per('draws'), instances: per('instances'), vertices: per('vertices') };
   return { ms: total / frames, lit: shown };
 }
 
@@ -44,7 +84,7 @@ export function litFraction(gl, w, h) {
 }
 
 export async function report(engine, v, ms, extra = {}) {
-  await log(`BENCH ${JSON.stringify({ engine, camera: v.camera, ms, ...extra })}`);
+  await log(`BENCH ${JSON.stringify({ engine, camera: v.camera, ms, gl: glCounts(), ...extra })}`);
 }
 
 export async function done() {
