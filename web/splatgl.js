@@ -7,7 +7,7 @@
 //   r.draw();                                         // cull, sort back to front, blend
 //   r.dispose();                                      // frees its GPU objects
 //
-// Types: splatgl.d.ts (checked with tsc --noEmit against example/example.ts).
+// Types: splatgl.d.ts (checked with tsc --noEmit --checkJs against example/example.js).
 // Errors (no WebGL2, a file that cannot be loaded, bad matrices) are thrown as Error with
 // splatgl's message; after a failed load the renderer keeps what it had.
 import init, { Renderer, sort_ms } from './pkg/splatgl_web.js';
@@ -57,10 +57,10 @@ class SplatglRenderer {
 
   /** Frees the renderer's GPU objects and its memory in the module; any later call throws. */
   dispose() {
-    if (!this.inner) return;
+    if (this.inner === disposed) return;
     this.inner.dispose();
     this.inner.free();
-    this.inner = null;
+    this.inner = disposed;
   }
 
   /** The view (world → eye, looking down −z) and projection matrices, column-major. */
@@ -93,6 +93,9 @@ class SplatglRenderer {
   /** GL_VERSION / GL_RENDERER and whether RGBA16F blending is available. */
   glInfo() { return this.inner.gl_info(); }
 }
+
+/** What a disposed renderer holds: any use throws with a message that says why. */
+const disposed = new Proxy({}, { get() { throw new Error('splatgl: this renderer was disposed'); } });
 
 /** The loader's JSON answer, with `undefined` (not null) for what is absent. */
 function info(json) {

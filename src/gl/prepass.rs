@@ -34,8 +34,10 @@ use super::uniforms::Uniforms;
 /// The pre-pass outputs, in capture order (the record layout: one vec4 each).
 pub(crate) const PREPASS_VARYINGS: [&str; RECORD_TEXELS] =
     ["t_clip", "t_axes", "t_color_opacity", "t_conic"];
+/// Bytes of one RGBA32F texel of the records buffer and texture.
+const TEXEL_BYTES: usize = 16;
 /// Bytes of one record: [`RECORD_TEXELS`] RGBA32F texels.
-pub(crate) const RECORD_BYTES: usize = RECORD_TEXELS * 16;
+pub(crate) const RECORD_BYTES: usize = RECORD_TEXELS * TEXEL_BYTES;
 
 /// Below this many splats drawn, [`Pipeline::Auto`](super::Pipeline::Auto) draws directly.
 /// On llvmpipe the pre-pass wins from about 10 splats on (`cargo bench --features testing --bench gl`,
@@ -189,7 +191,7 @@ impl PrePass {
         let (rows, layers) = self.layout.shape(capacity, RECORD_TEXELS);
         let width = self.layout.width();
         let bytes = (width * rows * layers)
-            .checked_mul(16)
+            .checked_mul(TEXEL_BYTES)
             .filter(|&b| b <= i32::MAX as usize);
         let Some(bytes) = bytes else {
             return Err(GlError::Upload(format!(
@@ -284,7 +286,7 @@ impl PrePass {
             let mut layer = 0;
             while rows > 0 {
                 let here = rows.min(layer_rows);
-                let offset = layer * layer_rows * width * 16;
+                let offset = layer * layer_rows * width * TEXEL_BYTES;
                 gl.tex_sub_image_3d(
                     glow::TEXTURE_2D_ARRAY,
                     0,

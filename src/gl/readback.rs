@@ -79,7 +79,8 @@ pub struct ReadbackTarget {
 impl ReadbackTarget {
     /// Creates the target (`depth: None` for colour only). Fails with
     /// [`GlError::MissingExtension`] for `Rgba16f` on an ES context without
-    /// `GL_EXT_color_buffer_float` or `GL_EXT_color_buffer_half_float`,
+    /// `GL_EXT_color_buffer_float` or `GL_EXT_color_buffer_half_float`, and for `Rgba32f` on
+    /// one without `GL_EXT_color_buffer_float` and `GL_EXT_float_blend` (splats blend in it),
     /// [`GlError::Framebuffer`] when incomplete, [`GlError::Gl`] on a GL error (the host's
     /// pending errors are kept, see [`super::state`]).
     pub fn new(
@@ -93,6 +94,12 @@ impl ReadbackTarget {
             return Err(GlError::MissingExtension {
                 extension: "GL_EXT_color_buffer_float or GL_EXT_color_buffer_half_float",
                 needed_for: "an RGBA16F render target on OpenGL ES",
+            });
+        }
+        if format == ColorFormat::Rgba32f && !caps::can_blend_rgba32f(gl) {
+            return Err(GlError::MissingExtension {
+                extension: "GL_EXT_color_buffer_float and GL_EXT_float_blend",
+                needed_for: "blending in an RGBA32F render target on OpenGL ES",
             });
         }
         let errors = ErrorScope::begin(gl)?;

@@ -55,7 +55,7 @@ pub(crate) fn available(gl: &glow::Context) -> bool {
 impl StageQueries {
     pub(crate) fn new(gl: &glow::Context) -> Result<Self, GlError> {
         if !available(gl) {
-            return Err(GlError::Upload(
+            return Err(GlError::Unsupported(
                 "this context has no GL_TIME_ELAPSED timer queries".into(),
             ));
         }

@@ -41,10 +41,10 @@ pub struct Renderer {
     projection: Mat4,
     sh_degree: Option<u8>,
     canvas: HtmlCanvasElement,
-    /// `draw` blends in an RGBA16F target resolved into the canvas (the default, as the RC
+    /// `draw` blends in a float target resolved into the canvas (the default, as the RC
     /// recommends), else directly in the canvas's 8 bits ([`Renderer::set_target`]).
     float_blending: bool,
-    /// The RGBA16F target of `draw` (made at the canvas's size on first use).
+    /// The float target of `draw` (made at the canvas's size on first use).
     float: Option<OffscreenTarget>,
     /// [`Renderer::dispose`] ran: every GPU object is gone.
     disposed: bool,
@@ -199,8 +199,8 @@ impl Renderer {
     /// Clears the canvas to `background` (RGB, 0–1) and draws the loaded cloud for the camera
     /// of [`Renderer::set_camera`]: culled, sorted back to front and blended — by default in
     /// a float target (RGBA32F where the browser can blend it, else RGBA16F) resolved into the
-    /// canvas (sRGB-encoding `lin_rec709_display`
-    /// clouds), with `set_target("rgba8")` directly in the canvas. Returns the milliseconds it
+    /// canvas (sRGB-encoding `lin_rec709_display` clouds), with `set_target("rgba8")` directly
+    /// in the canvas. Returns the milliseconds it
     /// took on the CPU (sort and GL calls; the GPU may still be drawing).
     pub fn draw(&mut self, r: f32, g: f32, b: f32) -> Result<f64, JsError> {
         self.live()?;
@@ -248,7 +248,7 @@ impl Renderer {
             let t =
                 OffscreenTarget::with_format(&self.gl, size.0, size.1, format).map_err(|e| {
                     JsError::new(&format!(
-                        "no RGBA16F target for float blending ({e}); set_target(\"rgba8\") blends \
+                        "no float target to blend in ({e}); set_target(\"rgba8\") blends \
                      in the canvas's 8 bits"
                     ))
                 })?;
