@@ -23,27 +23,52 @@ fn split(url: &str) -> Option<(&str, &str)> {
     Some((&url[..path_at], &url[path_at..end]))
 }
 
-/// Removes `.` and `..` segments; `None` when `..` climbs above the root.
-fn normalize(path: &str) -> Option<String> {
-    let mut out: Vec<&str> = Vec::new();
+/// Percent-decodes each segment of `path` (as the server will), removes `.` and `..`
+/// segments, and percent-encodes the result again, so the request names exactly the path that
+/// was checked. `Err` names why: an encoded separator (`%2F`, `%5C`), a backslash or a NUL
+/// (servers read them differently) or a `..` that climbs above the root.
+fn normalize(path: &str) -> Result<String, &'static str> {
+    let mut out: Vec<String> = Vec::new();
     for seg in path.split('/').skip(1) {
-        match seg {
+        let decoded = super::percent_decode(seg);
+        if decoded.contains(['/', '\\', '\0']) || seg.contains('\\') {
+            return Err("has an encoded separator, a backslash or a NUL in a segment");
+        }
+        match decoded.as_str() {
             "." => {}
             ".." => {
-                out.pop()?;
+                out.pop().ok_or("climbs above the host's root")?;
             }
-            s => out.push(s),
+            _ => out.push(encode_segment(&decoded)),
         }
     }
-    Some(format!("/{}", out.join("/")))
+    Ok(format!("/{}", out.join("/")))
+}
+
+/// `seg` percent-encoded but for RFC 3986's unreserved characters and the sub-delimiters
+/// servers take literally.
+fn encode_segment(seg: &str) -> String {
+    let mut out = String::with_capacity(seg.len());
+    for b in seg.bytes() {
+        if b.is_ascii_alphanumeric() || b"-._~!$&'()*+,;=:@".contains(&b) {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
 }
 
 /// `uri` resolved against the document at `base`, kept under `base`'s folder unless
-/// `allow_outside`. Errors name the rule.
+/// `allow_outside`. Errors name the rule. Percent-encoding is decoded before the check, as a
+/// server decodes it (`%2e%2e/x` is `../x`), and the URL returned names the checked path.
 pub fn resolve(base: &str, uri: &str, allow_outside: bool) -> io::Result<String> {
     let bad = |m: String| io::Error::new(io::ErrorKind::PermissionDenied, m);
+    let refused = |why: &str| bad(format!("{uri:?} {why}"));
     let (origin, path) =
         split(base).ok_or_else(|| bad(format!("{base:?} is not an http(s) URL")))?;
+    // The base's folder as the server reads it (decoded, normalised, encoded again).
+    let path = normalize(path).map_err(|why| bad(format!("{base:?} {why}")))?;
     let folder = &path[..path.rfind('/').map_or(0, |i| i + 1)];
     let uri_path = uri.find(['?', '#']).map_or(uri, |i| &uri[..i]);
     let (o, p) = if is_url(uri) {
@@ -51,12 +76,10 @@ pub fn resolve(base: &str, uri: &str, allow_outside: bool) -> io::Result<String>
     } else if uri_path.starts_with('/') {
         (origin, uri_path)
     } else {
-        let joined = format!("{folder}{uri_path}");
-        let p = normalize(&joined)
-            .ok_or_else(|| bad(format!("{uri:?} climbs above the host's root")))?;
+        let p = normalize(&format!("{folder}{uri_path}")).map_err(refused)?;
         return check(origin, folder, &p, allow_outside, uri);
     };
-    let p = normalize(p).ok_or_else(|| bad(format!("{uri:?} climbs above the host's root")))?;
+    let p = normalize(p).map_err(refused)?;
     if !o.eq_ignore_ascii_case(origin) && !allow_outside {
         return Err(bad(format!(
             "{uri:?} is on another host than the tileset ({origin}); --allow-outside-paths allows it"
@@ -174,5 +197,33 @@ mod tests {
             "http://h:8/a/x.glb"
         );
         assert!(is_url("HTTPS://x/y") && !is_url("tiles/x.glb"));
+    }
+
+    #[test]
+    fn percent_encoded_dots_and_separators_cannot_leave_the_folder() {
+        let base = "http://h:8/a/b/tileset.json";
+        for escape in [
+            "%2e%2e/secret.glb",
+            "%2E%2E/secret.glb",
+            "..%2fsecret.glb",
+            "%2e%2e%2fsecret.glb",
+            "t/%2e%2e/%2e%2e/secret.glb",
+            "..%5csecret.glb",
+            "t\\..\\..\\secret.glb",
+            "/a/b/%2e%2e/x.glb",
+            "http://h:8/a/b/%2E%2E/x.glb",
+            "x%00.glb",
+        ] {
+            assert!(resolve(base, escape, false).is_err(), "{escape}");
+        }
+        // What is left is requested as checked: decoded dots gone, names encoded once.
+        assert_eq!(
+            resolve(base, "t/%2e/r%20%C3%A9.glb", false).unwrap(),
+            "http://h:8/a/b/t/r%20%C3%A9.glb"
+        );
+        assert_eq!(
+            resolve(base, "t/%2e%2e/r.glb", false).unwrap(),
+            "http://h:8/a/b/r.glb"
+        );
     }
 }

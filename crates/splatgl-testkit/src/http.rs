@@ -6,7 +6,10 @@ use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 /// Serves `root` over HTTP/1.1 on a free local port until the test ends (GET only, one
-/// request per connection); returns the base URL and the log of paths requested.
+/// request per connection); returns the base URL and the log of paths requested. Paths are
+/// read as real servers read them: percent-decoded, then `.` and `..` resolved (a `..` above
+/// the root is a 400), so a client that sends `%2e%2e/x` gets `../x`; the log holds the paths
+/// as the server resolved them.
 pub fn serve(root: &Path) -> (String, Arc<Mutex<Vec<String>>>) {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let base = format!("http://{}", listener.local_addr().unwrap());
@@ -24,11 +27,14 @@ pub fn serve(root: &Path) -> (String, Arc<Mutex<Vec<String>>>) {
             while r.read_line(&mut h).is_ok_and(|n| n > 2) {
                 h.clear();
             }
-            let path = line.split_whitespace().nth(1).unwrap_or("/").to_owned();
-            seen.lock().unwrap().push(path.clone());
-            let file = root.join(path.trim_start_matches('/'));
+            let raw = line.split_whitespace().nth(1).unwrap_or("/");
+            let path = server_path(raw);
+            seen.lock()
+                .unwrap()
+                .push(path.clone().unwrap_or_else(|| format!("<refused {raw}>")));
+            let file = path.map(|p| root.join(p.trim_start_matches('/')));
             let mut w = &stream;
-            let _ = match std::fs::read(&file).ok().filter(|_| !path.contains("..")) {
+            let _ = match file.and_then(|f| std::fs::read(f).ok()) {
                 Some(body) => w
                     .write_all(
                         format!(
@@ -45,4 +51,42 @@ pub fn serve(root: &Path) -> (String, Arc<Mutex<Vec<String>>>) {
         }
     });
     (base, log)
+}
+
+/// `raw` (a request target) as a server resolves it: query dropped, percent-decoded,
+/// `.`/`..` removed; `None` when a `..` climbs above the root.
+fn server_path(raw: &str) -> Option<String> {
+    let raw = raw.split(['?', '#']).next().unwrap_or("/");
+    let mut bytes = Vec::new();
+    let b = raw.as_bytes();
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        match (
+            b[i],
+            b.get(i + 1).and_then(|c| hex(*c)),
+            b.get(i + 2).and_then(|c| hex(*c)),
+        ) {
+            (b'%', Some(h), Some(l)) => {
+                bytes.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                bytes.push(c);
+                i += 1;
+            }
+        }
+    }
+    let decoded = String::from_utf8_lossy(&bytes).into_owned();
+    let mut out: Vec<&str> = Vec::new();
+    for seg in decoded.split('/') {
+        match seg {
+            "" | "." => {}
+            ".." => {
+                out.pop()?;
+            }
+            s => out.push(s),
+        }
+    }
+    Some(format!("/{}", out.join("/")))
 }

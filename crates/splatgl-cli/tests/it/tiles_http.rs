@@ -107,3 +107,43 @@ fn missing_truncated_or_escaping_content_on_a_server_is_named_and_the_rest_draws
     assert!(!r.stderr.contains("panicked"), "{}", r.all());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn percent_encoded_dots_in_served_uris_request_nothing_outside_the_folder() {
+    let d = dir("encoded");
+    let ts = built(&d, 400);
+    let tiles = ts.parent().unwrap().join("tiles");
+    // A loadable file outside the tileset's folder, which a decoding server would serve.
+    std::fs::copy(tiles.join("r1.glb"), d.join("secret.glb")).unwrap();
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&ts).unwrap()).unwrap();
+    let (base, log) = serve(&d);
+    let url = format!("{base}/ts/tileset.json");
+    for uri in [
+        "%2e%2e/secret.glb",
+        "%2E%2E/secret.glb",
+        "..%2fsecret.glb",
+        "%2e%2e%2fsecret.glb",
+        "tiles/%2e%2e/%2e%2e/secret.glb",
+    ] {
+        let mut doc = doc.clone();
+        doc["root"]["children"][1]["content"]["uri"] = uri.into();
+        std::fs::write(&ts, serde_json::to_vec(&doc).unwrap()).unwrap();
+        let r = run(&["validate", &url, "--json"]);
+        assert_eq!(r.code, 1, "{uri}: {}", r.all());
+        let v: serde_json::Value = serde_json::from_str(&r.out()).unwrap();
+        let found = v["findings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|f| f["path"] == "root.children[1].content")
+            .unwrap_or_else(|| panic!("{uri}: {v:#}"));
+        let m = found["message"].as_str().unwrap();
+        assert!(
+            m.contains("outside") || m.contains("separator"),
+            "{uri}: {m}"
+        );
+    }
+    let seen = log.lock().unwrap().clone();
+    assert!(seen.iter().all(|p| p.starts_with("/ts/")), "{seen:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
