@@ -2,7 +2,7 @@
 //! `{id, img_name, width, height, position[3], rotation[3][3], fx, fy}` with optional `cx`, `cy`.
 
 use super::CameraError;
-use crate::files::{Limits, check_json_depth};
+use crate::files::{Limits, check_json};
 use serde_json::Value;
 
 /// One view of a `cameras.json`, values as written (f64).
@@ -108,8 +108,7 @@ pub fn parse_cameras_json(text: &str) -> Result<Vec<CamerasJsonEntry>, CameraErr
 }
 
 fn parse_limited(text: &str, limits: &Limits) -> Result<Vec<CamerasJsonEntry>, CameraError> {
-    check_json_depth(text.as_bytes(), limits.max_json_depth)
-        .map_err(|m| invalid(String::new(), m))?;
+    check_json(text.as_bytes(), limits).map_err(|m| invalid(String::new(), m))?;
     let v: Value = serde_json::from_str(text)?;
     let list = v
         .as_array()

@@ -24,6 +24,12 @@ pub struct Limits {
     /// Deepest nesting of JSON arrays and objects (glTF, `cameras.json`). Default
     /// [`Limits::DEFAULT_MAX_JSON_DEPTH`] = 64; `serde_json` stops at 128 whatever this says.
     pub max_json_depth: u32,
+    /// Most JSON values one document may hold (objects, arrays, strings — keys included —,
+    /// numbers and literals), counted before it is parsed: parsing costs up to ~450 bytes per
+    /// value (a glTF node), so this bounds the parse's memory whatever the file's size.
+    /// Default [`Limits::DEFAULT_MAX_JSON_VALUES`] = 2²⁰ (1,048,576; real glTF, tileset and
+    /// `cameras.json` files hold thousands); `--max-json-values` raises it.
+    pub max_json_values: u64,
     /// glTF decode budget, fixed part: f32 values every document may decode or instantiate.
     /// Default [`Limits::DEFAULT_DECODE_BUDGET_VALUES`] = 16 Mi (64 MiB).
     pub decode_budget_values: u64,
@@ -41,6 +47,8 @@ impl Limits {
     pub const DEFAULT_MAX_DECOMPRESSED_BYTES: u64 = 4 << 30;
     /// Default of [`Limits::max_json_depth`].
     pub const DEFAULT_MAX_JSON_DEPTH: u32 = 64;
+    /// Default of [`Limits::max_json_values`].
+    pub const DEFAULT_MAX_JSON_VALUES: u64 = 1 << 20;
     /// Default of [`Limits::decode_budget_values`].
     pub const DEFAULT_DECODE_BUDGET_VALUES: u64 = 16 << 20;
     /// Default of [`Limits::decode_values_per_byte`].
@@ -75,12 +83,13 @@ impl Limits {
     }
 
     /// Every limit as `(name, value)`, in declaration order (what `info -v` prints).
-    pub fn entries(&self) -> [(&'static str, u64); 6] {
+    pub fn entries(&self) -> [(&'static str, u64); 7] {
         [
             ("max_splats", self.max_splats),
             ("max_bytes", self.max_bytes),
             ("max_decompressed_bytes", self.max_decompressed_bytes),
             ("max_json_depth", self.max_json_depth as u64),
+            ("max_json_values", self.max_json_values),
             ("decode_budget_values", self.decode_budget_values),
             ("decode_values_per_byte", self.decode_values_per_byte),
         ]
@@ -94,6 +103,7 @@ impl Default for Limits {
             max_bytes: Self::DEFAULT_MAX_BYTES,
             max_decompressed_bytes: Self::DEFAULT_MAX_DECOMPRESSED_BYTES,
             max_json_depth: Self::DEFAULT_MAX_JSON_DEPTH,
+            max_json_values: Self::DEFAULT_MAX_JSON_VALUES,
             decode_budget_values: Self::DEFAULT_DECODE_BUDGET_VALUES,
             decode_values_per_byte: Self::DEFAULT_DECODE_VALUES_PER_BYTE,
         }
@@ -139,6 +149,7 @@ impl fmt::Display for LimitExceeded {
         let flag = match self.limit {
             "max_splats" => " (raise with --max-splats)",
             "max_bytes" => " (raise with --max-bytes)",
+            "max_json_values" => " (raise with --max-json-values)",
             _ => "",
         };
         write!(
@@ -152,7 +163,20 @@ impl fmt::Display for LimitExceeded {
 /// Checks that the JSON text nests arrays and objects at most `max` deep (strings skipped),
 /// before it is parsed. Returns the message for an error otherwise.
 pub fn check_json_depth(text: &[u8], max: u32) -> Result<(), String> {
+    check_json_shape(text, max, u64::MAX)
+}
+
+/// Checks, before a JSON text is parsed, that it nests at most `limits.max_json_depth` deep
+/// and holds at most `limits.max_json_values` values ([`Limits::max_json_values`] says what
+/// counts). Returns the message for an error otherwise, naming the limit.
+pub fn check_json(text: &[u8], limits: &Limits) -> Result<(), String> {
+    check_json_shape(text, limits.max_json_depth, limits.max_json_values)
+}
+
+/// One pass over the text outside strings: depth and values counted as they open.
+fn check_json_shape(text: &[u8], max_depth: u32, max_values: u64) -> Result<(), String> {
     let (mut depth, mut in_string, mut escaped) = (0u32, false, false);
+    let (mut values, mut after_separator) = (0u64, true);
     for (i, &b) in text.iter().enumerate() {
         if in_string {
             match (escaped, b) {
@@ -163,13 +187,31 @@ pub fn check_json_depth(text: &[u8], max: u32) -> Result<(), String> {
             }
             continue;
         }
+        // A value opens at a bracket, a quote, or a literal's first byte after `[`, `:`, `,`.
+        let opens = match b {
+            b'[' | b'{' | b'"' => true,
+            b'-' | b'0'..=b'9' | b't' | b'f' | b'n' => after_separator,
+            _ => false,
+        };
+        if opens {
+            values += 1;
+            if values > max_values {
+                return Err(format!(
+                    "JSON holds more than limits.max_json_values = {max_values} values (at \
+                     byte {i}; raise with --max-json-values)"
+                ));
+            }
+        }
+        if !b.is_ascii_whitespace() {
+            after_separator = matches!(b, b'[' | b':' | b',');
+        }
         match b {
             b'"' => in_string = true,
             b'[' | b'{' => {
                 depth += 1;
-                if depth > max {
+                if depth > max_depth {
                     return Err(format!(
-                        "JSON nests deeper than limits.max_json_depth = {max} (at byte {i})"
+                        "JSON nests deeper than limits.max_json_depth = {max_depth} (at byte {i})"
                     ));
                 }
             }
@@ -193,6 +235,27 @@ mod tests {
             "{e}"
         );
         assert!(check_json_depth(br#"{"s": "\"[[[[", "t": 1}"#, 1).is_ok());
+    }
+
+    #[test]
+    fn json_values_count_containers_strings_and_literals_once() {
+        let limits = |n| Limits {
+            max_json_values: n,
+            ..Limits::default()
+        };
+        // {"a": [1, -2.5e3, true, null], "b": "x,1"}: the object, 2 keys, the array, 4
+        // literals, 1 string = 9 values.
+        let doc = br#"{"a": [1, -2.5e3, true, null], "b": "x,1"}"#;
+        assert!(check_json(doc, &limits(9)).is_ok());
+        let e = check_json(doc, &limits(8)).unwrap_err();
+        assert!(
+            e.contains("max_json_values = 8") && e.contains("--max-json-values"),
+            "{e}"
+        );
+        // Empty objects in an array: one value each, and the array.
+        let nodes = format!("[{}]", vec!["{}"; 100].join(","));
+        assert!(check_json(nodes.as_bytes(), &limits(101)).is_ok());
+        assert!(check_json(nodes.as_bytes(), &limits(100)).is_err());
     }
 
     #[test]

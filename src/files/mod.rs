@@ -24,7 +24,7 @@ pub mod http;
 mod limits;
 mod map;
 pub use format::Format;
-pub use limits::{LimitExceeded, Limits, check_json_depth};
+pub use limits::{LimitExceeded, Limits, check_json, check_json_depth};
 pub use map::{FileBytes, Mapping, NO_MMAP_ENV, map_bounded, read_file_bytes, read_stdin_bounded};
 pub(crate) use map::{advise_huge, release_consumed};
 

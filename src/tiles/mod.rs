@@ -342,9 +342,15 @@ pub fn is_tileset(bytes: &[u8]) -> bool {
     if head.is_none_or(|i| bytes[i] != b'{') {
         return false;
     }
-    match serde_json::from_slice::<Value>(bytes) {
-        Ok(v) => (v.get("asset").is_some() && v.get("root").is_some()) || lod_meta::is_lod_meta(&v),
-        Err(_) => {
+    // Over the default JSON limits: told by its keys (the reader then names the limit).
+    let parsed = crate::files::check_json(bytes, &crate::files::Limits::default())
+        .ok()
+        .and_then(|_| serde_json::from_slice::<Value>(bytes).ok());
+    match parsed {
+        Some(v) => {
+            (v.get("asset").is_some() && v.get("root").is_some()) || lod_meta::is_lod_meta(&v)
+        }
+        None => {
             let has = |k: &[u8]| bytes.windows(k.len()).any(|w| w == k);
             (has(b"\"root\"") && has(b"\"geometricError\""))
                 || (has(b"\"lodLevels\"") && has(b"\"tree\""))
@@ -364,8 +370,7 @@ pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
         None => crate::files::read_bounded(path, opts.limits.max_bytes, "the tileset")
             .map_err(|e| format!("{shown}: {e}"))?,
     };
-    crate::files::check_json_depth(&bytes, opts.limits.max_json_depth)
-        .map_err(|e| format!("{shown}: {e}"))?;
+    crate::files::check_json(&bytes, &opts.limits).map_err(|e| format!("{shown}: {e}"))?;
     let v: Value = serde_json::from_slice(&bytes).map_err(|e| format!("{shown}: not JSON: {e}"))?;
     if lod_meta::is_lod_meta(&v) {
         let mut problems = Vec::new();

@@ -239,7 +239,7 @@ impl Manifest {
         let err = |e: &dyn std::fmt::Display| format!("{}: {e}", p.display());
         let text = splatgl::files::read_bounded(&p, limits.max_bytes, "the manifest")
             .map_err(|e| err(&e))?;
-        splatgl::load::check_json_depth(&text, limits.max_json_depth).map_err(|e| err(&e))?;
+        splatgl::load::check_json(&text, &limits).map_err(|e| err(&e))?;
         let v: Value = serde_json::from_slice(&text).map_err(|e| err(&e))?;
         Manifest::from_json(&v)
     }

@@ -3,7 +3,7 @@
 
 use super::GltfError;
 use crate::load::finding::Finding;
-use crate::load::{Format, LoadOptions, check_json_depth};
+use crate::load::{Format, LoadOptions, check_json};
 use gltf::json::validation::Validate;
 use serde_json::Value;
 use std::path::Path;
@@ -55,7 +55,7 @@ pub fn parse(
         }
         _ => (bytes, None),
     };
-    check_json_depth(json_bytes, opts.limits.max_json_depth).map_err(container)?;
+    check_json(json_bytes, &opts.limits).map_err(container)?;
     let json: Value =
         serde_json::from_slice(json_bytes).map_err(|e| container(format!("JSON: {e}")))?;
     if !json.is_object() {

@@ -161,7 +161,7 @@ fn range(v: &Value, path: &str, n: usize) -> Result<Quant, SogError> {
 /// Parses meta.json (version 2, or version 1 when `version` is absent) after checking its
 /// nesting against `limits.max_json_depth`; its count is checked against `limits.max_splats`.
 pub(crate) fn parse_meta(json: &[u8], limits: &Limits) -> Result<Meta, SogError> {
-    super::check_json_depth(json, limits.max_json_depth).map_err(|e| meta_err("$", e))?;
+    super::check_json(json, limits).map_err(|e| meta_err("$", e))?;
     let v: Value = serde_json::from_slice(json).map_err(|e| meta_err("$", e.to_string()))?;
     let version = match v.get("version") {
         None => 1,
@@ -225,9 +225,13 @@ pub(crate) fn parse_meta(json: &[u8], limits: &Limits) -> Result<Meta, SogError>
     })
 }
 
-/// Whether JSON bytes are a SOG meta (top-level `means` and `quats`), not glTF.
+/// Whether JSON bytes are a SOG meta (top-level `means` and `quats`), not glTF. Text over the
+/// default JSON limits is told by its keys (the reader then names the limit).
 pub(crate) fn is_meta_json(bytes: &[u8]) -> bool {
     let has = |k: &[u8]| bytes.windows(k.len()).any(|w| w == k);
+    if crate::files::check_json(bytes, &Limits::default()).is_err() {
+        return has(b"\"quats\"") && has(b"\"means\"");
+    }
     has(b"\"quats\"")
         && serde_json::from_slice::<serde_json::Map<String, Value>>(bytes)
             .is_ok_and(|m| m.contains_key("means") && m.contains_key("quats"))

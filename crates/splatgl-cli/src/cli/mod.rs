@@ -120,6 +120,11 @@ pub struct LoadCommonArgs {
     /// cameras.json). Plain bytes or with a K, M or G suffix (powers of 1024).
     #[arg(long, value_name = "BYTES", default_value = "4G", value_parser = parse_bytes)]
     pub max_bytes: u64,
+    /// Most values one JSON document may hold (glTF, tileset.json, meta.json, cameras.json:
+    /// objects, arrays, strings, numbers, literals), checked before parsing: parsing costs up
+    /// to ~450 bytes per value, so this bounds its memory.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT_MAX_JSON_VALUES)]
+    pub max_json_values: u64,
 }
 
 /// `123`, `64K`, `512M`, `4G` (binary multiples).
@@ -155,6 +160,7 @@ impl LoadCommonArgs {
             limits: Limits {
                 max_splats,
                 max_bytes: self.max_bytes,
+                max_json_values: self.max_json_values,
                 ..Limits::default()
             },
             // The command maps scene files (SPLATGL_NO_MMAP=1: read them).

@@ -407,6 +407,48 @@ fn limits_are_enforced_named_and_printed() {
 }
 
 #[test]
+fn json_of_millions_of_values_is_refused_before_parsing_with_the_limit_named() {
+    let d = dir("json_values");
+    // 8 million empty nodes (24 MB): parsed, ~3.5 GB; refused before the parse.
+    let nodes = format!(
+        "{{\"asset\":{{\"version\":\"2.0\"}},\"nodes\":[{}]}}",
+        vec!["{}"; 8_000_000].join(",")
+    );
+    let gltf = d.join("nodes.gltf");
+    std::fs::write(&gltf, &nodes).unwrap();
+    let tileset = d.join("tileset.json");
+    let tiles = vec![r#"{"geometricError":0}"#; 600_000].join(",");
+    std::fs::write(
+        &tileset,
+        format!(r#"{{"asset":{{"version":"1.1"}},"geometricError":1,"root":{{"geometricError":1,"children":[{tiles}]}}}}"#),
+    )
+    .unwrap();
+    for (file, cmd) in [
+        (&gltf, "info"),
+        (&gltf, "validate"),
+        (&tileset, "info"),
+        (&tileset, "validate"),
+    ] {
+        let (code, out) = splatgl(&[cmd, file.to_str().unwrap()]);
+        assert_ne!(code, 0, "{cmd} {}: {out}", file.display());
+        assert!(
+            out.contains("limits.max_json_values = 1048576") && out.contains("--max-json-values"),
+            "{cmd} {}: {out}",
+            file.display()
+        );
+    }
+    // Raised, the tileset parses (and is judged on its content).
+    let (_, out) = splatgl(&[
+        "validate",
+        tileset.to_str().unwrap(),
+        "--max-json-values",
+        "4000000",
+    ]);
+    assert!(!out.contains("max_json_values"), "{out}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
 fn external_buffers_count_against_max_bytes() {
     let (root, asset, bin) = layout("bytes");
     std::fs::write(asset.join("x.bin"), &bin).unwrap();
