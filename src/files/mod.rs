@@ -149,39 +149,77 @@ fn contained_named(
     name: &str,
     allow_outside: bool,
 ) -> Result<PathBuf, String> {
+    contained_file(base, rel, name, allow_outside).map_err(|e| match e {
+        Refused::Outside(m) | Refused::Missing(m) => m,
+    })
+}
+
+/// Why [`contained_file`] gave no file.
+pub(crate) enum Refused {
+    /// Outside the folder (by name, or once symlinks are followed): the message names the rule.
+    Outside(String),
+    /// Inside the folder but not there (or unreadable): the message names the path.
+    Missing(String),
+}
+
+/// The containment rule, told apart from a missing file. Containment is decided before
+/// existence is reported: a name that leads outside the folder is refused the same way
+/// whether or not its file exists, so a document cannot probe for files outside its folder.
+pub(crate) fn contained_file(
+    base: &Path,
+    rel: &Path,
+    name: &str,
+    allow_outside: bool,
+) -> Result<PathBuf, Refused> {
     let how = "files a document names must lie inside its folder (allow with --allow-outside-paths / LoadOptions::allow_outside_paths)";
     if !allow_outside {
         match lexical_escape(&rel.to_string_lossy()) {
             Some(Escape::Absolute) => {
-                return Err(format!("URI {name:?} is an absolute path; {how}"));
+                return Err(Refused::Outside(format!(
+                    "URI {name:?} is an absolute path; {how}"
+                )));
             }
             Some(Escape::Up) => {
-                return Err(format!(
+                return Err(Refused::Outside(format!(
                     "URI {name:?} resolves outside the asset's folder (its `..` climb above \
                      it); {how}"
-                ));
+                )));
             }
             None => {}
         }
     }
     let joined = base.join(rel);
-    let file = joined
-        .canonicalize()
-        .map_err(|e| format!("{}: {e}", joined.display()))?;
+    let canonical = joined.canonicalize();
     if allow_outside {
-        return Ok(file);
+        return canonical.map_err(|e| Refused::Missing(format!("{}: {e}", joined.display())));
     }
     let root = base
         .canonicalize()
-        .map_err(|e| format!("asset folder {}: {e}", base.display()))?;
-    if !file.starts_with(&root) {
-        return Err(format!(
-            "URI {name:?} resolves to {}, outside the asset's folder {}; {how}",
-            file.display(),
+        .map_err(|e| Refused::Missing(format!("asset folder {}: {e}", base.display())))?;
+    // A missing file is judged by the deepest part of its path that exists (a symlinked
+    // folder pointing outside is outside, whether or not the file is in it).
+    let (judged, missing) = match canonical {
+        Ok(file) => (file, None),
+        Err(e) => (
+            existing_ancestor(&joined).unwrap_or_else(|| root.clone()),
+            Some(format!("{}: {e}", joined.display())),
+        ),
+    };
+    if !judged.starts_with(&root) {
+        return Err(Refused::Outside(format!(
+            "URI {name:?} resolves outside the asset's folder {}; {how}",
             root.display()
-        ));
+        )));
     }
-    Ok(file)
+    match missing {
+        Some(m) => Err(Refused::Missing(m)),
+        None => Ok(judged),
+    }
+}
+
+/// The canonical form of the deepest ancestor of `path` that exists.
+fn existing_ancestor(path: &Path) -> Option<PathBuf> {
+    path.ancestors().skip(1).find_map(|a| a.canonicalize().ok())
 }
 
 /// How a name escapes its folder before any file is looked at.

@@ -1025,6 +1025,23 @@ fn unbundled_sog_rejects_paths_outside_its_folder() {
     }
     let gone = meta.replace("\"quats.webp\"", "\"nothere.webp\"");
     expect(gone.as_bytes(), name, &["'nothere.webp' is missing"]);
+    // Containment before existence: outside the folder, a file that is there and one that is
+    // not are refused alike (a meta.json cannot probe for files), through `..` or a symlink.
+    std::os::unix::fs::symlink(&root, dir.join("up")).unwrap();
+    for (there, absent) in [
+        ("../quats.webp", "../absent.webp"),
+        ("up/quats.webp", "up/absent.webp"),
+    ] {
+        let e = |n: &str| {
+            err_of(
+                meta.replace("\"quats.webp\"", &format!("{n:?}")).as_bytes(),
+                name,
+            )
+        };
+        let (a, b) = (e(there), e(absent));
+        assert!(a.contains("outside the asset's folder"), "{a}");
+        assert_eq!(a.replace(there, "X"), b.replace(absent, "X"));
+    }
     // Only regular files, within --max-bytes (all textures together).
     let fifo = dir.join("fifo.webp");
     assert!(

@@ -358,13 +358,17 @@ fn read_dir(
             member: name.into(),
             message,
         };
-        if !dir.join(name).exists() && !Path::new(name).is_absolute() {
-            return Err(SogError::Missing {
-                member: name.into(),
-            });
-        }
-        let file = crate::files::contained_path(&dir, Path::new(name), opts.allow_outside_paths)
-            .map_err(fail)?;
+        // Containment first: a name outside the folder is refused alike, there or not.
+        use crate::files::{Refused, contained_file};
+        let file = match contained_file(&dir, Path::new(name), name, opts.allow_outside_paths) {
+            Ok(file) => file,
+            Err(Refused::Outside(m)) => return Err(fail(m)),
+            Err(Refused::Missing(_)) => {
+                return Err(SogError::Missing {
+                    member: name.into(),
+                });
+            }
+        };
         let left = opts.limits.max_bytes.saturating_sub(so_far);
         let data = crate::files::read_bounded(&file, left, "the texture")
             .map_err(|e| fail(e.to_string()))?;
