@@ -217,9 +217,12 @@ pub struct Tileset {
 }
 
 impl Tileset {
-    /// The folder its content URIs are resolved against.
+    /// The folder its content URIs are resolved against (`.` for a bare file name).
     pub fn folder(&self) -> &Path {
-        self.file.parent().unwrap_or(Path::new("."))
+        self.file
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
     }
 
     /// The frame change from a tile's content to the tile (before its transform): glTF's

@@ -87,6 +87,11 @@ fn info_counts_tiles_and_splats_per_level() {
         (code, &v["status"], &v["format"]),
         (0, &json!("valid"), &json!("3dtiles"))
     );
+    // Named bare in its own folder, it reads the same content (resolved against `.`).
+    let name = ts.file_name().unwrap().to_str().unwrap();
+    let r = common::cli::run_in(ts.parent().unwrap(), &["info", name, "--json"]);
+    let v: Value = serde_json::from_str(&r.out()).unwrap_or_else(|e| panic!("{e}: {}", r.all()));
+    assert_eq!((r.code, &v["splat_count"]), (0, &json!(350)), "{v:#}");
     let _ = std::fs::remove_dir_all(&d);
 }
 
