@@ -740,6 +740,47 @@ fn sparse_all_zero_opacity_writes_a_valid_file() {
     assert_eq!(v.status(), Status::Valid, "{:#?}", v.findings);
 }
 
+#[test]
+fn a_ply_trailing_element_the_file_ends_inside_is_a_warning_saying_how_much_is_missing() {
+    let good = good_ply();
+    let text_end = good.windows(11).position(|w| w == b"end_header\n").unwrap();
+    // The same vertex data, then an element of 4 billion one-byte rows over 13 bytes.
+    let mut short = good[..text_end].to_vec();
+    short.extend_from_slice(b"element face 4000000000\nproperty uchar a\nend_header\n");
+    short.extend_from_slice(&good[text_end + 11..]);
+    short.extend_from_slice(&[0u8; 13]);
+    let v = validate_bytes(&short, Some(Path::new("t.ply")), &LoadOptions::default());
+    let f = v
+        .findings
+        .iter()
+        .find(|f| f.path == "face")
+        .expect("a finding on 'face'");
+    assert_eq!(f.severity.name(), "warning");
+    assert!(
+        f.message.contains("4000000000") && f.message.contains("13"),
+        "{}",
+        f.message
+    );
+    // Complete, it is valid; the vertex data loads either way.
+    let mut ok = good[..text_end].to_vec();
+    ok.extend_from_slice(b"element face 2\nproperty uchar a\nend_header\n");
+    ok.extend_from_slice(&good[text_end + 11..]);
+    ok.extend_from_slice(&[0u8; 2]);
+    let v = validate_bytes(&ok, Some(Path::new("t.ply")), &LoadOptions::default());
+    assert!(
+        v.findings.iter().all(|f| f.path != "face"),
+        "{:#?}",
+        v.findings
+    );
+    assert_eq!(
+        load_bytes(&short, Some(Path::new("t.ply")), &strict())
+            .unwrap()
+            .cloud
+            .len(),
+        4
+    );
+}
+
 // ---------- SPZ, .splat, .ksplat, SOG: errors name the block, member, section or texture ----------
 
 fn gunzip(b: &[u8]) -> Vec<u8> {

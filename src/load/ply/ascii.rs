@@ -64,8 +64,8 @@ pub(super) fn decode(
     Ok((cloud, notes, bad))
 }
 
-/// Skips the rows of the elements before the vertex element, one line each.
-fn skip_elements<'t>(
+/// Skips the rows of `elements` (those before the vertex element, or after it), one line each.
+pub(super) fn skip_elements<'t>(
     elements: &[Element],
     lines: &mut impl Iterator<Item = (usize, &'t str)>,
 ) -> Result<(), PlyError> {

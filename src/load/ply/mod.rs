@@ -23,7 +23,7 @@ mod compressed;
 mod header;
 mod stream;
 use binary::{decode_binary, skip_binary};
-use header::{Element, Encoding, Property, Scalar, parse_header};
+use header::{Element, Encoding, Header, Property, Scalar, parse_header};
 pub use stream::PlyRows;
 
 /// Which columns feed which output: offsets (binary) or column indices (ASCII) per field.
@@ -334,6 +334,12 @@ pub(crate) fn read(
     }
     let l = layout(vertex)?;
 
+    if let Some(e) = trailing_problem(&header, vi, body, l.stride) {
+        report.findings.push(Finding::warning(
+            header.elements[vi + 1].name.clone(),
+            format!("{e} (after the vertex data, which is read; the rest is ignored)"),
+        ));
+    }
     let (mut cloud, notes, bad) = match header.encoding {
         Encoding::Ascii => ascii::decode(&header, vi, &l, body)?,
         enc => {
@@ -379,6 +385,32 @@ pub(crate) fn read(
     report.non_unit_quaternions = non_unit;
     report.non_finite_opacities = notes.inf_opacity;
     Ok(cloud)
+}
+
+/// Whether the elements after `vertex` (element `vi`) are all there: the first one that the
+/// body ends inside, as the error that says how much is missing. `None` when there are none
+/// after it, or the vertex rows themselves are short (the decode reports that).
+fn trailing_problem(header: &Header, vi: usize, body: &[u8], stride: usize) -> Option<PlyError> {
+    let after = &header.elements[vi + 1..];
+    if after.is_empty() {
+        return None;
+    }
+    match header.encoding {
+        Encoding::Ascii => {
+            let text = std::str::from_utf8(body).ok()?;
+            let mut lines = text.lines().enumerate();
+            ascii::skip_elements(&header.elements[..=vi], &mut lines).ok()?;
+            ascii::skip_elements(after, &mut lines).err()
+        }
+        enc => {
+            let be = enc == Encoding::Be;
+            let start = skip_binary(&header.elements[..vi], body, be).ok()?;
+            let n = header.elements[vi].count;
+            let end = (start as u64).checked_add(n.checked_mul(stride as u64)?)?;
+            let rest = body.get(usize::try_from(end).ok()?..)?;
+            skip_binary(after, rest, be).err()
+        }
+    }
 }
 
 /// (bytes, row size) of an element of fixed-size rows, checked against the `available` bytes
