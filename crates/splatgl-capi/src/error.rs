@@ -2,7 +2,7 @@
 //! ([`call`]): a `Result` becomes a code and a message, a panic becomes
 //! [`SPLATGL_ERROR_PANIC`].
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::ffi::{CString, c_char, c_int};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -74,14 +74,27 @@ impl From<GlError> for CError {
 }
 
 thread_local! {
-    static LAST: RefCell<(c_int, CString)> = RefCell::new((SPLATGL_OK, CString::default()));
+    // The code needs no destructor, so it stays readable while the thread's locals are torn
+    // down; the message's slot may already be gone then (a host calling splatgl from another
+    // thread-local's destructor), and every access to it is `try_with`.
+    static CODE: Cell<c_int> = const { Cell::new(SPLATGL_OK) };
+    static LAST: RefCell<CString> = RefCell::new(CString::default());
 }
 
+/// What [`splatgl_last_error`] returns once this thread's message slot is destroyed.
+const GONE: &std::ffi::CStr =
+    c"the message is unavailable: this thread is exiting (splatgl_last_error_code has the code)";
+
 fn set_last(code: c_int, message: &str) {
+    CODE.set(code);
     // A message with a NUL byte is cut there (C strings end at the first NUL).
     let message = message.split('\0').next().unwrap_or_default();
     let text = CString::new(message).unwrap_or_default();
-    LAST.with(|l| *l.borrow_mut() = (code, text));
+    let _ = LAST.try_with(|l| {
+        if let Ok(mut slot) = l.try_borrow_mut() {
+            *slot = text;
+        }
+    });
 }
 
 /// Runs one entry point: `Ok` clears the last error, `Err` records it, a panic records
@@ -118,14 +131,17 @@ pub(super) fn status(f: impl FnOnce() -> Result<(), CError>) -> c_int {
 /// The string belongs to splatgl and stays valid until the next splatgl call on this thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn splatgl_last_error() -> *const c_char {
-    LAST.with(|l| l.borrow().1.as_ptr())
+    LAST.try_with(|l| l.try_borrow().map(|m| m.as_ptr()).ok())
+        .ok()
+        .flatten()
+        .unwrap_or(GONE.as_ptr())
 }
 
 /// The code of the last call on this thread ([`SPLATGL_OK`] after a call that succeeded):
 /// what a constructor that returned `NULL` failed with.
 #[unsafe(no_mangle)]
 pub extern "C" fn splatgl_last_error_code() -> c_int {
-    LAST.with(|l| l.borrow().0)
+    CODE.get()
 }
 
 /// The library's version, e.g. `"0.1.0"` (a static string).

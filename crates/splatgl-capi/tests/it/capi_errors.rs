@@ -420,3 +420,40 @@ fn a_panic_inside_becomes_an_error_code() {
         SPLATGL_OK
     );
 }
+
+/// Calls into the C API from its destructor: a host's thread-local torn down after splatgl's.
+struct CallsOnDrop(std::sync::mpsc::Sender<(c_int, c_int, String)>);
+
+impl Drop for CallsOnDrop {
+    fn drop(&mut self) {
+        // SAFETY: NULL `out` is a documented error.
+        let code = unsafe {
+            splatgl_cloud_from_arrays(0, null(), null(), null(), null(), 0, null(), null_mut())
+        };
+        let (last_code, msg) = last();
+        let _ = self.0.send((code, last_code, msg));
+    }
+}
+
+thread_local! {
+    static HOST: std::cell::RefCell<Option<CallsOnDrop>> = const { std::cell::RefCell::new(None) };
+}
+
+#[test]
+fn calls_during_thread_teardown_return_codes_instead_of_aborting() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        // The host's local first, then splatgl's: destroyed in reverse, so splatgl's message
+        // slot is gone when the host's destructor calls in.
+        HOST.with(|h| *h.borrow_mut() = Some(CallsOnDrop(tx)));
+        assert_eq!(splatgl_testing_panic(), SPLATGL_ERROR_PANIC);
+    })
+    .join()
+    .unwrap();
+    let (code, last_code, msg) = rx.recv().expect("the destructor ran and reported");
+    assert_eq!(
+        (code, last_code),
+        (SPLATGL_ERROR_NULL_POINTER, SPLATGL_ERROR_NULL_POINTER)
+    );
+    assert!(!msg.is_empty(), "{msg}");
+}
