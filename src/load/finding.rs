@@ -53,11 +53,12 @@ pub struct Finding {
 impl Finding {
     /// An error that stops loading.
     pub(crate) fn fatal(path: impl Into<String>, message: impl Into<String>) -> Self {
+        let (path, message) = (path.into(), message.into());
         Finding {
             severity: Severity::Error,
             blocks_loading: true,
-            path: path.into(),
-            message: message.into(),
+            path: printable(&path).into_owned(),
+            message: printable(&message).into_owned(),
             index: None,
         }
     }
@@ -144,5 +145,49 @@ impl fmt::Display for Finding {
             write!(f, " [index {i}]")?;
         }
         write!(f, ": {}", self.message)
+    }
+}
+
+/// `text` safe to print on a terminal: control characters but newline and tab (escape
+/// sequences, carriage returns, bells, C1 controls) and the bidirectional-override characters
+/// are written as `\u{…}` escapes. Every message that quotes a file's content goes through it
+/// before it reaches a terminal ([`Finding`]s at construction; the CLI's, the C API's and the
+/// Python package's error messages where they are printed or handed over).
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    let unsafe_char = |c: char| {
+        (c.is_control() && c != '\n' && c != '\t')
+            || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
+    };
+    if !text.contains(unsafe_char) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if unsafe_char(c) {
+            out.push_str(&c.escape_unicode().to_string());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn printable_escapes_terminal_controls_and_keeps_lines() {
+        assert_eq!(
+            printable("a\x1b[31mb\rc\u{7}"),
+            "a\\u{1b}[31mb\\u{d}c\\u{7}"
+        );
+        assert_eq!(printable("x\u{202E}y"), "x\\u{202e}y");
+        assert!(matches!(
+            printable("plain\nlines\tok é"),
+            std::borrow::Cow::Borrowed(_)
+        ));
+        let f = Finding::warning("a\x1bb", "m\x1b]0;t\x07");
+        assert!(!f.path.contains('\x1b') && !f.message.contains(['\x1b', '\x07']));
     }
 }

@@ -89,7 +89,8 @@ fn set_last(code: c_int, message: &str) {
     CODE.set(code);
     // A message with a NUL byte is cut there (C strings end at the first NUL).
     let message = message.split('\0').next().unwrap_or_default();
-    let text = CString::new(message).unwrap_or_default();
+    let message = splatgl::load::printable(message);
+    let text = CString::new(message.as_bytes()).unwrap_or_default();
     let _ = LAST.try_with(|l| {
         if let Ok(mut slot) = l.try_borrow_mut() {
             *slot = text;

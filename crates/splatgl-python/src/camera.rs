@@ -155,7 +155,7 @@ impl PyCamera {
     ) -> PyResult<Self> {
         let entries = py
             .detach(|| splatgl::camera::load_cameras_json(&path))
-            .map_err(|e| CameraError::new_err(e.to_string()))?;
+            .map_err(|e| CameraError::new_err(crate::message(e)))?;
         let n = entries.len();
         let e = entries.get(index).ok_or_else(|| {
             CameraError::new_err(format!(
@@ -163,7 +163,7 @@ impl PyCamera {
                 path.display()
             ))
         })?;
-        let mut cam = Camera::from_3dgs(e).map_err(|e| CameraError::new_err(e.to_string()))?;
+        let mut cam = Camera::from_3dgs(e).map_err(|e| CameraError::new_err(crate::message(e)))?;
         if width.is_some() || height.is_some() {
             let (w, h) = (width.unwrap_or(cam.width), height.unwrap_or(cam.height));
             size(w, h)?;

@@ -71,7 +71,7 @@ pub fn load(
     let o = options(max_splats, max_bytes, strict, allow_outside_paths);
     let scene = py
         .detach(|| splatgl::load::load_path(&path, &o))
-        .map_err(|e| LoadError::new_err(e.to_string()))?;
+        .map_err(|e| LoadError::new_err(crate::message(e)))?;
     cloud_of(py, scene)
 }
 
@@ -103,7 +103,7 @@ pub fn load_bytes(
             }
             splatgl::load::load_bytes(&data, shown.as_deref(), &o)
         })
-        .map_err(|e| LoadError::new_err(e.to_string()))?;
+        .map_err(|e| LoadError::new_err(crate::message(e)))?;
     cloud_of(py, scene)
 }
 
@@ -161,7 +161,7 @@ pub fn save(
         splatgl::write::write_bytes_atomic(&path, &[], &bytes)
             .map_err(|e| format!("{}: {e}", path.display()))
     })
-    .map_err(SaveError::new_err)
+    .map_err(|e| SaveError::new_err(crate::message(e)))
 }
 
 /// Renders `cloud` from `camera`: an (H, W, 4) float32 array, display-referred RGB and
@@ -211,7 +211,7 @@ pub fn render<'py>(
             engine.upload(&c)?;
             Ok(engine.render(&c, &cam, &opts)?.0)
         })
-        .map_err(RenderError::new_err)?;
+        .map_err(|e| RenderError::new_err(crate::message(e)))?;
     image_array(py, img)
 }
 
@@ -283,7 +283,7 @@ pub fn compare<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (ia, ib) = (image_of(a, "a")?, image_of(b, "b")?);
     let c = splatgl::compare::compare(&ia, &ib, threshold)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        .map_err(|e| PyValueError::new_err(crate::message(e)))?;
     let d = PyDict::new(py);
     d.set_item("psnr", c.psnr)?;
     d.set_item("max_abs", c.max_abs)?;

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 #[pyfunction]
 pub fn conformance_generate(py: Python<'_>, dir: PathBuf) -> PyResult<()> {
     py.detach(|| splatgl_conformance::generate(&dir).map(|_| ()))
-        .map_err(|e| ConformanceError::new_err(e.to_string()))
+        .map_err(|e| ConformanceError::new_err(crate::message(e)))
 }
 
 /// Grades another renderer's images (`images/ASSET/CAMERA.png` or `.pfm`) against the suite

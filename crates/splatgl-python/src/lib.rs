@@ -75,3 +75,9 @@ fn _splatgl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(kit::cli, m)?)?;
     Ok(())
 }
+
+/// An error's message as Python sees it: file content in it made safe to print
+/// ([`splatgl::load::printable`]: terminal control characters escaped).
+pub(crate) fn message(e: impl std::fmt::Display) -> String {
+    splatgl::load::printable(&e.to_string()).into_owned()
+}

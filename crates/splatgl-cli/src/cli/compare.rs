@@ -145,7 +145,7 @@ pub fn run(a: Args) -> ExitCode {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", splatgl::load::printable(&e.to_string()));
             ExitCode::from(2)
         }
     }

@@ -245,7 +245,7 @@ fn exit(r: Result<bool, String>) -> ExitCode {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", splatgl::load::printable(&e.to_string()));
             ExitCode::from(2)
         }
     }

@@ -18,7 +18,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     let loaded = match splatgl::load::load_path(&a.file, &opts) {
         Ok(l) => l,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", splatgl::load::printable(&e.to_string()));
             return ExitCode::from(2);
         }
     };
@@ -26,7 +26,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
     let r = &loaded.report;
     let file = a.file.display().to_string();
     if let Err(e) = a.load.common.check_applies(&file, Some(r.format)) {
-        eprintln!("error: {e}");
+        eprintln!("error: {}", splatgl::load::printable(&e.to_string()));
         return ExitCode::from(2);
     }
     let b = c.bounds();

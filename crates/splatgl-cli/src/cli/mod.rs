@@ -216,7 +216,7 @@ pub(crate) fn exit_status(result: Result<(), String>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", splatgl::load::printable(&e.to_string()));
             ExitCode::from(2)
         }
     }

@@ -85,7 +85,7 @@ pub fn info(a: &super::FileArgs, opts: &LoadOptions) -> ExitCode {
     let t = splatgl::tiles::check(&a.file, opts, true);
     let Some(ts) = &t.tileset else {
         for line in t.report.summarized() {
-            eprintln!("{line}");
+            eprintln!("{}", splatgl::load::printable(&line));
         }
         return ExitCode::from(2);
     };

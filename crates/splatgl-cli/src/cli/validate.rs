@@ -20,7 +20,7 @@ pub fn run(a: super::FileArgs) -> ExitCode {
             .common
             .check_applies(&a.file.display().to_string(), Some(format))
     {
-        eprintln!("error: {e}");
+        eprintln!("error: {}", splatgl::load::printable(&e.to_string()));
         return ExitCode::from(2);
     }
     print(&a, &report, &opts, None)

@@ -218,3 +218,35 @@ fn info_validate_and_render_word_an_error_alike() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn file_content_in_messages_reaches_the_terminal_with_its_control_characters_escaped() {
+    let d = dir("controls");
+    // A PLY element name and a glTF buffer URI carrying terminal escape sequences.
+    let ply = d.join("esc.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty \x1b]0;owned\x07float x\nend_header\n1\n",
+    )
+    .unwrap();
+    let gltf = d.join("esc.gltf");
+    std::fs::write(
+        &gltf,
+        r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"\u001b[2J\u001b[31mx.bin","byteLength":4}]}"#,
+    )
+    .unwrap();
+    for f in [&ply, &gltf] {
+        for cmd in ["info", "validate"] {
+            let (code, out, err) = splatgl(&[cmd, f.to_str().unwrap()]);
+            assert_ne!(code, 0, "{cmd} {}: {out}{err}", f.display());
+            let all = out + &err;
+            assert!(
+                !all.contains(['\x1b', '\x07']),
+                "{cmd} {}: {all:?}",
+                f.display()
+            );
+            assert!(all.contains("\\u{1b}"), "{cmd} {}: {all}", f.display());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

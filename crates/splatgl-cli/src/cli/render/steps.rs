@@ -104,7 +104,8 @@ fn load_tileset(
     let ts = splatgl::tiles::read(p, opts)?;
     if !a.quiet {
         for pr in &ts.problems {
-            eprintln!("warning: {}: {}: {}", p.display(), pr.path, pr.message);
+            let line = format!("{}: {}: {}", p.display(), pr.path, pr.message);
+            eprintln!("warning: {}", splatgl::load::printable(&line));
         }
     }
     let mut cache = splatgl::tiles::TileCache::new(&ts, opts);
