@@ -37,6 +37,23 @@ pub use json::{
 };
 pub use up::{UpAxis, Z_UP_BELOW, Z_UP_TALLER};
 
+/// The largest image side any entry point renders (the CLI's `--width`/`--height`, the Python
+/// package, [`crate::engine::Engine::render`]): 16384 pixels, an f32 RGBA image of at most
+/// 4 GiB.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// `Ok` when a `width` × `height` image is within `1..=MAX_IMAGE_SIDE` per side; else the
+/// message naming the size and the limit.
+pub fn check_image_size(width: u32, height: u32) -> Result<(), String> {
+    let side = 1..=MAX_IMAGE_SIDE;
+    if side.contains(&width) && side.contains(&height) {
+        return Ok(());
+    }
+    Err(format!(
+        "image size {width}x{height} is outside 1..={MAX_IMAGE_SIDE} pixels per side"
+    ))
+}
+
 /// Why a camera could not be built.
 #[derive(Debug, thiserror::Error)]
 pub enum CameraError {

@@ -160,6 +160,7 @@ impl Engine {
         camera: &Camera,
         opts: &RenderOptions,
     ) -> Result<(Image, Option<usize>), String> {
+        crate::camera::check_image_size(camera.width, camera.height)?;
         match self {
             Engine::Reference => {
                 let space = cloud.meta.color_space.effective();

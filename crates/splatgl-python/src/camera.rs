@@ -28,14 +28,9 @@ fn vec3(name: &str, v: &PyArrayLike1<'_, f64, AllowTypeChange>) -> PyResult<Vec3
     Ok(Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32))
 }
 
-/// Checks an image size.
+/// Checks an image size (the CLI's limit, [`splatgl::camera::MAX_IMAGE_SIDE`] per side).
 fn size(width: u32, height: u32) -> PyResult<()> {
-    if width == 0 || height == 0 || width > 16384 || height > 16384 {
-        return Err(PyValueError::new_err(format!(
-            "image size {width}×{height}: each side 1–16384 pixels"
-        )));
-    }
-    Ok(())
+    splatgl::camera::check_image_size(width, height).map_err(PyValueError::new_err)
 }
 
 #[pymethods]
@@ -164,9 +159,11 @@ impl PyCamera {
             ))
         })?;
         let mut cam = Camera::from_3dgs(e).map_err(|e| CameraError::new_err(crate::message(e)))?;
+        // The file's own size is bounded like one given here (a camera of 65536 × 65536
+        // would make `render` allocate 64 GiB).
+        let (w, h) = (width.unwrap_or(cam.width), height.unwrap_or(cam.height));
+        size(w, h)?;
         if width.is_some() || height.is_some() {
-            let (w, h) = (width.unwrap_or(cam.width), height.unwrap_or(cam.height));
-            size(w, h)?;
             cam = cam.resized(w, h);
         }
         Ok(PyCamera { inner: cam })

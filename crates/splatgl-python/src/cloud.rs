@@ -136,6 +136,11 @@ fn build(
                 "scales[{i}]: {scale:?}: scales are linear standard deviations, ≥ 0 (log scales: pass numpy.exp of them)"
             )));
         }
+        if scale.iter().any(|x| !(x * x).is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "scales[{i}]: {scale:?}: a scale whose square overflows f32 (the covariance)"
+            )));
+        }
         let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
         if norm == 0.0 || !norm.is_finite() {
             return Err(PyValueError::new_err(format!(
@@ -163,6 +168,23 @@ fn build(
     Ok(c)
 }
 
+/// Refuses an array (NumPy's, before conversion) of more than `max` rows, or of more values
+/// than `max` splats at SH degree 3 hold: the loaders' splat limit, applied to arrays.
+fn rows_within(a: &Bound<'_, PyAny>, name: &str, max: u64) -> PyResult<()> {
+    let Ok(a) = a.cast::<numpy::PyUntypedArray>() else {
+        return Ok(()); // a list or the like: already whole in memory
+    };
+    let shape = a.shape();
+    let rows = shape.first().copied().unwrap_or(0) as u128;
+    let values: u128 = shape.iter().map(|&d| d as u128).product();
+    if rows > u128::from(max) || values > u128::from(max) * 48 {
+        return Err(PyValueError::new_err(format!(
+            "{name}: shape {shape:?}: more than max_splats = {max} splats (raise with max_splats=)"
+        )));
+    }
+    Ok(())
+}
+
 /// A meta value as written (known values by name).
 fn known<T: Copy>(k: &Known<T>, name: fn(T) -> &'static str) -> String {
     k.to_string_with(name)
@@ -176,18 +198,42 @@ impl Cloud {
     /// (the degree-0 coefficient `(c − 0.5) / 0.2820948`); `color_space` one of
     /// "srgb_rec709_display" (default) or "lin_rec709_display".
     #[staticmethod]
-    #[pyo3(signature = (positions, scales, rotations, opacities, sh=None, colors=None, color_space=None))]
+    #[pyo3(signature = (positions, scales, rotations, opacities, sh=None, colors=None, color_space=None, *, max_splats=None))]
     #[allow(clippy::too_many_arguments)]
     fn from_arrays(
         py: Python<'_>,
-        positions: PyArrayLike2<'_, f32, AllowTypeChange>,
-        scales: PyArrayLike2<'_, f32, AllowTypeChange>,
-        rotations: PyArrayLike2<'_, f32, AllowTypeChange>,
-        opacities: PyArrayLike1<'_, f32, AllowTypeChange>,
-        sh: Option<PyArrayLike3<'_, f32, AllowTypeChange>>,
-        colors: Option<PyArrayLike2<'_, f32, AllowTypeChange>>,
+        positions: &Bound<'_, PyAny>,
+        scales: &Bound<'_, PyAny>,
+        rotations: &Bound<'_, PyAny>,
+        opacities: &Bound<'_, PyAny>,
+        sh: Option<&Bound<'_, PyAny>>,
+        colors: Option<&Bound<'_, PyAny>>,
         color_space: Option<&str>,
+        max_splats: Option<u64>,
     ) -> PyResult<Self> {
+        // Sizes first, before any conversion copies an array (a broadcast view of a billion
+        // rows takes no memory until converted).
+        let max = max_splats.unwrap_or(splatgl::load::Limits::DEFAULT_MAX_SPLATS);
+        for (name, a) in [
+            ("positions", Some(positions)),
+            ("scales", Some(scales)),
+            ("rotations", Some(rotations)),
+            ("opacities", Some(opacities)),
+            ("sh", sh),
+            ("colors", colors),
+        ] {
+            if let Some(a) = a {
+                rows_within(a, name, max)?;
+            }
+        }
+        let positions: PyArrayLike2<'_, f32, AllowTypeChange> = positions.extract()?;
+        let scales: PyArrayLike2<'_, f32, AllowTypeChange> = scales.extract()?;
+        let rotations: PyArrayLike2<'_, f32, AllowTypeChange> = rotations.extract()?;
+        let opacities: PyArrayLike1<'_, f32, AllowTypeChange> = opacities.extract()?;
+        let sh: Option<PyArrayLike3<'_, f32, AllowTypeChange>> =
+            sh.map(|a| a.extract()).transpose()?;
+        let colors: Option<PyArrayLike2<'_, f32, AllowTypeChange>> =
+            colors.map(|a| a.extract()).transpose()?;
         let mut meta = SplatMeta::default();
         if let Some(cs) = color_space {
             meta.color_space = match ColorSpace::parse(cs) {
@@ -211,9 +257,9 @@ impl Cloud {
                         c.shape()
                     )));
                 }
-                from_colors = c
-                    .mapv(|v| (v - 0.5) / splatgl::sh::SH_C0 as f32)
-                    .into_shape_with_order((n, 1, 3))
+                // In logical order whatever the strides (a broadcast view has zero ones).
+                let dc = c.iter().map(|v| (v - 0.5) / splatgl::sh::SH_C0 as f32);
+                from_colors = numpy::ndarray::Array3::from_shape_vec((n, 1, 3), dc.collect())
                     .map_err(|e| PyValueError::new_err(e.to_string()))?;
                 from_colors.view()
             }
@@ -233,6 +279,8 @@ impl Cloud {
             sh_view,
             meta,
         )?;
+        c.validate()
+            .map_err(|v| PyValueError::new_err(v.to_string()))?;
         Cloud::from_splat_cloud(py, c, Vec::new(), "arrays".into())
     }
 

@@ -3,7 +3,9 @@
 use crate::camera::PyCamera;
 use crate::cloud::Cloud;
 use crate::{LoadError, RenderError, SaveError};
-use numpy::{AllowTypeChange, PyArray1, PyArray3, PyArrayLike3, PyArrayMethods};
+use numpy::{
+    AllowTypeChange, PyArray1, PyArray3, PyArrayLike3, PyArrayMethods, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -24,7 +26,9 @@ fn options(
     let mut o = LoadOptions {
         strict,
         allow_outside_paths,
-        memory_map: true,
+        // Read, not mapped: a file truncated under a mapping kills the process with SIGBUS,
+        // which an interpreter must not risk (the library's default for embedders).
+        memory_map: false,
         ..Default::default()
     };
     if let Some(n) = max_splats {
@@ -76,7 +80,9 @@ pub fn load(
 }
 
 /// Loads from bytes; `name` (a file name) helps detect the format and names it in errors.
-/// External glTF buffers are not read (GLB and data-URI buffers are). Raises `LoadError`.
+/// No file is opened, whatever `name` says: a glTF's buffers must be in the bytes (GLB,
+/// data URIs) and an unbundled SOG `meta.json` cannot load (its textures are files).
+/// Raises `LoadError`.
 #[pyfunction]
 #[pyo3(signature = (data, name=None, *, max_splats=None, strict=false))]
 pub fn load_bytes(
@@ -87,22 +93,15 @@ pub fn load_bytes(
     strict: bool,
 ) -> PyResult<Cloud> {
     let mut o = options(max_splats, None, strict, false);
-    o.memory_map = false;
-    // No path: no external buffer is opened.
+    // Whatever the name: every file a document names goes to this resolver, which opens none.
+    o.resolver = Some(std::sync::Arc::new(|uri: &str| {
+        Err(format!(
+            "{uri:?}: load_bytes opens no file (pass a GLB, data URIs, or use load)"
+        ))
+    }));
     let shown = name.map(PathBuf::from);
     let scene = py
-        .detach(|| {
-            if shown
-                .as_ref()
-                .is_some_and(|p| p.extension().is_some_and(|e| e == "gltf"))
-            {
-                // A .gltf from memory: its buffers must be data URIs (nothing is opened).
-                o.resolver = Some(std::sync::Arc::new(|uri: &str| {
-                    Err(format!("{uri}: load_bytes reads no external buffer"))
-                }));
-            }
-            splatgl::load::load_bytes(&data, shown.as_deref(), &o)
-        })
+        .detach(|| splatgl::load::load_bytes(&data, shown.as_deref(), &o))
         .map_err(|e| LoadError::new_err(crate::message(e)))?;
     cloud_of(py, scene)
 }
@@ -194,8 +193,9 @@ pub fn render<'py>(
             "background: finite RGB; sh_degree: 0–3",
         ));
     }
-    let c = cloud.to_splat_cloud(py)?;
     let cam = camera.inner;
+    splatgl::camera::check_image_size(cam.width, cam.height).map_err(PyValueError::new_err)?;
+    let c = cloud.to_splat_cloud(py)?;
     let img = py
         .detach(|| -> Result<Image, String> {
             let mut engine = match wanted {
@@ -245,12 +245,23 @@ fn image_of(v: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
     if let Ok(p) = v.extract::<PathBuf>() {
         return read_image(&p);
     }
+    // The size before any conversion copies the array (a broadcast view takes no memory).
+    if let Ok(arr) = v.cast::<numpy::PyUntypedArray>()
+        && let [h, w, _] = arr.shape()
+    {
+        let side = |n: &usize| u32::try_from(*n).unwrap_or(u32::MAX);
+        splatgl::camera::check_image_size(side(w), side(h))
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+    }
     let a: PyArrayLike3<'_, f32, AllowTypeChange> = v
         .extract()
         .map_err(|_| PyValueError::new_err(format!("{name}: a path or an (H, W, 3|4) array")))?;
     let a = a.as_array();
     let (h, w, ch) = a.dim();
-    if !(ch == 3 || ch == 4) || h == 0 || w == 0 {
+    let side = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+    splatgl::camera::check_image_size(side(w), side(h))
+        .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+    if !(ch == 3 || ch == 4) {
         return Err(PyValueError::new_err(format!(
             "{name}: shape {:?}, expected (H, W, 3) or (H, W, 4)",
             a.shape()

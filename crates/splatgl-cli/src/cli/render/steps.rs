@@ -255,17 +255,14 @@ pub(super) fn render_tileset_views(
     Ok((visible, drawn))
 }
 
-/// Refuses views whose image size is outside `1..=16384` per side.
+/// Refuses views whose image size is outside `1..=16384` per side
+/// ([`splatgl::camera::MAX_IMAGE_SIDE`]).
 pub(super) fn check_image_sizes(views: &[(Camera, f32)]) -> Result<(), String> {
     for (cam, _) in views {
         // cameras.json sizes and derived sizes are bounded like the flags (an image is 16
         // bytes per pixel in f32).
-        if !(1..=16384).contains(&cam.width) || !(1..=16384).contains(&cam.height) {
-            return Err(format!(
-                "image size {}x{} is outside 1..=16384 per side; give --width/--height",
-                cam.width, cam.height
-            ));
-        }
+        splatgl::camera::check_image_size(cam.width, cam.height)
+            .map_err(|e| format!("{e}; give --width/--height"))?;
     }
     Ok(())
 }
