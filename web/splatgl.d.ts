@@ -33,6 +33,14 @@ export interface View {
  * resolved into the canvas (the default), or the canvas's 8 bits. */
 export type Target = 'float' | 'rgba8';
 
+/** What one load may take (`Renderer.setLimits`). */
+export interface Limits {
+  /** Most bytes of a file (and of what a compressed format inflates to); default 1 GiB. */
+  maxBytes: number;
+  /** Most splats; default 4,194,304. */
+  maxSplats: number;
+}
+
 /** GPU milliseconds of the stages of one draw (undefined: the stage did not run). */
 export interface StageTimes {
   /** The pre-pass: the per-splat maths, once per splat (transform feedback). */
@@ -48,6 +56,11 @@ export interface Renderer {
   /** Loads a file from its bytes; `name`'s extension helps detect the format. Throws with the
    * loader's message on a file that cannot be loaded (the previous scene stays). */
   load(bytes: ArrayBuffer | Uint8Array, name: string): Promise<LoadInfo>;
+  /** Bounds what one load may take (an absent key keeps its bound); a load over a bound
+   * throws an Error naming it and the previous scene stays drawn. */
+  setLimits(limits: Partial<Limits>): void;
+  /** The bounds of a load. */
+  readonly limits: Limits;
   /** Loads the bundled default scene. */
   loadDefault(): LoadInfo;
   /** The view (world → eye, looking down −z) and projection matrices, 16 numbers each,

@@ -32,7 +32,23 @@ class SplatglRenderer {
    * { name, format, splats, sh_degree, cameras, warnings } (`format` undefined for none). */
   async load(bytes, name) {
     const data = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
+    // Checked before the bytes are copied into the module's memory.
+    const { maxBytes } = this.limits;
+    if (data.byteLength > maxBytes) {
+      throw new Error(`${name}: ${data.byteLength} bytes, more than the renderer's limit of ${maxBytes} bytes (setLimits({ maxBytes }))`);
+    }
     return info(this.inner.load(data, name));
+  }
+
+  /** Bounds what one load may take: `maxBytes` of file (default 1 GiB; also what a compressed
+   * format may inflate to) and `maxSplats` (default 4,194,304); an absent key keeps its bound.
+   * A load over a bound throws an Error naming it, and the previous scene stays drawn. */
+  setLimits({ maxBytes, maxSplats } = {}) { this.inner.set_limits(maxBytes, maxSplats); }
+
+  /** The bounds of a load: { maxBytes, maxSplats }. */
+  get limits() {
+    const l = JSON.parse(this.inner.limits());
+    return { maxBytes: l.max_bytes, maxSplats: l.max_splats };
   }
 
   /** Loads the bundled default scene. */

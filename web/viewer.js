@@ -45,6 +45,40 @@ async function open(bytes, name) {
   window.splatglLoaded = (window.splatglLoaded || 0) + 1; // for the tests
 }
 
+// A file picked or dropped: its size checked against the renderer's limit before it is read.
+async function openFile(f) {
+  const { maxBytes } = renderer.limits;
+  if (f.size > maxBytes) {
+    showError(`${f.name}: ${f.size} bytes, more than the viewer's limit of ${maxBytes} bytes`);
+    return;
+  }
+  await open(await f.arrayBuffer(), f.name);
+}
+
+// `url`'s body, read as it arrives and refused past `maxBytes` (a server's Content-Length
+// is checked first, but a body may be longer than it says, or have none).
+async function fetchBounded(url, maxBytes) {
+  const res = await fetch(url);
+  if (!res.ok) throw new Error(`${url}: HTTP ${res.status}`);
+  const tooBig = (n) => new Error(`${url}: ${n} bytes or more, more than the viewer's limit of ${maxBytes} bytes`);
+  const declared = Number(res.headers.get('content-length'));
+  if (declared > maxBytes) throw tooBig(declared);
+  const reader = res.body.getReader();
+  const parts = [];
+  let total = 0;
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (done) break;
+    total += value.byteLength;
+    if (total > maxBytes) { await reader.cancel(); throw tooBig(total); }
+    parts.push(value);
+  }
+  const bytes = new Uint8Array(total);
+  let at = 0;
+  for (const p of parts) { bytes.set(p, at); at += p.byteLength; }
+  return bytes;
+}
+
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
 const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
@@ -129,7 +163,7 @@ function fly(dt) {
 
 document.getElementById('file').addEventListener('change', async (e) => {
   const f = e.target.files[0];
-  if (f) await open(await f.arrayBuffer(), f.name);
+  if (f) await openFile(f);
 });
 document.getElementById('sh').addEventListener('change', (e) => {
   renderer.setShDegree(e.target.value === '' ? undefined : Number(e.target.value));
@@ -142,7 +176,7 @@ window.addEventListener('drop', async (e) => {
   e.preventDefault();
   document.body.classList.remove('dragging');
   const f = e.dataTransfer.files[0];
-  if (f) await open(await f.arrayBuffer(), f.name);
+  if (f) await openFile(f);
 });
 
 let last = performance.now();
@@ -183,12 +217,13 @@ async function main() {
   window.splatglRenderer = renderer; // for the tests and the console
   window.splatglOpen = open;
   resize();
-  const url = new URLSearchParams(location.search).get('url');
+  const params = new URLSearchParams(location.search);
+  // ?maxBytes=N: the most bytes a file may have (default: the renderer's, 1 GiB).
+  if (params.get('maxBytes')) renderer.setLimits({ maxBytes: Number(params.get('maxBytes')) });
+  const url = params.get('url');
   if (url) {
     try {
-      const res = await fetch(url);
-      if (!res.ok) throw new Error(`${url}: HTTP ${res.status}`);
-      await open(await res.arrayBuffer(), url.split('/').pop().split('?')[0]);
+      await open(await fetchBounded(url, renderer.limits.maxBytes), url.split('/').pop().split('?')[0]);
     } catch (e) {
       showError(e);
     }

@@ -48,6 +48,26 @@ pub struct Renderer {
     float: Option<OffscreenTarget>,
     /// [`Renderer::dispose`] ran: every GPU object is gone.
     disposed: bool,
+    /// What one load may take ([`Renderer::set_limits`]).
+    limits: splatgl::load::Limits,
+}
+
+/// Default [`Renderer::set_limits`] `max_bytes`: 1 GiB. A load holds the file, the cloud
+/// (~250 bytes per splat at SH degree 3) and the upload's staging copy in wasm's 4 GiB at
+/// once, and wasm cannot recover from a failed allocation: the bounds keep a load within it.
+pub const WEB_MAX_BYTES: u64 = 1 << 30;
+/// Default [`Renderer::set_limits`] `max_splats`: 4 Mi (about 1 GiB of cloud at SH degree 3).
+pub const WEB_MAX_SPLATS: u64 = 1 << 22;
+
+/// The loader's limits in the browser: [`WEB_MAX_BYTES`] for the file and what it inflates
+/// to, [`WEB_MAX_SPLATS`].
+fn web_limits() -> splatgl::load::Limits {
+    splatgl::load::Limits {
+        max_splats: WEB_MAX_SPLATS,
+        max_bytes: WEB_MAX_BYTES,
+        max_decompressed_bytes: WEB_MAX_BYTES,
+        ..Default::default()
+    }
 }
 
 fn js_error(e: impl std::fmt::Display) -> JsError {
@@ -110,6 +130,7 @@ impl Renderer {
             float_blending: true,
             float: None,
             disposed: false,
+            limits: web_limits(),
         })
     }
 
@@ -121,12 +142,19 @@ impl Renderer {
     /// the previous cloud stays.
     pub fn load(&mut self, bytes: &[u8], name: &str) -> Result<String, JsError> {
         self.live()?;
-        let scene = load_bytes(
-            bytes,
-            Some(std::path::Path::new(name)),
-            &LoadOptions::default(),
-        )
-        .map_err(js_error)?;
+        let limits = self.limits;
+        if bytes.len() as u64 > limits.max_bytes {
+            return Err(JsError::new(&format!(
+                "{name}: {} bytes, more than the renderer's limit of {} bytes (setLimits({{ maxBytes }}))",
+                bytes.len(),
+                limits.max_bytes
+            )));
+        }
+        let opts = LoadOptions {
+            limits,
+            ..LoadOptions::default()
+        };
+        let scene = load_bytes(bytes, Some(std::path::Path::new(name)), &opts).map_err(js_error)?;
         let warnings: Vec<String> = scene
             .report
             .findings
@@ -143,6 +171,43 @@ impl Renderer {
         Ok(self.info(&warnings))
     }
 
+    /// Bounds what one load may take: `max_bytes` of file (and what a compressed format
+    /// inflates to; default [`WEB_MAX_BYTES`]) and `max_splats` (default [`WEB_MAX_SPLATS`]).
+    /// `None` keeps a bound as it is. A load over a bound is an error naming it, and the
+    /// previous scene stays.
+    pub fn set_limits(
+        &mut self,
+        max_bytes: Option<f64>,
+        max_splats: Option<f64>,
+    ) -> Result<(), JsError> {
+        let count = |what: &str, v: f64| -> Result<u64, JsError> {
+            if v.is_finite() && v >= 1.0 && v <= 2f64.powi(53) {
+                Ok(v as u64)
+            } else {
+                Err(JsError::new(&format!(
+                    "{what}: expected a positive whole number, got {v}"
+                )))
+            }
+        };
+        if let Some(b) = max_bytes {
+            self.limits.max_bytes = count("maxBytes", b)?;
+            self.limits.max_decompressed_bytes = self.limits.max_bytes;
+        }
+        if let Some(n) = max_splats {
+            self.limits.max_splats = count("maxSplats", n)?;
+        }
+        Ok(())
+    }
+
+    /// The bounds of a load: `{"max_bytes": …, "max_splats": …}`.
+    pub fn limits(&self) -> String {
+        serde_json::json!({
+            "max_bytes": self.limits.max_bytes,
+            "max_splats": self.limits.max_splats,
+        })
+        .to_string()
+    }
+
     /// Loads the bundled default scene (what `splatgl render` draws without a file).
     pub fn load_default(&mut self) -> Result<String, JsError> {
         self.live()?;
@@ -155,10 +220,16 @@ impl Renderer {
         Ok(self.info(&[]))
     }
 
+    /// Uploads `loaded`; when the GPU refuses it, the previous cloud is uploaded again (the
+    /// renderer keeps drawing what it had) and the error returned.
     fn upload(&mut self, loaded: Loaded) -> Result<(), JsError> {
-        self.renderer
-            .upload(&self.gl, &loaded.cloud)
-            .map_err(js_error)?;
+        if let Err(e) = self.renderer.upload(&self.gl, &loaded.cloud) {
+            if let Some(previous) = &self.loaded {
+                // Best effort: it fitted before.
+                let _ = self.renderer.upload(&self.gl, &previous.cloud);
+            }
+            return Err(js_error(e));
+        }
         self.loaded = Some(loaded);
         Ok(())
     }

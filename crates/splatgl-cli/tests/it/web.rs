@@ -137,7 +137,7 @@ fn web_build_passes_every_required_asset_of_the_generated_suite() {
 }
 
 #[test]
-fn web_viewer_shows_a_malformed_files_error_and_keeps_working() {
+fn web_viewer_shows_a_malformed_or_oversized_files_error_and_keeps_drawing() {
     if let Some(why) = missing() {
         common::skip(&why);
         return;
@@ -161,6 +161,13 @@ fn web_viewer_shows_a_malformed_files_error_and_keeps_working() {
     assert_eq!(r["errorAfterGood"], "", "{r}");
     assert_eq!(r["splats"], 4721, "{r}");
     assert!(r["litPixels"].as_u64().unwrap() > 1000, "{r}");
+    // Over the size limit: refused by name, the previous scene kept and drawn.
+    let over = r["overLimitError"].as_str().unwrap();
+    assert!(over.contains("limit of 1000 bytes"), "{r}");
+    assert_eq!(r["splatsAfterOverLimit"], 4721, "{r}");
+    assert!(r["litPixelsAfterOverLimit"].as_u64().unwrap() > 1000, "{r}");
+    let fetched = r["fetchOverLimitError"].as_str().unwrap();
+    assert!(fetched.contains("limit of 1000 bytes"), "{r}");
 }
 
 #[test]
