@@ -212,6 +212,38 @@ fn cameras_seeds(dir: &Path) {
     put(dir, "cameras_json", "empty.json", b"[]");
 }
 
+/// Tilesets over the fuzz target's `c.ply` (fuzz/src/lib.rs), and URIs that try to leave.
+fn tileset_seeds(dir: &Path) {
+    let tile = |uri: &str| {
+        format!(
+            r#"{{"asset": {{"version": "1.1"}}, "geometricError": 10, "root": {{"boundingVolume":
+            {{"box": [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]}}, "geometricError": 1, "refine": "ADD",
+            "content": {{"uri": "{uri}"}}, "children": [{{"boundingVolume": {{"box": [0, 0, 0, 1, 0,
+            0, 0, 1, 0, 0, 0, 1]}}, "geometricError": 0, "content": {{"uri": "./c.ply"}}}}]}}}}"#
+        )
+    };
+    for (i, uri) in [
+        "c.ply",
+        "%2e%2e/secret.ply",
+        "..%2fsecret.ply",
+        "sub/../../secret.ply",
+    ]
+    .iter()
+    .enumerate()
+    {
+        put(
+            dir,
+            "tileset",
+            &format!("tileset{i}.json"),
+            tile(uri).as_bytes(),
+        );
+        put(dir, "tileset", &format!("uri{i}"), uri.as_bytes());
+    }
+    let lod = r#"{"lodLevels": 1, "filenames": ["c.ply"], "tree": {"bound": {"min": [0, 0, 0],
+        "max": [1, 1, 1]}, "lods": {"0": {"file": 0, "offset": 0, "count": 4}}}}"#;
+    put(dir, "tileset", "lod-meta.json", lod.as_bytes());
+}
+
 /// Real files small enough to be fast seeds, by the target their format belongs to.
 fn real_seeds(dir: &Path, real: &Path) {
     let Ok(entries) = std::fs::read_dir(real) else {
@@ -251,6 +283,7 @@ fn main() {
     ply_seeds(dir);
     gltf_seeds(dir);
     cameras_seeds(dir);
+    tileset_seeds(dir);
     packed_seeds(dir);
     // The structure-aware target decodes any bytes; a few fixed ones start it off.
     for (i, seed) in [&[0u8; 16][..], &[7; 64], &(0..=255).collect::<Vec<u8>>()]

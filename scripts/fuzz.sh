@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-targets=(ply gltf_json glb gltf_struct cameras_json spz splat ksplat sog)
+targets=(ply gltf_json glb gltf_struct cameras_json spz splat ksplat sog tileset)
 which=${1:-all}
 secs=${2:-60}
 if [ "$which" != all ]; then

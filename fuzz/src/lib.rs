@@ -115,3 +115,94 @@ pub fn check_cameras_json(data: &[u8]) {
         }
     }
 }
+
+/// The folder the tileset target works in: `ts/` holds `c.ply` (4 splats) and gets each
+/// input as `ts/tileset.json`; beside `ts/` lies `secret.ply` (1001 splats), which no content
+/// URI may reach.
+fn tileset_dir() -> &'static Path {
+    static DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let root =
+            std::env::temp_dir().join(format!("splatgl-fuzz-tileset-{}", std::process::id()));
+        std::fs::create_dir_all(root.join("ts")).expect("fuzz folder");
+        let cloud = |n: usize| {
+            let mut c = splatgl::SplatCloud::with_capacity(0, n);
+            for i in 0..n {
+                c.push(
+                    [i as f32 * 0.01, 0.0, 0.0],
+                    [0.1; 3],
+                    [0.0, 0.0, 0.0, 1.0],
+                    0.5,
+                    &[[0.0; 3]],
+                );
+            }
+            splatgl::write::to_inria_ply(&c)
+        };
+        std::fs::write(root.join("ts/c.ply"), cloud(4)).expect("content");
+        std::fs::write(root.join("secret.ply"), cloud(1001)).expect("secret");
+        root
+    })
+}
+
+/// A tileset's JSON and URIs: read, checked and its content loaded (every URI resolved under
+/// the containment rule) without a panic, and no splat from outside its folder — every
+/// content it can reach holds 4 splats, the one outside 1001. The input as a URI is also
+/// resolved against an http tileset's URL: a URL it gives stays under the folder, with no
+/// segment that decodes to `.` or `..` or holds a separator.
+pub fn check_tileset(data: &[u8]) {
+    let dir = tileset_dir();
+    let path = dir.join("ts").join("tileset.json");
+    if std::fs::write(&path, data).is_err() {
+        return;
+    }
+    let r = splatgl::tiles::check(&path, &options(false), true);
+    if let Some(n) = r.report.splat_count {
+        assert_eq!(
+            n % 4,
+            0,
+            "{n} splats: content from outside the tileset's folder"
+        );
+    }
+    let Ok(uri) = std::str::from_utf8(data) else {
+        return;
+    };
+    let base = "http://h:8/a/b/tileset.json";
+    if let Ok(url) = splatgl::files::http::resolve(base, uri, false) {
+        let rest = url
+            .strip_prefix("http://h:8/a/b/")
+            .unwrap_or_else(|| panic!("{uri:?} resolved outside the folder: {url}"));
+        for seg in rest.split('/') {
+            let decoded = percent_decoded(seg);
+            assert!(
+                decoded != b"."
+                    && decoded != b".."
+                    && !decoded.contains(&b'/')
+                    && !decoded.contains(&b'\\'),
+                "{uri:?} gave {url}: segment {seg:?}"
+            );
+        }
+    }
+}
+
+/// `%XX` escapes decoded (as a server does).
+fn percent_decoded(s: &str) -> Vec<u8> {
+    let b = s.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%'
+            && let (Some(h), Some(l)) = (
+                b.get(i + 1).and_then(|c| hex(*c)),
+                b.get(i + 2).and_then(|c| hex(*c)),
+            )
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    out
+}
