@@ -31,6 +31,8 @@ class Cloud:
         sh: Optional[ArrayLike] = None,
         colors: Optional[ArrayLike] = None,
         color_space: Optional[str] = None,
+        *,
+        max_splats: Optional[int] = None,
     ) -> "Cloud": ...
     @property
     def positions(self) -> npt.NDArray[np.float32]: ...
