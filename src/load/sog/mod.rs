@@ -229,6 +229,10 @@ pub(crate) fn parse_meta(json: &[u8], limits: &Limits) -> Result<Meta, SogError>
 /// default JSON limits is told by its keys (the reader then names the limit).
 pub(crate) fn is_meta_json(bytes: &[u8]) -> bool {
     let has = |k: &[u8]| bytes.windows(k.len()).any(|w| w == k);
+    let object = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{');
+    if !object {
+        return false;
+    }
     if crate::files::check_json(bytes, &Limits::default()).is_err() {
         return has(b"\"quats\"") && has(b"\"means\"");
     }
