@@ -6,6 +6,9 @@ KHR_gaussian_splatting files, and run the conformance kit.
     cloud = splatgl.load("scene.ply")
     cam = splatgl.Camera.look_at(eye=(0, 0, 4), target=(0, 0, 0), width=640, height=480)
     image = splatgl.render(cloud, cam)          # (480, 640, 4) float32
+    with splatgl.Renderer() as r:               # kept open: one context, one upload
+        r.upload(cloud)
+        images = r.render_many([cam, cam])
 
 See docs/python.md.
 """
@@ -17,6 +20,7 @@ from ._splatgl import (
     ConformanceError,
     LoadError,
     RenderError,
+    Renderer,
     SaveError,
     SplatglError,
     __version__,
@@ -36,6 +40,7 @@ __all__ = [
     "ConformanceError",
     "LoadError",
     "RenderError",
+    "Renderer",
     "SaveError",
     "SplatglError",
     "__version__",

@@ -125,6 +125,35 @@ def save(
     spz_compress: bool = False,
     color_space: Optional[str] = None,
 ) -> None: ...
+class Renderer:
+    """A renderer kept open: one GL context (or the reference) and one uploaded cloud."""
+
+    def __init__(
+        self, backend: str = "auto", width: Optional[int] = None, height: Optional[int] = None
+    ) -> None: ...
+    def upload(self, cloud: Cloud) -> None: ...
+    def render(
+        self,
+        camera: Camera,
+        sh_degree: int = 3,
+        background: Tuple[float, float, float] = (0.0, 0.0, 0.0),
+        antialiased: bool = False,
+    ) -> npt.NDArray[np.float32]: ...
+    def render_many(
+        self,
+        cameras: Sequence[Camera],
+        sh_degree: int = 3,
+        background: Tuple[float, float, float] = (0.0, 0.0, 0.0),
+        antialiased: bool = False,
+    ) -> List[npt.NDArray[np.float32]]: ...
+    def close(self) -> None: ...
+    @property
+    def backend(self) -> str: ...
+    @property
+    def closed(self) -> bool: ...
+    def __enter__(self) -> "Renderer": ...
+    def __exit__(self, *args: object) -> bool: ...
+
 def render(
     cloud: Cloud,
     camera: Camera,

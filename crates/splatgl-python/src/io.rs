@@ -2,16 +2,14 @@
 
 use crate::camera::PyCamera;
 use crate::cloud::Cloud;
+use crate::renderer;
 use crate::{LoadError, RenderError, SaveError};
-use numpy::{
-    AllowTypeChange, PyArray1, PyArray3, PyArrayLike3, PyArrayMethods, PyUntypedArrayMethods,
-};
+use numpy::{AllowTypeChange, PyArray3, PyArrayLike3, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use splatgl::cloud::{ColorSpace, Known};
 use splatgl::convert::{ConvertOptions, OutputFormat};
-use splatgl::engine::{Backend, Engine};
 use splatgl::image::Image;
 use splatgl::load::{LoadOptions, Scene};
 use std::path::{Path, PathBuf};
@@ -177,48 +175,19 @@ pub fn render<'py>(
     background: (f32, f32, f32),
     antialiased: bool,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let wanted = match backend {
-        "auto" => None,
-        "gl" => Some(Backend::Gl),
-        "reference" => Some(Backend::Reference),
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "backend {other:?}: expected \"auto\", \"gl\" or \"reference\""
-            )));
-        }
-    };
-    let bg = [background.0, background.1, background.2];
-    if bg.iter().any(|v| !v.is_finite()) || sh_degree > 3 {
-        return Err(PyValueError::new_err(
-            "background: finite RGB; sh_degree: 0–3",
-        ));
-    }
-    let cam = camera.inner;
-    splatgl::camera::check_image_size(cam.width, cam.height).map_err(PyValueError::new_err)?;
+    // One-shot: a renderer made, used once and closed (splatgl.Renderer keeps it open).
+    let o = renderer::render_options(sh_degree, background, antialiased)?;
+    let cam = renderer::sized(camera, None)?;
+    let wanted = renderer::backend(backend)?;
     let c = cloud.to_splat_cloud(py)?;
     let img = py
         .detach(|| -> Result<Image, String> {
-            let mut engine = match wanted {
-                Some(b) => Engine::new(b)?,
-                None => Engine::new(Backend::Gl).or_else(|_| Engine::new(Backend::Reference))?,
-            };
-            let opts = splatgl::reference::RenderOptions {
-                sh_degree,
-                background: bg,
-                antialiased,
-                ..Default::default()
-            };
+            let mut engine = renderer::make_engine(wanted)?;
             engine.upload(&c)?;
-            Ok(engine.render(&c, &cam, &opts)?.0)
+            Ok(engine.render(&c, &cam, &o)?.0)
         })
         .map_err(|e| RenderError::new_err(crate::message(e)))?;
-    image_array(py, img)
-}
-
-/// An image as an (H, W, 4) float32 array.
-fn image_array(py: Python<'_>, img: Image) -> PyResult<Bound<'_, PyArray3<f32>>> {
-    let (w, h) = (img.width as usize, img.height as usize);
-    PyArray1::from_vec(py, img.pixels.into_flattened()).reshape([h, w, 4])
+    renderer::image_array(py, img)
 }
 
 /// Validates a file against KHR_gaussian_splatting (and the formats' own rules): a list of

@@ -11,6 +11,7 @@ mod camera;
 mod cloud;
 mod io;
 mod kit;
+mod renderer;
 
 use pyo3::prelude::*;
 
@@ -64,6 +65,7 @@ fn _splatgl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<cloud::Cloud>()?;
     m.add_class::<camera::PyCamera>()?;
+    m.add_class::<renderer::Renderer>()?;
     m.add_function(wrap_pyfunction!(io::load, m)?)?;
     m.add_function(wrap_pyfunction!(io::load_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(io::save, m)?)?;
