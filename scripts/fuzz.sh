@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Runs the loader fuzz targets (fuzz/, cargo-fuzz layout):
 #   scripts/fuzz.sh [TARGET|all] [SECONDS]      default: all targets, 60 s each, one after the other
+#   scripts/fuzz.sh smoke [SECONDS]             CI's smoke test: every target replays its seeds
+#                                               and fuzzes SECONDS (default 2), built in the dev
+#                                               profile (44 s to build instead of 110 s; slower
+#                                               executions, so -timeout=10 instead of 1)
 # Each run: libFuzzer with -timeout=1 (an input taking over 1 s is a hang) and -rss_limit_mb=1024
 # (an allocation over 1 GiB is a failure), debug assertions and overflow checks on, no sanitizer
 # (the loaders are safe Rust; a sanitizer only slows the search on a 2-core machine).
@@ -16,11 +20,17 @@ root=$(pwd)
 targets=(ply gltf_json glb gltf_struct cameras_json spz splat ksplat sog tileset)
 which=${1:-all}
 secs=${2:-60}
+build=(--sanitizer none --debug-assertions --release)
+timeout=1
+if [ "$which" = smoke ]; then
+  which=all secs=${2:-2} timeout=10
+  build=(--sanitizer none --dev)
+fi
 if [ "$which" != all ]; then
   [[ " ${targets[*]} " == *" $which "* ]] || { echo "unknown target $which (${targets[*]})" >&2; exit 2; }
   targets=("$which")
 fi
-command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --version 0.13.2 --locked
+command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --version 0.13.2 --locked --debug
 if rustup toolchain list 2>/dev/null | grep -q '^nightly'; then
   fuzz=(cargo +nightly fuzz)
 else
@@ -29,13 +39,12 @@ else
 fi
 rm -rf fuzz/seeds
 cargo run --quiet --example fuzz_seeds -- fuzz/seeds "$root/../shared/data/real"
-build=(--sanitizer none --debug-assertions --release)
 "${fuzz[@]}" build "${build[@]}"
 for t in "${targets[@]}"; do
   mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"
   echo "== $t: ${secs}s"
   # shellcheck disable=SC2086
   "${fuzz[@]}" run "${build[@]}" "$t" "$root/fuzz/corpus/$t" "$root/fuzz/seeds/$t" -- \
-    -max_total_time="$secs" -timeout=1 -rss_limit_mb=1024 -print_final_stats=1 \
+    -max_total_time="$secs" -timeout="$timeout" -rss_limit_mb=1024 -print_final_stats=1 \
     -artifact_prefix="$root/fuzz/artifacts/$t/" ${FUZZ_FLAGS:-}
 done
