@@ -5,8 +5,8 @@
 #         independent Python re-implementation of the reference's math, and every unit and
 #         integration test of every crate except the slow cross-checks;
 #   python: the Python package (crates/splatgl-python) installed into a venv under the target
-#         folder with `pip install .` (maturin, the dev profile: the fast lane's dependencies
-#         are reused), then its pytest suite (python/tests) against the command;
+#         folder with `pip install .` (maturin, the dev profile), Ray for the `ray` extra, then
+#         its pytest suite (python/tests, splatgl.ray's on a local cluster) against the command;
 #   platforms: the other platforms (docs/platforms.md): clippy with warnings as errors for
 #         Windows (x86_64-pc-windows-gnu), macOS (aarch64-apple-darwin, which can only be
 #         checked here) and the browser (wasm32-unknown-unknown), the Windows build staged by
@@ -55,8 +55,9 @@ fast() {
 python() {
   local venv="$target/pyvenv"
   [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+  # ray: the optional extra splatgl.ray needs (its tests start a local cluster).
   "$venv/bin/pip" install --quiet --disable-pip-version-check \
-    maturin==1.16.0 pytest==9.2.0 numpy==2.4.6
+    maturin==1.16.0 pytest==9.2.0 numpy==2.4.6 ray==2.60.0
   PATH="$PWD/$venv/bin:$PATH" MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/pip" install --quiet \
     --disable-pip-version-check --no-build-isolation --force-reinstall --no-deps .
   SPLATGL_BIN="$target/debug/splatgl" "$venv/bin/python" -m pytest -q python/tests

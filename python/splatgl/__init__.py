@@ -29,6 +29,7 @@ from ._splatgl import (
     load_bytes,
     render,
     save,
+    save_image,
     validate,
 )
 from . import conformance
@@ -50,5 +51,6 @@ __all__ = [
     "load_bytes",
     "render",
     "save",
+    "save_image",
     "validate",
 ]

@@ -246,6 +246,30 @@ fn image_of(v: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
     Ok(img)
 }
 
+/// Writes an (H, W, 3|4) float array (as `render` returns) by `path`'s extension: `.png`
+/// (8-bit RGBA, sRGB-encoded values as given, clamped to 0–1; written atomically) or `.pfm`
+/// (32-bit float RGB). Raises `ValueError` for another extension or shape, `OSError`'s
+/// message as `SaveError` when the file cannot be written.
+#[pyfunction]
+pub fn save_image(py: Python<'_>, image: &Bound<'_, PyAny>, path: PathBuf) -> PyResult<()> {
+    let img = image_of(image, "image")?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let result = match ext.as_deref() {
+        Some("png") => py.detach(|| img.write_png(&path, splatgl::image::PngDepth::Eight, true)),
+        Some("pfm") => py.detach(|| img.write_pfm(&path)),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{}: expected a file name ending in .png or .pfm",
+                path.display()
+            )));
+        }
+    };
+    result.map_err(|e| SaveError::new_err(crate::message(format!("{}: {e}", path.display()))))
+}
+
 /// Reads an image file.
 fn read_image(p: &Path) -> PyResult<Image> {
     Image::read(p).map_err(|e| PyValueError::new_err(format!("{}: {e}", p.display())))

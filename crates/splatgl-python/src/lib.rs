@@ -69,6 +69,7 @@ fn _splatgl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(io::load, m)?)?;
     m.add_function(wrap_pyfunction!(io::load_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(io::save, m)?)?;
+    m.add_function(wrap_pyfunction!(io::save_image, m)?)?;
     m.add_function(wrap_pyfunction!(io::render, m)?)?;
     m.add_function(wrap_pyfunction!(io::validate, m)?)?;
     m.add_function(wrap_pyfunction!(io::compare, m)?)?;
