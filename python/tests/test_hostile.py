@@ -132,3 +132,38 @@ def test_error_messages_escape_terminal_control_characters():
     with pytest.raises(splatgl.LoadError) as e:
         splatgl.load_bytes(ply, "x.ply")
     assert "\x1b" not in str(e.value) and "\\u{1b}" in str(e.value)
+
+
+def test_load_reads_files_and_never_maps_them(tmp_path):
+    """A file truncated under a memory map kills the process (SIGBUS): the package reads.
+    While three loads of a 100 MB file run (the GIL released), a thread watches this
+    process's mappings for the file; on a build that maps it, the mapping lasts the whole
+    parse and is seen."""
+    maps = Path("/proc/self/maps")
+    if not maps.exists():
+        pytest.skip("no /proc/self/maps on this platform")
+    import threading
+    n = 400_000
+    fields = (["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2"] + [f"f_rest_{i}" for i in range(45)]
+              + ["opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"])
+    data = np.random.default_rng(1).normal(size=(n, len(fields))).astype("<f4")
+    p = tmp_path / "big.ply"
+    header = f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\n"
+    header += "".join(f"property float {f}\n" for f in fields) + "end_header\n"
+    p.write_bytes(header.encode() + data.tobytes())
+    seen, stop = [], threading.Event()
+
+    def watch():
+        while not stop.is_set():
+            if str(p) in maps.read_text():
+                seen.append(True)
+
+    t = threading.Thread(target=watch)
+    t.start()
+    try:
+        for _ in range(3):
+            assert len(splatgl.load(p)) > 0
+    finally:
+        stop.set()
+        t.join()
+    assert not seen, "the file was memory-mapped"
