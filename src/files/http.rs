@@ -31,7 +31,7 @@ fn normalize(path: &str) -> Result<String, &'static str> {
     let mut out: Vec<String> = Vec::new();
     for seg in path.split('/').skip(1) {
         let decoded = super::percent_decode(seg);
-        if decoded.contains(['/', '\\', '\0']) || seg.contains('\\') {
+        if decoded.contains(['/', '\\', '\0']) {
             return Err("has an encoded separator, a backslash or a NUL in a segment");
         }
         match decoded.as_str() {
