@@ -19,15 +19,17 @@ except ImportError:
 
 
 @pytest.fixture(scope="module")
-def cluster():
+def cluster(tmp_path_factory):
     if ray is None:
         why = "ray is not installed (pip install 'splatgl[ray]')"
         if os.environ.get("SPLATGL_REQUIRE") == "all":
             pytest.fail(why + " (SPLATGL_REQUIRE=all)")
         pytest.skip(why)
     import splatgl.ray  # noqa: F401  (the module under test)
+    # Workers inherit this: a test arms it by creating the marker's folder (splatgl.tiles).
+    os.environ["SPLATGL_TEST_KILL_ONCE"] = str(tmp_path_factory.mktemp("kill") / "armed" / "x")
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
-    yield
+    yield os.environ["SPLATGL_TEST_KILL_ONCE"]
     ray.shutdown()
 
 
@@ -121,3 +123,81 @@ def test_save_image_writes_what_compare_reads(tmp_path):
     assert splatgl.compare(tmp_path / "x.pfm", img[..., :3])["max_abs"] == 0.0
     with pytest.raises(ValueError, match=r"\.png or \.pfm"):
         splatgl.save_image(img, tmp_path / "x.jpg")
+
+
+def big_ply(tmp_path, n=6000):
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=(n, 4))
+    c = splatgl.Cloud.from_arrays(
+        rng.normal(0, 2, (n, 3)), rng.uniform(0.01, 0.1, (n, 3)),
+        q / np.linalg.norm(q, axis=1, keepdims=True), rng.uniform(0.2, 1, n),
+        sh=rng.normal(0, 0.3, (n, 4, 3)))
+    p = tmp_path / "big.ply"
+    splatgl.save(c, p)
+    return p
+
+
+def files_of(d):
+    out = {}
+    for root, _, names in os.walk(d):
+        for n in names:
+            p = os.path.join(root, n)
+            with open(p, "rb") as f:
+                out[os.path.relpath(p, d)] = f.read()
+    return out
+
+
+def convert_streamed(src, out, scratch):
+    argv = ["splatgl", "convert", str(src), str(out / "tileset.json"), "--chunk-splats", "256",
+            "--scratch-dir", str(scratch), "--bucket-splats", "700"]
+    assert splatgl._splatgl.cli(argv) == 0
+    return files_of(out)
+
+
+def test_a_distributed_build_writes_the_streamed_builds_tileset_byte_for_byte(cluster, tmp_path):
+    import splatgl.tiles
+    src = big_ply(tmp_path)
+    want = convert_streamed(src, tmp_path / "one", tmp_path / "s1")
+    seen = []
+    s = splatgl.tiles.build_distributed(src, tmp_path / "many", scratch_dir=tmp_path / "s2",
+                                        bucket_splats=700, chunk_splats=256,
+                                        progress=lambda *a: seen.append(a))
+    assert files_of(tmp_path / "many") == want and "tileset.json" in want
+    assert s["splats"] == 6000 and s["buckets"] == 9 and s["ranges"] == 2
+    assert s["tiles"] == len(want) - 1 and len(s["workers"]) >= 1
+    assert ("building", 9, 9) in seen and ("routing", 2, 2) in seen
+    assert os.listdir(tmp_path / "s2") == []
+
+
+def test_a_worker_killed_mid_build_is_retried_and_the_tileset_is_the_same(cluster, tmp_path):
+    import splatgl.tiles
+    src = big_ply(tmp_path)
+    want = convert_streamed(src, tmp_path / "one", tmp_path / "s1")
+    marker = cluster
+    os.makedirs(os.path.dirname(marker))  # armed: the next step's worker dies once
+    try:
+        s = splatgl.tiles.build_distributed(src, tmp_path / "many", scratch_dir=tmp_path / "s2",
+                                            bucket_splats=700, chunk_splats=256,
+                                            progress=lambda *a: None)
+    finally:
+        fired = os.path.exists(marker)
+        shutil.rmtree(os.path.dirname(marker))
+    assert fired, "no worker was killed"
+    assert files_of(tmp_path / "many") == want
+    assert s["splats"] == 6000
+
+
+def test_a_step_given_a_wrong_plan_raises_the_tiles_error(tmp_path):
+    import splatgl.tiles
+    with pytest.raises(splatgl.tiles.TilesError, match="not a build plan"):
+        splatgl._splatgl.tiles_route("{}", 0)
+    with pytest.raises(splatgl.tiles.TilesError, match="binary PLY"):
+        splatgl._splatgl.tiles_plan(str(tmp_path / "none.ply"), str(tmp_path / "t.json"),
+                                    str(tmp_path / "s"), 1000, 256, 2)
+
+
+def test_the_distributed_build_without_ray_says_to_install_the_extra(monkeypatch, tmp_path):
+    import splatgl.tiles
+    monkeypatch.setitem(sys.modules, "ray", None)
+    with pytest.raises(ImportError, match=r"splatgl\[ray\]"):
+        splatgl.tiles.build_distributed(tmp_path / "x.ply", tmp_path, scratch_dir=tmp_path)

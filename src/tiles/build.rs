@@ -54,7 +54,7 @@ pub const ERROR_QUANTILE: f64 = 0.9;
 pub const ERROR_SIGMAS: f64 = 3.0;
 
 /// One tile of a built tree: what `tileset.json` says of it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BuiltTile {
     /// Its name in the tree: `r` for the root, then one digit per level (`r01` is the root's
     /// first child's second child); the content file is named after it.

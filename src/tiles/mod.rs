@@ -5,7 +5,8 @@
 //! [`select`] chooses the tiles one camera needs within a splat budget, and [`TileCache`]
 //! loads their content once, in the tileset's frame, for `render`. [`build`] makes a LOD
 //! tree from one cloud (moment-matched merges, `convert … tileset.json`), [`build_streamed`]
-//! the same from a [`SplatSource`] read in passes, and [`tileset_json`] its `tileset.json`.
+//! the same from a [`SplatSource`] read in passes ([`steps`]: its steps for workers of a
+//! cluster), and [`tileset_json`] its `tileset.json`.
 //! For the viewer, a [`Streamer`] thread selects and loads while the camera moves, and
 //! [`pages::PageTable`] keeps each selected tile in GPU pages of its own.
 //!
@@ -27,6 +28,8 @@ mod lod_meta_write;
 pub mod pages;
 mod scratch;
 mod select;
+mod source;
+pub mod steps;
 mod stream;
 mod units;
 
@@ -38,10 +41,14 @@ pub use build::{
 pub use check::{LevelSummary, TilesetReport, check};
 pub use lod_meta::{MAX_LOD_LEVELS, level_error};
 pub use lod_meta_write::{LodMetaLayout, layout as lod_meta_layout};
-pub use scratch::{MAX_BUCKETS, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed};
+pub use scratch::{
+    MAX_BUCKETS, Plane, SAMPLE, SplatSource, StreamOptions, StreamReport, build_streamed,
+};
 pub use select::{
     SelectOptions, Selection, TileCache, Y_UP_TO_Z_UP, screen_space_error, select, visible,
 };
+pub use source::{PlySource, READ_ROWS};
+pub use steps::{TILES_DIR, content_extensions};
 pub use stream::{
     LOAD_BATCH, StreamFrame, StreamSettings, Streamer, coarse_cover, merged, select_resident,
 };

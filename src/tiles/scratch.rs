@@ -93,43 +93,86 @@ pub fn build_streamed(
             super::BuildOptions::MIN_CHUNK_SPLATS
         ));
     }
-    let n = src.len();
-    let buckets = n
-        .div_ceil(o.bucket_splats.max(o.chunk_splats) as u64)
-        .clamp(1, MAX_BUCKETS as u64) as usize;
-    let planes = sample_planes(src, buckets, progress)?;
+    let buckets = bucket_count(src.len(), o);
+    let (planes, _) = sample_planes(src, buckets, progress)?;
     std::fs::create_dir_all(&o.scratch_dir)
         .map_err(|e| format!("{}: {e}", o.scratch_dir.display()))?;
-    let mut files = Buckets::create(&o.scratch_dir, buckets, src.sh_degree())?;
+    let tag = std::process::id();
+    let paths = (0..buckets)
+        .map(|i| o.scratch_dir.join(format!("splatgl-bucket-{tag}-{i}.bin")))
+        .collect();
+    let mut files = Buckets::create(paths, src.sh_degree())?;
     let result = scatter_and_build(src, &planes, &mut files, o.chunk_splats, sink, progress);
     files.remove_all();
     result
 }
 
+/// Checks the options and counts the buckets of `n` splats.
+pub(super) fn bucket_count(n: u64, o: &StreamOptions) -> usize {
+    n.div_ceil(o.bucket_splats.max(o.chunk_splats) as u64)
+        .clamp(1, MAX_BUCKETS as u64) as usize
+}
+
 /// The top of the tree: a plane over two sides, or a bucket.
-enum Plane {
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Plane {
+    /// Splats with `p[axis] >= value` go `above`, the others `below`.
     Split {
+        /// 0, 1 or 2: x, y or z.
         axis: usize,
+        /// The plane's place on its axis (as bits: it may be +∞, which JSON cannot hold).
+        #[serde(with = "f32_bits")]
         value: f32,
+        /// The side below the plane (its tile's first child).
         below: Box<Plane>,
+        /// The side above (the second child).
         above: Box<Plane>,
     },
+    /// A bucket, numbered left to right.
     Bucket(usize),
 }
 
+impl Plane {
+    /// The tile name of bucket `b` (its path through the planes from `r`), if it is here.
+    pub fn bucket_name(&self, b: usize) -> Option<String> {
+        match self {
+            Plane::Bucket(x) => (*x == b).then(|| "r".to_string()),
+            Plane::Split { below, above, .. } => {
+                let (side, digit) = match below.bucket_name(b) {
+                    Some(n) => (n, '0'),
+                    None => (above.bucket_name(b)?, '1'),
+                };
+                Some(format!("r{digit}{}", &side[1..]))
+            }
+        }
+    }
+}
+
+/// An `f32` kept exactly, as its bits.
+mod f32_bits {
+    pub fn serialize<S: serde::Serializer>(v: &f32, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_u32(v.to_bits())
+    }
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+        <u32 as serde::Deserialize>::deserialize(d).map(f32::from_bits)
+    }
+}
+
 /// Planes over `buckets` buckets from a sample of the source's means.
-fn sample_planes(
+pub(super) fn sample_planes(
     src: &mut dyn SplatSource,
     buckets: usize,
     progress: &dyn Fn(&str, u64, u64),
-) -> Result<Plane, String> {
+) -> Result<(Plane, crate::cloud::SplatMeta), String> {
     let n = src.len();
+    let mut meta = None;
     let stride = n.div_ceil(SAMPLE as u64).max(1);
     let mut sample: Vec<[f32; 3]> = Vec::new();
     let mut seen = 0u64;
     src.rewind()?;
     while let Some(c) = src.next_chunk() {
         let c = c?;
+        meta.get_or_insert_with(|| c.meta.clone());
         for (i, p) in c.positions.iter().enumerate() {
             if (seen + i as u64).is_multiple_of(stride) {
                 sample.push(*p);
@@ -142,7 +185,8 @@ fn sample_planes(
         return Err("no splats to build a tileset from".into());
     }
     let mut next = 0;
-    Ok(split_sample(&mut sample, buckets, &mut next))
+    let planes = split_sample(&mut sample, buckets, &mut next);
+    Ok((planes, meta.unwrap_or_default()))
 }
 
 /// Splits `s` for `buckets` buckets, numbered from `next` left to right.
@@ -182,7 +226,7 @@ fn split_sample(s: &mut [[f32; 3]], buckets: usize, next: &mut usize) -> Plane {
 }
 
 /// The bucket of `p`: its path through the planes.
-fn route(mut plane: &Plane, p: [f32; 3]) -> usize {
+pub(super) fn route(mut plane: &Plane, p: [f32; 3]) -> usize {
     loop {
         match plane {
             Plane::Bucket(b) => return *b,
@@ -197,7 +241,7 @@ fn route(mut plane: &Plane, p: [f32; 3]) -> usize {
 }
 
 /// The buckets' scratch files.
-struct Buckets {
+pub(super) struct Buckets {
     paths: Vec<PathBuf>,
     writers: Vec<Option<BufWriter<File>>>,
     counts: Vec<usize>,
@@ -206,12 +250,11 @@ struct Buckets {
 }
 
 impl Buckets {
-    fn create(dir: &Path, n: usize, sh_degree: u8) -> Result<Self, String> {
-        let tag = std::process::id();
+    /// One file per bucket, at `paths`.
+    pub(super) fn create(paths: Vec<PathBuf>, sh_degree: u8) -> Result<Self, String> {
+        let n = paths.len();
         let mut b = Buckets {
-            paths: (0..n)
-                .map(|i| dir.join(format!("splatgl-bucket-{tag}-{i}.bin")))
-                .collect(),
+            paths,
             writers: Vec::with_capacity(n),
             counts: vec![0; n],
             sh_degree,
@@ -229,13 +272,13 @@ impl Buckets {
         Ok(b)
     }
 
-    /// Floats per splat in a bucket file.
-    fn floats(&self) -> usize {
-        11 + 3 * crate::cloud::sh_coeff_count(self.sh_degree)
+    /// Splats written to each bucket, and bytes in all.
+    pub(super) fn written(&self) -> (&[usize], u64) {
+        (&self.counts, self.bytes)
     }
 
-    fn push(&mut self, b: usize, c: &SplatCloud, i: usize) -> Result<(), String> {
-        let floats = self.floats();
+    pub(super) fn push(&mut self, b: usize, c: &SplatCloud, i: usize) -> Result<(), String> {
+        let floats = row_floats(self.sh_degree);
         let w = self.writers[b].as_mut().ok_or("bucket already closed")?;
         let values = c.positions[i]
             .iter()
@@ -252,7 +295,7 @@ impl Buckets {
         Ok(())
     }
 
-    fn finish_writing(&mut self) -> Result<(), String> {
+    pub(super) fn finish_writing(&mut self) -> Result<(), String> {
         for (w, p) in self.writers.iter_mut().zip(&self.paths) {
             if let Some(mut w) = w.take() {
                 w.flush().map_err(|e| format!("{}: {e}", p.display()))?;
@@ -264,39 +307,57 @@ impl Buckets {
     /// Reads bucket `b` back (and removes its file).
     fn read(&self, b: usize) -> Result<SplatCloud, String> {
         let p = &self.paths[b];
-        let err = |e: std::io::Error| format!("{}: {e}", p.display());
-        let mut f = std::io::BufReader::with_capacity(1 << 20, File::open(p).map_err(err)?);
-        let k = crate::cloud::sh_coeff_count(self.sh_degree);
-        let row = 4 * self.floats();
         let mut c = SplatCloud::with_capacity(self.sh_degree, self.counts[b]);
-        let mut sh = vec![[0.0f32; 3]; k];
-        let mut r = vec![0u8; row];
-        for _ in 0..self.counts[b] {
-            f.read_exact(&mut r).map_err(err)?;
-            let f =
-                |j: usize| f32::from_le_bytes([r[4 * j], r[4 * j + 1], r[4 * j + 2], r[4 * j + 3]]);
-            for (j, t) in sh.iter_mut().enumerate() {
-                *t = [f(11 + 3 * j), f(12 + 3 * j), f(13 + 3 * j)];
-            }
-            c.push(
-                [f(0), f(1), f(2)],
-                [f(3), f(4), f(5)],
-                [f(6), f(7), f(8), f(9)],
-                f(10),
-                &sh,
-            );
-        }
-        drop(f);
+        read_rows(p, self.sh_degree, self.counts[b], &mut c)?;
         let _ = std::fs::remove_file(p);
         Ok(c)
     }
 
-    fn remove_all(&mut self) {
+    pub(super) fn remove_all(&mut self) {
         self.writers.clear();
         for p in &self.paths {
             let _ = std::fs::remove_file(p);
         }
     }
+}
+
+/// Floats per splat in a bucket file.
+fn row_floats(sh_degree: u8) -> usize {
+    11 + 3 * crate::cloud::sh_coeff_count(sh_degree)
+}
+
+/// Bytes per splat in a bucket file.
+pub(super) fn row_bytes(sh_degree: u8) -> u64 {
+    4 * row_floats(sh_degree) as u64
+}
+
+/// Appends `count` splats read from the bucket file at `p` to `c`.
+pub(super) fn read_rows(
+    p: &Path,
+    sh_degree: u8,
+    count: usize,
+    c: &mut SplatCloud,
+) -> Result<(), String> {
+    let err = |e: std::io::Error| format!("{}: {e}", p.display());
+    let mut f = std::io::BufReader::with_capacity(1 << 20, File::open(p).map_err(err)?);
+    let k = crate::cloud::sh_coeff_count(sh_degree);
+    let mut sh = vec![[0.0f32; 3]; k];
+    let mut r = vec![0u8; row_bytes(sh_degree) as usize];
+    for _ in 0..count {
+        f.read_exact(&mut r).map_err(err)?;
+        let f = |j: usize| f32::from_le_bytes([r[4 * j], r[4 * j + 1], r[4 * j + 2], r[4 * j + 3]]);
+        for (j, t) in sh.iter_mut().enumerate() {
+            *t = [f(11 + 3 * j), f(12 + 3 * j), f(13 + 3 * j)];
+        }
+        c.push(
+            [f(0), f(1), f(2)],
+            [f(3), f(4), f(5)],
+            [f(6), f(7), f(8), f(9)],
+            f(10),
+            &sh,
+        );
+    }
+    Ok(())
 }
 
 /// Passes 2 and 3 (see the module docs).

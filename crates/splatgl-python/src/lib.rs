@@ -12,6 +12,7 @@ mod cloud;
 mod io;
 mod kit;
 mod renderer;
+mod tiles;
 
 use pyo3::prelude::*;
 
@@ -52,6 +53,13 @@ pyo3::create_exception!(
     "A conformance suite that cannot be generated or graded."
 );
 
+pyo3::create_exception!(
+    _splatgl,
+    TilesError,
+    SplatglError,
+    "A tileset that cannot be built (the input, a step's files, or a plan that does not fit)."
+);
+
 /// The native module.
 #[pymodule]
 fn _splatgl(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -62,7 +70,14 @@ fn _splatgl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RenderError", py.get_type::<RenderError>())?;
     m.add("CameraError", py.get_type::<CameraError>())?;
     m.add("ConformanceError", py.get_type::<ConformanceError>())?;
+    m.add("TilesError", py.get_type::<TilesError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    let (chunk, bucket) = (
+        splatgl::tiles::BuildOptions::DEFAULT_CHUNK_SPLATS,
+        splatgl::tiles::StreamOptions::DEFAULT_BUCKET_SPLATS,
+    );
+    m.add("TILE_CHUNK_SPLATS", chunk)?;
+    m.add("TILE_BUCKET_SPLATS", bucket)?;
     m.add_class::<cloud::Cloud>()?;
     m.add_class::<camera::PyCamera>()?;
     m.add_class::<renderer::Renderer>()?;
@@ -76,6 +91,10 @@ fn _splatgl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(kit::conformance_generate, m)?)?;
     m.add_function(wrap_pyfunction!(kit::conformance_run, m)?)?;
     m.add_function(wrap_pyfunction!(kit::cli, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_route, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_build_bucket, m)?)?;
+    m.add_function(wrap_pyfunction!(tiles::tiles_join, m)?)?;
     Ok(())
 }
 

@@ -117,8 +117,18 @@ impl PlyRows {
 
     /// Starts again from the first row.
     pub fn rewind(&mut self) {
-        self.next = 0;
+        self.seek(0);
+    }
+
+    /// Goes on from row `row` (clamped to the rows there are), forgetting the findings.
+    pub fn seek(&mut self, row: u64) {
+        self.next = row.min(self.len());
         self.findings.clear();
+    }
+
+    /// The row the next chunk starts at.
+    pub fn position(&self) -> u64 {
+        self.next
     }
 
     /// The next at most `rows` rows (`None` after the last; fewer when `rows` of them would

@@ -5,17 +5,12 @@
 use super::convert::{Args, Progress, check_output, write_output};
 use splatgl::SplatCloud;
 use splatgl::convert::{self, ConvertOptions, OutputFormat};
-use splatgl::load::Format;
-use splatgl::load::ply::PlyRows;
-use splatgl::tiles::{BuildOptions, BuiltTile, SplatSource, StreamOptions};
+use splatgl::tiles::{BuildOptions, BuiltTile, PlySource, SplatSource, StreamOptions, TILES_DIR};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
-
-/// The folder, next to the tileset, that holds the tiles' content.
-const TILES_DIR: &str = "tiles";
 
 /// The kind of LOD tree an output asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,18 +50,6 @@ pub(super) fn check_args(a: &Args) -> Result<(), String> {
         ));
     }
     Ok(())
-}
-
-/// The glTF extensions every tile's content uses (and requires), for `3DTILES_content_gltf`.
-fn content_extensions(o: &ConvertOptions) -> Vec<&'static str> {
-    let mut e = vec!["KHR_gaussian_splatting"];
-    if o.spz_compress {
-        e.push("KHR_gaussian_splatting_compression_spz_2");
-    }
-    if o.quantize.position != splatgl::write::Comp::F32 {
-        e.push("KHR_mesh_quantization");
-    }
-    e
 }
 
 /// Writes each tile's `.glb` as the builder hands it over, counting files and bytes.
@@ -143,7 +126,12 @@ impl<'a> TileWriter<'a> {
         } else {
             0.0
         };
-        let doc = splatgl::tiles::tileset_json(root, &uri, &content_extensions(self.o), margin);
+        let doc = splatgl::tiles::tileset_json(
+            root,
+            &uri,
+            &splatgl::tiles::content_extensions(self.o),
+            margin,
+        );
         let text = serde_json::to_vec_pretty(&doc).map_err(|e| e.to_string())?;
         let a = self.a;
         check_output(&a.output, &a.input, a.force)?;
@@ -192,54 +180,6 @@ pub(super) fn write_tree(
     w.finish(&root, cloud.len() as u64, t0)
 }
 
-/// A binary PLY read in chunks, each cropped, relabelled and turned as the in-memory path
-/// turns the whole cloud.
-struct PlySource<'a> {
-    rows: PlyRows,
-    o: &'a ConvertOptions,
-    crop: Option<splatgl::cull::CropBox>,
-    rotation: Option<glam::DMat3>,
-    format: Format,
-    dropped: u64,
-}
-
-/// Rows per chunk of a streamed read.
-const READ_ROWS: usize = 1 << 20;
-
-impl SplatSource for PlySource<'_> {
-    fn len(&self) -> u64 {
-        self.rows.len()
-    }
-    fn sh_degree(&self) -> u8 {
-        self.o
-            .sh_degree
-            .map_or(self.rows.sh_degree(), |d| d.min(self.rows.sh_degree()))
-    }
-    fn rewind(&mut self) -> Result<(), String> {
-        self.rows.rewind();
-        self.dropped = 0;
-        Ok(())
-    }
-    fn next_chunk(&mut self) -> Option<Result<SplatCloud, String>> {
-        let c = match self.rows.next_chunk(READ_ROWS)? {
-            Ok(c) => c,
-            Err(e) => return Some(Err(e)),
-        };
-        let n = c.len();
-        let mut c = match self.crop.and_then(|b| b.apply(&c)) {
-            Some(kept) => kept,
-            None => c,
-        };
-        self.dropped += (n - c.len()) as u64;
-        convert::relabel(&mut c, self.o);
-        // The up axis is decided on the first chunk, as it would be on the whole cloud.
-        let r = *self
-            .rotation
-            .get_or_insert_with(|| self.o.rotation_for(self.format, &c, OutputFormat::Glb));
-        Some(convert::rotate(&c, r))
-    }
-}
-
 /// Builds the tree from a binary PLY read in passes, never whole (`--scratch-dir`).
 pub(super) fn write_tileset_streamed(
     a: &Args,
@@ -247,16 +187,8 @@ pub(super) fn write_tileset_streamed(
     scratch: &Path,
     t0: Instant,
 ) -> Result<(), String> {
-    let rows = PlyRows::open(&a.input, &a.load.options())
+    let mut src = PlySource::open(&a.input, &a.load.options(), o.clone(), a.crop)
         .map_err(|e| format!("--scratch-dir reads binary PLY in chunks: {e}"))?;
-    let mut src = PlySource {
-        rows,
-        o,
-        crop: a.crop,
-        rotation: None,
-        format: Format::Ply,
-        dropped: 0,
-    };
     let p = Progress::new(true);
     let w = TileWriter::new(a, o, &p, src.len())?;
     let opts = StreamOptions {
