@@ -22,7 +22,7 @@ pub struct PlySource {
     options: ConvertOptions,
     crop: Option<CropBox>,
     /// The rotation into the output's frame: decided on the file's first chunk (as it would
-    /// be on the whole cloud), or given ([`Self::with_rotation`]).
+    /// be on the whole cloud), or given ([`Self::with_range`]).
     pub rotation: Option<DMat3>,
     start: u64,
     end: u64,
