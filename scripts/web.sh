@@ -41,7 +41,8 @@ build() {
     # The debug build of the one binary used: 58 s to build on 2 cores instead of ~4 min
     # optimised (no registry this project reaches ships it prebuilt), and 1.0 s instead of
     # 0.24 s per run, with byte-identical output.
-    cargo install --quiet --debug wasm-bindgen-cli --version "$version" --bin wasm-bindgen
+    env -u RUSTC_WORKSPACE_WRAPPER -u CLIPPY_ARGS \
+      cargo install --quiet --debug wasm-bindgen-cli --version "$version" --bin wasm-bindgen
   fi
   echo "== building splatgl-web for wasm32-unknown-unknown ($profile)"
   cargo build --locked --quiet --target wasm32-unknown-unknown --profile "$profile" -p splatgl-web
