@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # The project's test command (README), in four lanes, each timed:
 #   fast: format check, clippy with warnings as errors for every feature set users build
-#         (default, --no-default-features, --all-features), docs without broken links, an
+#         (default and --no-default-features checked; --all-features and every target linted
+#         as the tests build them: see RUSTC_WORKSPACE_WRAPPER below), docs without broken links, an
 #         independent Python re-implementation of the reference's math, and every unit and
 #         integration test of every crate except the slow cross-checks;
 #   python: the Python package (crates/splatgl-python) installed into a venv under the target
 #         folder with `pip install .` (maturin, the dev profile), Ray for the `ray` extra, then
 #         its pytest suite (python/tests, splatgl.ray's on a local cluster) against the command;
 #   platforms: the other platforms (docs/platforms.md): clippy with warnings as errors for
-#         Windows (x86_64-pc-windows-gnu), macOS (aarch64-apple-darwin, which can only be
-#         checked here) and the browser (wasm32-unknown-unknown), the Windows build staged by
-#         scripts/windows/build.sh (mingw-w64) and the web build (scripts/web.sh build);
+#         macOS (aarch64-apple-darwin, which can only be checked here), and for Windows
+#         (x86_64-pc-windows-gnu) and the browser (wasm32-unknown-unknown) as they are built:
+#         the Windows build staged by scripts/windows/build.sh (mingw-w64), its tests, and the
+#         web build (scripts/web.sh build);
 #   slow: the cross-checks that drive a browser, an X server or Wine: the engines graded in
 #         headless Chromium (GaussianSplats3D, Spark, CesiumJS, PlayCanvas, Babylon.js),
 #         splat-transform's streamed SOG and glTF, the viewer under Xvfb, the Windows build
