@@ -17,14 +17,17 @@ struct Counting;
 static CURRENT: AtomicUsize = AtomicUsize::new(0);
 static PEAK: AtomicUsize = AtomicUsize::new(0);
 
+// SAFETY: every call is passed on to the system allocator unchanged.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
         let now = CURRENT.fetch_add(l.size(), SeqCst) + l.size();
         PEAK.fetch_max(now, SeqCst);
+        // SAFETY: the caller's contract, passed on to the system allocator.
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
         CURRENT.fetch_sub(l.size(), SeqCst);
+        // SAFETY: the caller's contract, passed on to the system allocator.
         unsafe { System.dealloc(p, l) }
     }
 }

@@ -31,20 +31,25 @@ fn note_alloc() {
         ALLOCS.fetch_add(1, AtOrd::Relaxed);
     }
 }
+// SAFETY: every call is passed on to the system allocator unchanged.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
         note_alloc();
+        // SAFETY: the caller's contract, passed on to the system allocator.
         unsafe { System.alloc(l) }
     }
     unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
         note_alloc();
+        // SAFETY: the caller's contract, passed on to the system allocator.
         unsafe { System.alloc_zeroed(l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
         note_alloc();
+        // SAFETY: the caller's contract, passed on to the system allocator.
         unsafe { System.realloc(p, l, n) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        // SAFETY: the caller's contract, passed on to the system allocator.
         unsafe { System.dealloc(p, l) }
     }
 }

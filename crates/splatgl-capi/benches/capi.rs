@@ -29,6 +29,7 @@ static EGL: std::sync::OnceLock<Egl> = std::sync::OnceLock::new();
 unsafe extern "C" fn loader(name: *const c_char, _user: *mut c_void) -> *mut c_void {
     // SAFETY: a NUL-terminated name from splatgl; libEGL loaded once.
     let name = unsafe { CStr::from_ptr(name) }.to_str().unwrap();
+    // SAFETY: libEGL's initialisation run once, by the OnceLock.
     let egl = EGL.get_or_init(|| unsafe { Egl::load_required() }.unwrap());
     egl.get_proc_address(name)
         .map_or(std::ptr::null_mut(), |f| f as *mut c_void)
@@ -77,6 +78,7 @@ fn main() {
         let scales: Vec<f32> = cloud.scales.iter().flatten().copied().collect();
         let rots: Vec<f32> = cloud.rotations.iter().flatten().copied().collect();
         let sh: Vec<f32> = cloud.sh.iter().flatten().copied().collect();
+        // SAFETY: the arrays hold n splats each, as the call is told; `out` is writable.
         unsafe {
             let code = splatgl_cloud_from_arrays(
                 n,
@@ -102,6 +104,7 @@ fn main() {
             // SAFETY: as above.
             let code =
                 unsafe { splatgl_renderer_draw(c, v.as_ptr(), p.as_ptr(), viewport.as_ptr()) };
+            // SAFETY: glFinish has no preconditions.
             unsafe { gl.finish() };
             let t2 = Instant::now();
             assert_eq!(code, SPLATGL_OK);

@@ -301,8 +301,8 @@ fn from_arrays(n: usize, degree: u8, [p, s, r, o, c]: [&[f32]; 5]) -> Result<Spl
 /// `cloud` is `NULL` or a live cloud.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn splatgl_cloud_len(cloud: *const SplatglCloud) -> usize {
-    // SAFETY: NULL or live (the caller's contract).
     call(0, || {
+        // SAFETY: NULL or live (the caller's contract).
         Ok(unsafe { cloud.as_ref() }.map_or(0, |c| c.cloud.len()))
     })
     .0

@@ -325,6 +325,7 @@ mod tests {
         assert!(e.contains("directory"), "{e}");
         let fifo = d.join("fifo.ply");
         let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path that lives through the call.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         let e = read_with_progress(0, &fifo, 1 << 30, &quiet).unwrap_err();
         assert!(e.contains("FIFO"), "{e}");

@@ -165,6 +165,7 @@ impl<T> Copy for SharedMut<T> {}
 // SAFETY: users only write disjoint positions from different tasks (argued at each use), and
 // the pointee outlives the tasks.
 unsafe impl<T: Send> Send for SharedMut<T> {}
+// SAFETY: as for `Send`: shared between tasks that write disjoint positions only.
 unsafe impl<T: Send> Sync for SharedMut<T> {}
 impl<T> SharedMut<T> {
     #[inline(always)]
@@ -249,10 +250,10 @@ impl RadixBuffers {
                 let d = msd_digit(k, kmin, low);
                 let pos = off[d] as usize;
                 off[d] += 1;
+                debug_assert!(pos < n);
                 // SAFETY: chunk `c` owns positions `[start_d + Σ_{c'<c} count[c'][d], … +
                 // count[c][d])` of digit `d`; these partition `0..n`, so `pos < n` and no other
                 // task writes `pos`.
-                debug_assert!(pos < n);
                 unsafe {
                     if low == 0 {
                         o.get().add(pos).write(id(ids, base + i));

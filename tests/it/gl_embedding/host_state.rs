@@ -158,6 +158,7 @@ impl<'a> Host<'a> {
 
 /// A complete RGBA8 + depth/stencil framebuffer of `w × h`.
 unsafe fn framebuffer(gl: &glow::Context, w: i32, h: i32) -> glow::Framebuffer {
+    // SAFETY: the caller's contract (a current context); objects made here, bound and unbound.
     unsafe {
         let fbo = gl.create_framebuffer().unwrap();
         gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
@@ -187,6 +188,7 @@ unsafe fn host_program(gl: &glow::Context, desktop: bool) -> glow::Program {
     } else {
         "#version 300 es\nprecision highp float;\n"
     };
+    // SAFETY: the caller's contract (a current context); shaders and a program made here.
     unsafe {
         let p = gl.create_program().unwrap();
         for (kind, body) in [
@@ -253,6 +255,7 @@ pub fn query(gl: &glow::Context, lgl: &LegacyGl, p: &Piece) -> Vec<f64> {
 pub fn query_all(gl: &glow::Context, lgl: &LegacyGl, pieces: &[Piece]) -> Vec<Vec<f64>> {
     // SAFETY: a state query, and restoring the value read after each per-unit query.
     let active = unsafe { gl.get_parameter_i32(glow::ACTIVE_TEXTURE) } as u32;
+    // SAFETY: restores a value read from this context.
     let restore = || unsafe { gl.active_texture(active) };
     pieces
         .iter()
@@ -267,8 +270,11 @@ pub fn query_all(gl: &glow::Context, lgl: &LegacyGl, pieces: &[Piece]) -> Vec<Ve
 /// A setter closure from an unsafe GL block.
 macro_rules! s {
     (|$h:ident| $body:expr) => {
-        Some(Box::new(move |$h: &Host| unsafe {
-            $body;
+        Some(Box::new(move |$h: &Host| {
+            // SAFETY: a state setter on the host's own current context and objects.
+            unsafe {
+                $body;
+            }
         }) as Setter)
     };
 }
@@ -364,9 +370,12 @@ fn bindings(p: &mut Pieces, desktop: bool) {
     p.add("GL_READ_FRAMEBUFFER_BINDING", glow::READ_FRAMEBUFFER_BINDING, None, int(glow::READ_FRAMEBUFFER_BINDING), s!(|h| h.gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(h.read_fbo))));
     // --- textures and samplers on several units ---
     let unit_bind = |target: u32, pick: fn(&Host, usize) -> glow::Texture, unit: u32| -> Setter {
-        Box::new(move |h: &Host| unsafe {
-            h.gl.active_texture(glow::TEXTURE0 + unit);
-            h.gl.bind_texture(target, Some(pick(h, unit as usize)));
+        Box::new(move |h: &Host| {
+            // SAFETY: binds the host's own texture on its current context.
+            unsafe {
+                h.gl.active_texture(glow::TEXTURE0 + unit);
+                h.gl.bind_texture(target, Some(pick(h, unit as usize)));
+            }
         })
     };
     for u in 0..4 {
@@ -374,7 +383,10 @@ fn bindings(p: &mut Pieces, desktop: bool) {
     }
     for u in 0..3 {
         p.add("GL_TEXTURE_BINDING_2D_ARRAY", glow::TEXTURE_BINDING_2D_ARRAY, Some(u), int(glow::TEXTURE_BINDING_2D_ARRAY), Some(unit_bind(glow::TEXTURE_2D_ARRAY, |h, u| h.tex_array[u], u)));
-        p.add("GL_SAMPLER_BINDING", glow::SAMPLER_BINDING, Some(u), int(glow::SAMPLER_BINDING), Some(Box::new(move |h: &Host| unsafe { h.gl.bind_sampler(u, Some(h.samplers[u as usize])) })));
+        p.add("GL_SAMPLER_BINDING", glow::SAMPLER_BINDING, Some(u), int(glow::SAMPLER_BINDING), Some(Box::new(move |h: &Host| {
+            // SAFETY: binds the host's own sampler on its current context.
+            unsafe { h.gl.bind_sampler(u, Some(h.samplers[u as usize])) }
+        })));
     }
     p.add("GL_TEXTURE_BINDING_3D", glow::TEXTURE_BINDING_3D, Some(0), int(glow::TEXTURE_BINDING_3D), Some(unit_bind(glow::TEXTURE_3D, |h, _| h.tex3d, 0)));
     p.add("GL_TEXTURE_BINDING_CUBE_MAP", glow::TEXTURE_BINDING_CUBE_MAP, Some(1), int(glow::TEXTURE_BINDING_CUBE_MAP), Some(unit_bind(glow::TEXTURE_CUBE_MAP, |h, _| h.cube, 1)));
@@ -504,6 +516,7 @@ fn compatibility_state(p: &mut Pieces) {
     use Q::*;
     {
         let load = |mode: u32, m: Mat4, unit: u32| -> Setter {
+            // SAFETY: a state setter on the host's own current context and objects.
             Box::new(move |h: &Host| unsafe {
                 h.gl.active_texture(glow::TEXTURE0 + unit);
                 (h.lgl.matrix_mode)(mode);
@@ -514,11 +527,13 @@ fn compatibility_state(p: &mut Pieces) {
         p.add("GL_PROJECTION_MATRIX", lg::PROJECTION_MATRIX, None, Float(lg::PROJECTION_MATRIX, 16), Some(load(lg::PROJECTION, matrix(2.0), 0)));
         p.add("GL_TEXTURE_MATRIX", lg::TEXTURE_MATRIX, Some(0), Float(lg::TEXTURE_MATRIX, 16), Some(load(lg::TEXTURE, matrix(3.0), 0)));
         for u in 0..2 {
+            // SAFETY: a state setter on the host's own current context and objects.
             p.add("GL_TEXTURE_2D (enable)", glow::TEXTURE_2D, Some(u), Enabled(glow::TEXTURE_2D), Some(Box::new(move |h: &Host| unsafe {
                 h.gl.active_texture(glow::TEXTURE0 + u);
                 h.gl.enable(glow::TEXTURE_2D)
             })));
         }
+        // SAFETY: a state setter on the host's own current context and objects.
         p.add("GL_TEXTURE_ENV_MODE", lg::TEXTURE_ENV_MODE, Some(0), EnvMode, Some(Box::new(|h: &Host| unsafe {
             h.gl.active_texture(glow::TEXTURE0);
             (h.lgl.tex_envi)(lg::TEXTURE_ENV, lg::TEXTURE_ENV_MODE, lg::DECAL as i32)

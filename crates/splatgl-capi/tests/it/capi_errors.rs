@@ -62,6 +62,7 @@ unsafe extern "C" fn no_context_loader(name: *const c_char, user: *mut c_void) -
 }
 
 fn last() -> (c_int, String) {
+    // SAFETY: the library's last error is a NUL-terminated string it keeps alive.
     let msg = unsafe { CStr::from_ptr(splatgl_last_error()) };
     (
         splatgl_last_error_code(),
@@ -413,9 +414,10 @@ fn a_panic_inside_becomes_an_error_code() {
     assert_eq!(code, SPLATGL_ERROR_PANIC);
     assert!(msg.contains("the test hook's panic"), "{msg}");
     // The library still works afterwards.
+    // SAFETY: a plain C struct, for which all zero bytes are a valid value.
     let mut opts = unsafe { std::mem::zeroed() };
-    // SAFETY: a writable struct.
     assert_eq!(
+        // SAFETY: a writable struct.
         unsafe { splatgl_load_options_default(&mut opts) },
         SPLATGL_OK
     );

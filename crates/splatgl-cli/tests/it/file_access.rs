@@ -225,6 +225,7 @@ fn special_files(d: &Path) -> Vec<(PathBuf, &'static str)> {
     {
         let fifo = d.join("fifo.ply");
         let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path that lives through the call.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
         out.push((fifo, "FIFO"));
         let sock = d.join("sock.ply");
@@ -319,6 +320,7 @@ fn conformance_inputs_are_regular_files_inside_the_suite() {
     let fifo = d.join("fifo");
     std::fs::create_dir_all(&fifo).unwrap();
     let c = std::ffi::CString::new(fifo.join("manifest.json").to_str().unwrap()).unwrap();
+    // SAFETY: a NUL-terminated path that lives through the call.
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
     let f = fifo.to_str().unwrap().to_owned();
     let (code, out) = within_a_second("conformance run", move || {
