@@ -9,9 +9,9 @@
 
 use super::Erratum;
 pub use super::deviation::Deviation;
-use super::generate::{measure, over_bound};
 use super::manifest::{AssetEntry, CameraEntry};
 use super::model::{self, Variant};
+use super::verdict::{measure, over_bound};
 use splatgl::SplatCloud;
 use splatgl::camera::Camera;
 use splatgl::image::Image;

@@ -4,11 +4,11 @@
 use super::assets::{AssetSpec, CameraSpec};
 use super::isolation::{admit, admitted_errata};
 use super::manifest::{AssetEntry, CameraEntry, Manifest, Tolerance};
+use super::verdict::{measure, tolerance};
 use super::{Erratum, HEIGHT, WIDTH, judge, model};
 use glam::{DMat3, DQuat, DVec3};
 use serde_json::json;
 use splatgl::camera::Camera;
-use splatgl::compare::{Comparison, compare};
 use splatgl::image::{Image, PngDepth};
 use splatgl::load::{LoadOptions, load_bytes, validate::validate_bytes};
 use splatgl::write::scene::{NodeTransform, PerspectiveCamera, SceneNode};
@@ -60,53 +60,6 @@ fn gltf_axes(c: &CameraSpec) -> DMat3 {
     DMat3::from_cols(right, right.cross(fwd), -fwd)
 }
 
-/// The measures a camera is judged by: the comparison, and the largest ratio of a pixel's
-/// error to its bound.
-pub(crate) fn measure(img: &Image, want: &Image, bound: &[f64]) -> (Comparison, f64) {
-    let (mut a, b) = (clamped(img), clamped(want));
-    // Pixels outside the judged region (an infinite bound) count as equal.
-    for ((p, q), bd) in a.pixels.iter_mut().zip(&b.pixels).zip(bound) {
-        if bd.is_infinite() {
-            *p = *q;
-        }
-    }
-    let c = compare(&a, &b, 0.0).expect("same size");
-    let ratio = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .zip(bound)
-        .map(|((p, q), &bd)| {
-            let e = (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0f32, f32::max) as f64;
-            if e.is_finite() { e / bd } else { f64::INFINITY }
-        })
-        .fold(0.0, f64::max);
-    (c, ratio)
-}
-
-/// How many pixels of `a` differ from `b` by more than their bound (in any channel).
-pub(crate) fn over_bound(a: &Image, b: &Image, bound: &[f64]) -> usize {
-    a.pixels
-        .iter()
-        .zip(&b.pixels)
-        .zip(bound)
-        .filter(|((p, q), bd)| {
-            bd.is_finite()
-                && (0..3).any(|k| {
-                    let e = (p[k] - q[k]).abs() as f64;
-                    e.is_nan() || e > **bd
-                })
-        })
-        .count()
-}
-
-/// Whether `img` fails the camera: a pixel over its bound, the max error over `max_abs` or
-/// the PSNR under `min_psnr`.
-pub(crate) fn fails(img: &Image, want: &Image, bound: &[f64], t: &Tolerance) -> bool {
-    let (c, ratio) = measure(img, want, bound);
-    ratio > 1.0 || c.max_abs as f64 > t.max_abs || c.psnr < t.min_psnr
-}
-
 /// How far from its tolerance an erratum's model must land for the prediction to be robust
 /// to the renderer's own rounding: max error ×/÷ this factor, PSNR ± [`PSNR_MARGIN`] dB.
 pub const ABS_MARGIN: f64 = 1.3;
@@ -133,31 +86,6 @@ fn margin_text(img: &Image, want: &Image, bound: &[f64], t: &Tolerance) -> Strin
         "worst pixel at {ratio:.2} × its bound, max error {:.4} vs {:.4}, PSNR {:.1} vs {:.1} dB",
         c.max_abs, t.max_abs, c.psnr, t.min_psnr
     )
-}
-
-/// RGB clamped to [0, 1] (what a display and an 8-bit file hold).
-pub(crate) fn clamped(img: &Image) -> Image {
-    let mut out = img.clone();
-    for p in &mut out.pixels {
-        for c in &mut p[..3] {
-            *c = c.clamp(0.0, 1.0);
-        }
-    }
-    out
-}
-
-/// The tolerance from the model's per-pixel bound: `max_abs` is the largest bound, and if
-/// every pixel's error is within its bound the MSE is at most the mean squared bound.
-pub(crate) fn tolerance(m: &model::ModelImage) -> Tolerance {
-    // Over the judged region (finite bounds); the other pixels count as equal ([`measure`]).
-    let judged = || m.bound.iter().copied().filter(|b| b.is_finite());
-    let max_abs = judged().fold(0.0, f64::max);
-    let mse = judged().map(|b| b * b).sum::<f64>() / m.bound.len().max(1) as f64;
-    Tolerance {
-        max_abs,
-        min_psnr: 10.0 * (1.0 / mse).log10(),
-        terms: m.worst,
-    }
 }
 
 /// The asset's cameras as perspective camera nodes (roots, after the content).

@@ -4,10 +4,10 @@
 
 use super::{InputPrecision, ModelInput};
 use crate::diagnosis::{self, Deviation};
-use crate::generate::{clamped, fails, measure, over_bound, tolerance};
 use crate::isolation::derived_bound;
 use crate::manifest::{AssetEntry, CameraEntry, suite_path};
 use crate::model::Variant;
+use crate::verdict::{clamped, fails, measure, over_bound, tolerance};
 use splatgl::image::Image;
 use std::path::Path;
 
