@@ -42,16 +42,30 @@ pub use up::{UpAxis, Z_UP_BELOW, Z_UP_TALLER};
 /// 4 GiB.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
+/// An image size outside `1..=MAX_IMAGE_SIDE` per side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("image size {width}x{height} is outside 1..={MAX_IMAGE_SIDE} pixels per side")]
+pub struct ImageSizeError {
+    /// The width asked for.
+    pub width: u32,
+    /// The height asked for.
+    pub height: u32,
+}
+
+impl From<ImageSizeError> for String {
+    fn from(e: ImageSizeError) -> String {
+        e.to_string()
+    }
+}
+
 /// `Ok` when a `width` × `height` image is within `1..=MAX_IMAGE_SIDE` per side; else the
-/// message naming the size and the limit.
-pub fn check_image_size(width: u32, height: u32) -> Result<(), String> {
+/// error naming the size and the limit.
+pub fn check_image_size(width: u32, height: u32) -> Result<(), ImageSizeError> {
     let side = 1..=MAX_IMAGE_SIDE;
     if side.contains(&width) && side.contains(&height) {
         return Ok(());
     }
-    Err(format!(
-        "image size {width}x{height} is outside 1..={MAX_IMAGE_SIDE} pixels per side"
-    ))
+    Err(ImageSizeError { width, height })
 }
 
 /// Why a camera could not be built.

@@ -229,6 +229,40 @@ pub struct SplatCloud {
     pub meta: SplatMeta,
 }
 
+/// A cloud whose arrays do not agree ([`SplatCloud::check_lengths`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LengthError {
+    /// The SH degree is above [`MAX_SH_DEGREE`].
+    #[error("sh_degree {0} > {MAX_SH_DEGREE}")]
+    ShDegree(u8),
+    /// An attribute has another length than the positions.
+    #[error("{name} has {len} entries, positions {n}")]
+    Attribute {
+        /// Its name.
+        name: &'static str,
+        /// Its length.
+        len: usize,
+        /// The positions'.
+        n: usize,
+    },
+    /// The SH array is not `n × k` triples.
+    #[error("sh has {len} triples, expected {n} × {k}")]
+    Sh {
+        /// Its length in triples.
+        len: usize,
+        /// Splats.
+        n: usize,
+        /// Coefficients per splat.
+        k: usize,
+    },
+}
+
+impl From<LengthError> for String {
+    fn from(e: LengthError) -> String {
+        e.to_string()
+    }
+}
+
 impl SplatCloud {
     /// An empty cloud of the given SH degree.
     pub fn new(sh_degree: u8) -> Self {
@@ -291,11 +325,11 @@ impl SplatCloud {
 
     /// Checks the invariants (equal lengths, SH length). Loaders guarantee them; this is for
     /// clouds built by hand.
-    pub fn check_lengths(&self) -> Result<(), String> {
+    pub fn check_lengths(&self) -> Result<(), LengthError> {
         let n = self.len();
         let k = self.coeffs_per_splat();
         if self.sh_degree > MAX_SH_DEGREE {
-            return Err(format!("sh_degree {} > {MAX_SH_DEGREE}", self.sh_degree));
+            return Err(LengthError::ShDegree(self.sh_degree));
         }
         for (name, len) in [
             ("scales", self.scales.len()),
@@ -303,14 +337,15 @@ impl SplatCloud {
             ("opacities", self.opacities.len()),
         ] {
             if len != n {
-                return Err(format!("{name} has {len} entries, positions {n}"));
+                return Err(LengthError::Attribute { name, len, n });
             }
         }
         if self.sh.len() != n * k {
-            return Err(format!(
-                "sh has {} triples, expected {n} × {k}",
-                self.sh.len()
-            ));
+            return Err(LengthError::Sh {
+                len: self.sh.len(),
+                n,
+                k,
+            });
         }
         Ok(())
     }

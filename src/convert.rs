@@ -86,29 +86,31 @@ impl Default for Quantize {
 impl Quantize {
     /// Sets one attribute from `ATTR=TYPE` (attributes `position`, `rotation`, `scale`,
     /// `opacity`; types [`Comp::name`]s), checking the RC's table.
-    pub fn set(&mut self, spec: &str) -> Result<(), String> {
-        let (attr, ty) = spec
-            .split_once('=')
-            .ok_or_else(|| format!("--quantize {spec:?}: expected ATTR=TYPE, e.g. scale=u8n"))?;
-        let comp: Comp = ty.trim().parse()?;
+    pub fn set(&mut self, spec: &str) -> Result<(), ConvertError> {
+        let (attr, ty) = spec.split_once('=').ok_or_else(|| {
+            ConvertError::Quantize(format!(
+                "--quantize {spec:?}: expected ATTR=TYPE, e.g. scale=u8n"
+            ))
+        })?;
+        let comp: Comp = ty.trim().parse().map_err(ConvertError::Quantize)?;
         let (slot, allowed): (&mut Comp, &[Comp]) = match attr.trim() {
             "position" => (&mut self.position, &write::POSITION_TYPES),
             "rotation" => (&mut self.rotation, &write::ROTATION_TYPES),
             "scale" => (&mut self.scale, &write::SCALE_TYPES),
             "opacity" => (&mut self.opacity, &write::OPACITY_TYPES),
             other => {
-                return Err(format!(
+                return Err(ConvertError::Quantize(format!(
                     "--quantize: unknown attribute {other:?} (position, rotation, scale, opacity; SH coefficients are float per the RC)"
-                ));
+                )));
             }
         };
         if !allowed.contains(&comp) {
             let names: Vec<&str> = allowed.iter().map(|c| c.name()).collect();
-            return Err(format!(
+            return Err(ConvertError::Quantize(format!(
                 "--quantize {spec}: the RC allows {} for {}",
                 names.join(", "),
                 attr.trim()
-            ));
+            )));
         }
         *slot = comp;
         Ok(())
@@ -203,6 +205,43 @@ impl Up {
     }
 }
 
+/// Why a conversion step failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ConvertError {
+    /// A `--quantize ATTR=TYPE` spec that names no attribute or type, or a type the RC does not
+    /// allow for that attribute (the message lists what it allows).
+    #[error("{0}")]
+    Quantize(String),
+    /// A rotation that leaves values that are not finite (the loader's findings).
+    #[error("{0}")]
+    NotFinite(String),
+    /// Camera nodes asked of a format other than glTF.
+    #[error("camera nodes need a .glb or .gltf output")]
+    CamerasNeedGltf,
+    /// SPZ cannot hold the cloud (its 24-bit fixed-point positions).
+    #[error("cannot write SPZ: {0}")]
+    Spz(#[from] write::SpzWriteError),
+    /// The SOG writer failed.
+    #[error(transparent)]
+    Sog(#[from] write::SogWriteError),
+    /// A `cameras.json` view that makes no camera or no finite glTF camera.
+    #[error("view {index}{}: {message}", name.as_ref().map(|n| format!(" ({n})")).unwrap_or_default())]
+    View {
+        /// Its index in the file.
+        index: usize,
+        /// Its name, once known.
+        name: Option<String>,
+        /// What is wrong with it.
+        message: String,
+    },
+}
+
+impl From<ConvertError> for String {
+    fn from(e: ConvertError) -> String {
+        e.to_string()
+    }
+}
+
 /// What to do to the cloud before writing.
 #[derive(Debug, Clone, Default)]
 pub struct ConvertOptions {
@@ -281,15 +320,12 @@ pub fn truncate_sh(cloud: &mut SplatCloud, degree: u8) {
 
 /// Rotates a cloud (positions, covariances, SH by Wigner-D) exactly as the glTF loader
 /// applies a node rotation. `Err` if the result is not finite.
-pub fn rotate(cloud: &SplatCloud, r: DMat3) -> Result<SplatCloud, String> {
+pub fn rotate(cloud: &SplatCloud, r: DMat3) -> Result<SplatCloud, ConvertError> {
     let mut findings = Vec::new();
     crate::load::gltf::apply_node_transform(cloud, DMat4::from_mat3(r), 0, &mut findings)
         .ok_or_else(|| {
-            findings
-                .iter()
-                .map(|f| f.to_string())
-                .collect::<Vec<_>>()
-                .join("; ")
+            let all: Vec<String> = findings.iter().map(|f| f.to_string()).collect();
+            ConvertError::NotFinite(all.join("; "))
         })
 }
 
@@ -309,7 +345,7 @@ pub fn encode(
     cloud: &SplatCloud,
     format: OutputFormat,
     o: &ConvertOptions,
-) -> Result<(Vec<u8>, Vec<String>), String> {
+) -> Result<(Vec<u8>, Vec<String>), ConvertError> {
     encode_with_cameras(cloud, format, o, &[])
 }
 
@@ -320,17 +356,16 @@ pub fn encode_with_cameras(
     format: OutputFormat,
     o: &ConvertOptions,
     cameras: &[CameraNode],
-) -> Result<(Vec<u8>, Vec<String>), String> {
+) -> Result<(Vec<u8>, Vec<String>), ConvertError> {
     if !cameras.is_empty() && !format.is_gltf() {
-        return Err("camera nodes need a .glb or .gltf output".into());
+        return Err(ConvertError::CamerasNeedGltf);
     }
     let mut notes = Vec::new();
-    let spz_err = |e: write::SpzWriteError| format!("cannot write SPZ: {e}");
     match format {
         OutputFormat::Ply => return Ok((write::to_inria_ply(cloud), notes)),
         OutputFormat::Sog => return Ok((write::to_sog_bundle(cloud)?, notes)),
         OutputFormat::Spz => {
-            return Ok((write::to_spz(cloud, o.spz_version).map_err(spz_err)?, notes));
+            return Ok((write::to_spz(cloud, o.spz_version)?, notes));
         }
         OutputFormat::Splat => {
             if cloud.sh_degree > 0 {
@@ -342,8 +377,7 @@ pub fn encode_with_cameras(
             return Ok((write::to_splat(cloud), notes));
         }
         OutputFormat::Glb if o.spz_compress => {
-            let (mut doc, spz) =
-                write::build_glb_spz(cloud, &write::SpzWriteOptions::default()).map_err(spz_err)?;
+            let (mut doc, spz) = write::build_glb_spz(cloud, &write::SpzWriteOptions::default())?;
             add_camera_nodes(&mut doc, cameras);
             return Ok((write::glb_bytes(&doc, &spz), notes));
         }
@@ -388,8 +422,12 @@ pub fn camera_node(
     e: &CamerasJsonEntry,
     index: usize,
     r: DMat3,
-) -> Result<(CameraNode, Option<String>), String> {
-    let cam = Camera::from_3dgs(e).map_err(|err| format!("view {index}: {err}"))?;
+) -> Result<(CameraNode, Option<String>), ConvertError> {
+    let cam = Camera::from_3dgs(e).map_err(|err| ConvertError::View {
+        index,
+        name: None,
+        message: err.to_string(),
+    })?;
     // The rotation as the renderer uses it (Camera::from_3dgs orthonormalises it), so that the
     // node shows what `render --camera` shows; the centre as written (f64).
     let c2w = DMat3::from_mat4(cam.world_to_camera.as_dmat4()).transpose();
@@ -429,10 +467,14 @@ pub fn camera_node(
     .chain(&eye.to_array())
     .all(|v| v.is_finite());
     if !finite || camera.aspect_ratio.is_some_and(|a| a <= 0.0) {
-        return Err(format!(
-            "view {index} ({name}): its numbers give no finite glTF camera (yfov {}, aspectRatio {:?})",
-            camera.yfov, camera.aspect_ratio
-        ));
+        return Err(ConvertError::View {
+            index,
+            message: format!(
+                "its numbers give no finite glTF camera (yfov {}, aspectRatio {:?})",
+                camera.yfov, camera.aspect_ratio
+            ),
+            name: Some(name),
+        });
     }
     let node = CameraNode {
         name,

@@ -21,7 +21,7 @@
 //! Every comparison is written so that NaN keeps the splat (the backends decide).
 
 mod crop;
-pub use crop::CropBox;
+pub use crop::{CropBox, CropError};
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;

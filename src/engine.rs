@@ -27,6 +27,34 @@ pub fn is_software(description: &str) -> bool {
     SOFTWARE_RENDERERS.iter().any(|s| d.contains(s))
 }
 
+/// Why an [`Engine`] could not be made, take a cloud or draw.
+#[derive(Debug, thiserror::Error)]
+pub enum EngineError {
+    /// GL was asked of a build without the `gl` feature.
+    #[error("this splatgl was built without the `gl` feature")]
+    NoGlFeature,
+    /// GL was asked in the browser, where there is no headless GL.
+    #[error("no headless GL in the browser: draw on a WebGL2 canvas")]
+    NoHeadlessGl,
+    /// The headless context could not be made.
+    #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
+    #[error("{0}")]
+    Context(crate::headless::HeadlessError),
+    /// The GL renderer failed to upload or draw.
+    #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
+    #[error("GL: {0}")]
+    Gl(crate::headless::HeadlessError),
+    /// The camera's image is larger than any renderer draws.
+    #[error(transparent)]
+    ImageSize(#[from] crate::camera::ImageSizeError),
+}
+
+impl From<EngineError> for String {
+    fn from(e: EngineError) -> String {
+        e.to_string()
+    }
+}
+
 /// A renderer made for a batch of images.
 pub enum Engine {
     /// The CPU reference rasterizer (nothing to keep between images).
@@ -53,15 +81,15 @@ impl std::fmt::Debug for Engine {
 impl Engine {
     /// The engine of `backend` (GL: a new headless context blending in RGBA16F where it can
     /// render to it, see [`Engine::gl`]).
-    pub fn new(backend: Backend) -> Result<Self, String> {
+    pub fn new(backend: Backend) -> Result<Self, EngineError> {
         match backend {
             Backend::Reference => Ok(Engine::Reference),
             #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
             Backend::Gl => Self::gl(None),
             #[cfg(not(feature = "gl"))]
-            Backend::Gl => Err("this splatgl was built without the `gl` feature".into()),
+            Backend::Gl => Err(EngineError::NoGlFeature),
             #[cfg(all(feature = "gl", target_arch = "wasm32"))]
-            Backend::Gl => Err("no headless GL in the browser: draw on a WebGL2 canvas".into()),
+            Backend::Gl => Err(EngineError::NoHeadlessGl),
         }
     }
 
@@ -70,9 +98,9 @@ impl Engine {
     /// it (desktop GL; ES with `EXT_color_buffer_half_float` or `_float`), else RGBA8 with a
     /// warning ([`Engine::fallback`]).
     #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
-    pub fn gl(target: Option<crate::headless::TargetKind>) -> Result<Self, String> {
+    pub fn gl(target: Option<crate::headless::TargetKind>) -> Result<Self, EngineError> {
         use crate::headless::TargetKind;
-        let renderer = crate::headless::HeadlessRenderer::new().map_err(|e| e.to_string())?;
+        let renderer = crate::headless::HeadlessRenderer::new().map_err(EngineError::Context)?;
         let float = renderer.context().can_render_rgba16f();
         let (target, fallback) = match target {
             Some(t) => (t, None),
@@ -140,14 +168,14 @@ impl Engine {
 
     /// Makes `cloud` the one [`Engine::render`] draws (GL uploads it; the reference keeps
     /// nothing).
-    pub fn upload(&mut self, cloud: &SplatCloud) -> Result<(), String> {
+    pub fn upload(&mut self, cloud: &SplatCloud) -> Result<(), EngineError> {
         match self {
             Engine::Reference => {
                 let _ = cloud;
                 Ok(())
             }
             #[cfg(all(feature = "gl", not(target_arch = "wasm32")))]
-            Engine::Gl { renderer, .. } => renderer.upload(cloud).map_err(|e| format!("GL: {e}")),
+            Engine::Gl { renderer, .. } => renderer.upload(cloud).map_err(EngineError::Gl),
         }
     }
 
@@ -159,7 +187,7 @@ impl Engine {
         cloud: &SplatCloud,
         camera: &Camera,
         opts: &RenderOptions,
-    ) -> Result<(Image, Option<usize>), String> {
+    ) -> Result<(Image, Option<usize>), EngineError> {
         crate::camera::check_image_size(camera.width, camera.height)?;
         match self {
             Engine::Reference => {
@@ -181,7 +209,7 @@ impl Engine {
                 renderer
                     .render(camera, &o)
                     .map(|img| (img, None))
-                    .map_err(|e| format!("GL: {e}"))
+                    .map_err(EngineError::Gl)
             }
         }
     }

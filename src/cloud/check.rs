@@ -100,7 +100,7 @@ impl SplatCloud {
     pub fn validate(&self) -> Result<(), Violation> {
         self.check_lengths().map_err(|message| Violation {
             index: None,
-            message,
+            message: message.to_string(),
         })?;
         debug_assert!(self.sh_degree <= MAX_SH_DEGREE);
         for i in 0..self.len() {

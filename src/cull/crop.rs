@@ -14,10 +14,37 @@ pub struct CropBox {
     pub max: [f32; 3],
 }
 
+/// Why a crop box could not be read ([`CropBox::parse`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CropError {
+    /// A value that is not a finite number.
+    #[error("`{0}` is not a finite number")]
+    NotANumber(String),
+    /// Not six values.
+    #[error("{0} values; a crop box is minx,miny,minz,maxx,maxy,maxz")]
+    Count(usize),
+    /// A min above its max.
+    #[error("min {axis} {min} > max {axis} {max}")]
+    Inverted {
+        /// `x`, `y` or `z`.
+        axis: &'static str,
+        /// The min given.
+        min: f32,
+        /// The max given.
+        max: f32,
+    },
+}
+
+impl From<CropError> for String {
+    fn from(e: CropError) -> String {
+        e.to_string()
+    }
+}
+
 impl CropBox {
     /// The box of `minx,miny,minz,maxx,maxy,maxz`; an error naming the problem when a value
     /// is not a finite number, there are not six, or a min exceeds its max.
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, CropError> {
         let v: Vec<f32> = s
             .split(',')
             .map(|t| {
@@ -25,22 +52,23 @@ impl CropBox {
                     .parse::<f32>()
                     .ok()
                     .filter(|x| x.is_finite())
-                    .ok_or_else(|| format!("`{}` is not a finite number", t.trim()))
+                    .ok_or_else(|| CropError::NotANumber(t.trim().to_owned()))
             })
             .collect::<Result<_, _>>()?;
         let [x0, y0, z0, x1, y1, z1] = v[..] else {
-            return Err(format!(
-                "{} values; a crop box is minx,miny,minz,maxx,maxy,maxz",
-                v.len()
-            ));
+            return Err(CropError::Count(v.len()));
         };
         let b = CropBox {
             min: [x0, y0, z0],
             max: [x1, y1, z1],
         };
-        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        for (a, axis) in ["x", "y", "z"].into_iter().enumerate() {
             if b.min[a] > b.max[a] {
-                return Err(format!("min {axis} {} > max {axis} {}", b.min[a], b.max[a]));
+                return Err(CropError::Inverted {
+                    axis,
+                    min: b.min[a],
+                    max: b.max[a],
+                });
             }
         }
         Ok(b)
@@ -76,12 +104,23 @@ mod tests {
         assert!(b.contains([1.0, -2.0, 0.0]));
         assert!(!b.contains([1.0001, 0.0, 0.0]));
         assert!(!b.contains([f32::NAN, 0.0, 0.0]));
-        assert!(CropBox::parse("1,2,3").unwrap_err().contains("3 values"));
-        assert!(CropBox::parse("0,0,0,1,1,x").unwrap_err().contains("`x`"));
+        assert!(
+            CropBox::parse("1,2,3")
+                .unwrap_err()
+                .to_string()
+                .contains("3 values")
+        );
+        assert!(
+            CropBox::parse("0,0,0,1,1,x")
+                .unwrap_err()
+                .to_string()
+                .contains("`x`")
+        );
         assert!(CropBox::parse("0,0,0,1,1,inf").is_err());
         assert!(
             CropBox::parse("2,0,0,1,1,1")
                 .unwrap_err()
+                .to_string()
                 .contains("min x 2 > max x 1")
         );
     }

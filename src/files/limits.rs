@@ -160,21 +160,51 @@ impl fmt::Display for LimitExceeded {
     }
 }
 
+/// A JSON text past a limit, found before it is parsed ([`check_json`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum JsonShapeError {
+    /// Arrays and objects nest deeper than the limit.
+    #[error("JSON nests deeper than limits.max_json_depth = {max} (at byte {at})")]
+    TooDeep {
+        /// The limit.
+        max: u32,
+        /// The byte where it was passed.
+        at: usize,
+    },
+    /// More values than the limit.
+    #[error(
+        "JSON holds more than limits.max_json_values = {max} values (at byte {at}; raise with \
+         --max-json-values)"
+    )]
+    TooManyValues {
+        /// The limit.
+        max: u64,
+        /// The byte where it was passed.
+        at: usize,
+    },
+}
+
+impl From<JsonShapeError> for String {
+    fn from(e: JsonShapeError) -> String {
+        e.to_string()
+    }
+}
+
 /// Checks that the JSON text nests arrays and objects at most `max` deep (strings skipped),
-/// before it is parsed. Returns the message for an error otherwise.
-pub fn check_json_depth(text: &[u8], max: u32) -> Result<(), String> {
+/// before it is parsed.
+pub fn check_json_depth(text: &[u8], max: u32) -> Result<(), JsonShapeError> {
     check_json_shape(text, max, u64::MAX)
 }
 
 /// Checks, before a JSON text is parsed, that it nests at most `limits.max_json_depth` deep
 /// and holds at most `limits.max_json_values` values ([`Limits::max_json_values`] says what
-/// counts). Returns the message for an error otherwise, naming the limit.
-pub fn check_json(text: &[u8], limits: &Limits) -> Result<(), String> {
+/// counts). The error names the limit.
+pub fn check_json(text: &[u8], limits: &Limits) -> Result<(), JsonShapeError> {
     check_json_shape(text, limits.max_json_depth, limits.max_json_values)
 }
 
 /// One pass over the text outside strings: depth and values counted as they open.
-fn check_json_shape(text: &[u8], max_depth: u32, max_values: u64) -> Result<(), String> {
+fn check_json_shape(text: &[u8], max_depth: u32, max_values: u64) -> Result<(), JsonShapeError> {
     let (mut depth, mut in_string, mut escaped) = (0u32, false, false);
     let (mut values, mut after_separator) = (0u64, true);
     for (i, &b) in text.iter().enumerate() {
@@ -196,10 +226,10 @@ fn check_json_shape(text: &[u8], max_depth: u32, max_values: u64) -> Result<(), 
         if opens {
             values += 1;
             if values > max_values {
-                return Err(format!(
-                    "JSON holds more than limits.max_json_values = {max_values} values (at \
-                     byte {i}; raise with --max-json-values)"
-                ));
+                return Err(JsonShapeError::TooManyValues {
+                    max: max_values,
+                    at: i,
+                });
             }
         }
         if !b.is_ascii_whitespace() {
@@ -210,9 +240,10 @@ fn check_json_shape(text: &[u8], max_depth: u32, max_values: u64) -> Result<(), 
             b'[' | b'{' => {
                 depth += 1;
                 if depth > max_depth {
-                    return Err(format!(
-                        "JSON nests deeper than limits.max_json_depth = {max_depth} (at byte {i})"
-                    ));
+                    return Err(JsonShapeError::TooDeep {
+                        max: max_depth,
+                        at: i,
+                    });
                 }
             }
             b']' | b'}' => depth = depth.saturating_sub(1),
@@ -229,7 +260,9 @@ mod tests {
     #[test]
     fn json_depth_counts_brackets_outside_strings() {
         assert!(check_json_depth(br#"{"a": [[1]], "b": "[[[[[[["}"#, 3).is_ok());
-        let e = check_json_depth(br#"{"a": [[[1]]]}"#, 3).unwrap_err();
+        let e = check_json_depth(br#"{"a": [[[1]]]}"#, 3)
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("max_json_depth = 3") && e.contains("byte 8"),
             "{e}"
@@ -247,7 +280,7 @@ mod tests {
         // literals, 1 string = 9 values.
         let doc = br#"{"a": [1, -2.5e3, true, null], "b": "x,1"}"#;
         assert!(check_json(doc, &limits(9)).is_ok());
-        let e = check_json(doc, &limits(8)).unwrap_err();
+        let e = check_json(doc, &limits(8)).unwrap_err().to_string();
         assert!(
             e.contains("max_json_values = 8") && e.contains("--max-json-values"),
             "{e}"

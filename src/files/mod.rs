@@ -24,7 +24,7 @@ pub mod http;
 mod limits;
 mod map;
 pub use format::Format;
-pub use limits::{LimitExceeded, Limits, check_json, check_json_depth};
+pub use limits::{JsonShapeError, LimitExceeded, Limits, check_json, check_json_depth};
 pub use map::{FileBytes, Mapping, NO_MMAP_ENV, map_bounded, read_file_bytes, read_stdin_bounded};
 pub(crate) use map::{advise_huge, release_consumed};
 
@@ -139,8 +139,8 @@ pub(crate) fn contained(base: &Path, uri: &str, allow_outside: bool) -> Result<P
 /// (`..` resolved, symlinks followed) and the file must lie inside `base`. Absolute paths, `..`
 /// escapes and symlinks pointing outside are refused with a message naming the file and the
 /// rule, unless `allow_outside`. Returns the canonical path.
-pub fn contained_path(base: &Path, rel: &Path, allow_outside: bool) -> Result<PathBuf, String> {
-    contained_named(base, rel, &rel.to_string_lossy(), allow_outside)
+pub fn contained_path(base: &Path, rel: &Path, allow_outside: bool) -> Result<PathBuf, Refused> {
+    contained_file(base, rel, &rel.to_string_lossy(), allow_outside)
 }
 
 fn contained_named(
@@ -154,12 +154,21 @@ fn contained_named(
     })
 }
 
-/// Why [`contained_file`] gave no file.
-pub(crate) enum Refused {
+/// Why [`contained_path`] gave no file.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Refused {
     /// Outside the folder (by name, or once symlinks are followed): the message names the rule.
+    #[error("{0}")]
     Outside(String),
     /// Inside the folder but not there (or unreadable): the message names the path.
+    #[error("{0}")]
     Missing(String),
+}
+
+impl From<Refused> for String {
+    fn from(e: Refused) -> String {
+        e.to_string()
+    }
 }
 
 /// The containment rule, told apart from a missing file. Containment is decided before

@@ -32,7 +32,7 @@ pub mod spz;
 pub mod validate;
 
 pub use crate::files::Format;
-pub use crate::files::{LimitExceeded, Limits, check_json, check_json_depth};
+pub use crate::files::{JsonShapeError, LimitExceeded, Limits, check_json, check_json_depth};
 pub use details::{AttributeBits, Details};
 pub use finding::{Finding, Severity, printable};
 pub use format::detect_format;

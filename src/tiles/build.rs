@@ -93,19 +93,20 @@ pub fn build(
     cloud: &SplatCloud,
     o: &BuildOptions,
     sink: &ContentSink,
-) -> Result<BuiltTile, String> {
+) -> Result<BuiltTile, super::TilesError> {
+    use super::TilesError;
     if cloud.is_empty() {
-        return Err("no splats to build a tileset from".into());
+        return Err(TilesError::Empty);
     }
     if o.chunk_splats < BuildOptions::MIN_CHUNK_SPLATS {
-        return Err(format!(
-            "chunk_splats {} is below the minimum {}",
-            o.chunk_splats,
-            BuildOptions::MIN_CHUNK_SPLATS
-        ));
+        return Err(TilesError::ChunkTooSmall {
+            chunk: o.chunk_splats,
+            min: BuildOptions::MIN_CHUNK_SPLATS,
+        });
     }
     let mut idx: Vec<u32> = (0..cloud.len() as u32).collect();
-    let (tile, _) = node(cloud, &mut idx, "r".into(), o.chunk_splats, sink)?;
+    let (tile, _) =
+        node(cloud, &mut idx, "r".into(), o.chunk_splats, sink).map_err(TilesError::Build)?;
     Ok(tile)
 }
 

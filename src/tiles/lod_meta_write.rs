@@ -45,11 +45,11 @@ pub fn layout(
     root: &BuiltTile,
     contents: &HashMap<String, SplatCloud>,
     unit_splats: usize,
-) -> Result<LodMetaLayout, String> {
+) -> Result<LodMetaLayout, super::TilesError> {
     let content = |name: &str| {
         contents
             .get(name)
-            .ok_or_else(|| format!("tile {name}: no content"))
+            .ok_or_else(|| super::TilesError::Build(format!("tile {name}: no content")))
     };
     let leaves = leaves_below(root);
     let depth = |t: &BuiltTile| t.name.len() - 1;

@@ -58,6 +58,46 @@ use glam::{DMat3, DMat4, DVec3};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
+/// Why a tileset could not be read, built, laid out, selected from or streamed.
+#[derive(Debug, thiserror::Error)]
+pub enum TilesError {
+    /// No splats to build a tileset from.
+    #[error("no splats to build a tileset from")]
+    Empty,
+    /// A tile size below [`BuildOptions::MIN_CHUNK_SPLATS`].
+    #[error("chunk_splats {chunk} is below the minimum {min}")]
+    ChunkTooSmall {
+        /// The size asked for.
+        chunk: usize,
+        /// The minimum.
+        min: usize,
+    },
+    /// The root tile alone holds more splats than the budget.
+    #[error("the root tile alone holds {splats} splats, more than the budget of {budget}")]
+    OverBudget {
+        /// The root's splats.
+        splats: u64,
+        /// The budget.
+        budget: u64,
+    },
+    /// The tileset could not be read, or is not one (the message names the file and what).
+    #[error("{0}")]
+    Read(String),
+    /// A step of a build failed: the splat source, the content sink, the scratch folder, or a
+    /// tile without content (the message names it).
+    #[error("{0}")]
+    Build(String),
+    /// The streaming thread could not start, or nothing at the top of the tree loads.
+    #[error("{0}")]
+    Stream(String),
+}
+
+impl From<TilesError> for String {
+    fn from(e: TilesError) -> String {
+        e.to_string()
+    }
+}
+
 /// At most this many tiles are read from one tileset (a hostile file cannot make the tree
 /// unbounded).
 pub const MAX_TILES: usize = 1 << 20;
@@ -372,7 +412,11 @@ pub fn is_tileset(bytes: &[u8]) -> bool {
 /// at most [`MAX_TILES`] tiles [`MAX_DEPTH`] deep. `Err` when it cannot be read at all (not
 /// JSON, no `root`, no usable `asset.version`); rule breaks inside tiles are
 /// [`Tileset::problems`].
-pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
+pub fn read(path: &Path, opts: &LoadOptions) -> Result<Tileset, TilesError> {
+    read_tileset(path, opts).map_err(TilesError::Read)
+}
+
+fn read_tileset(path: &Path, opts: &LoadOptions) -> Result<Tileset, String> {
     let shown = path.display();
     let bytes = match path.to_str().filter(|s| crate::files::http::is_url(s)) {
         Some(url) => crate::files::http::fetch_bounded(url, opts.limits.max_bytes, "the tileset")

@@ -85,14 +85,24 @@ pub fn build_streamed(
     o: &StreamOptions,
     sink: &ContentSink,
     progress: &dyn Fn(&str, u64, u64),
-) -> Result<(BuiltTile, StreamReport), String> {
-    if o.chunk_splats < super::BuildOptions::MIN_CHUNK_SPLATS {
-        return Err(format!(
-            "chunk_splats {} is below the minimum {}",
-            o.chunk_splats,
-            super::BuildOptions::MIN_CHUNK_SPLATS
-        ));
+) -> Result<(BuiltTile, StreamReport), super::TilesError> {
+    use super::TilesError;
+    let min = super::BuildOptions::MIN_CHUNK_SPLATS;
+    if o.chunk_splats < min {
+        return Err(TilesError::ChunkTooSmall {
+            chunk: o.chunk_splats,
+            min,
+        });
     }
+    streamed(src, o, sink, progress).map_err(TilesError::Build)
+}
+
+fn streamed(
+    src: &mut dyn SplatSource,
+    o: &StreamOptions,
+    sink: &ContentSink,
+    progress: &dyn Fn(&str, u64, u64),
+) -> Result<(BuiltTile, StreamReport), String> {
     let buckets = bucket_count(src.len(), o);
     let (planes, _) = sample_planes(src, buckets, progress)?;
     std::fs::create_dir_all(&o.scratch_dir)

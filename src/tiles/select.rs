@@ -98,14 +98,14 @@ pub fn select<'a>(
     cam: &Camera,
     o: &SelectOptions,
     splats: &mut dyn FnMut(&'a Tile) -> u64,
-) -> Result<Selection<'a>, String> {
+) -> Result<Selection<'a>, super::TilesError> {
     let root = &ts.root;
     let mut used = splats(root);
     if used > o.splat_budget {
-        return Err(format!(
-            "the root tile alone holds {used} splats, more than the budget of {}",
-            o.splat_budget
-        ));
+        return Err(super::TilesError::OverBudget {
+            splats: used,
+            budget: o.splat_budget,
+        });
     }
     let mut chosen: Vec<&Tile> = vec![root];
     let mut open: Vec<(f64, &Tile)> = vec![(priority(root, used, cam), root)];

@@ -6,7 +6,7 @@ use super::SplatSource;
 use crate::cloud::SplatCloud;
 use crate::convert::{self, ConvertOptions, OutputFormat};
 use crate::cull::CropBox;
-use crate::load::ply::PlyRows;
+use crate::load::ply::{PlyRows, StreamError};
 use crate::load::{Format, LoadOptions};
 use glam::DMat3;
 use std::path::Path;
@@ -37,7 +37,7 @@ impl PlySource {
         load: &LoadOptions,
         options: ConvertOptions,
         crop: Option<CropBox>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, StreamError> {
         let rows = PlyRows::open(path, load)?;
         let end = rows.len();
         Ok(PlySource {
@@ -81,7 +81,7 @@ impl SplatSource for PlySource {
         }
         let c = match self.rows.next_chunk(READ_ROWS.min(left as usize))? {
             Ok(c) => c,
-            Err(e) => return Some(Err(e)),
+            Err(e) => return Some(Err(e.into())),
         };
         let n = c.len();
         let mut c = match self.crop.and_then(|b| b.apply(&c)) {
@@ -94,6 +94,6 @@ impl SplatSource for PlySource {
         let r = *self
             .rotation
             .get_or_insert_with(|| o.rotation_for(format, &c, OutputFormat::Glb));
-        Some(convert::rotate(&c, r))
+        Some(convert::rotate(&c, r).map_err(Into::into))
     }
 }

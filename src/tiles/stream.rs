@@ -113,17 +113,21 @@ impl Streamer {
         opts: LoadOptions,
         settings: StreamSettings,
         publish: Box<dyn Fn(StreamFrame) + Send>,
-    ) -> Result<(Streamer, StreamFrame), String> {
+    ) -> Result<(Streamer, StreamFrame), super::TilesError> {
+        use super::TilesError;
         let shared: Shared = Arc::default();
         let (first_tx, first_rx) = mpsc::channel();
         let s = shared.clone();
         let thread = std::thread::Builder::new()
             .name("splatgl-tiles".into())
             .spawn(move || run(&ts, &opts, settings, &s, first_tx, &*publish))
-            .map_err(|e| format!("cannot start the tile streaming thread: {e}"))?;
+            .map_err(|e| {
+                TilesError::Stream(format!("cannot start the tile streaming thread: {e}"))
+            })?;
         let first = first_rx
             .recv()
-            .map_err(|_| "the tile streaming thread ended".to_owned())??;
+            .map_err(|_| TilesError::Stream("the tile streaming thread ended".to_owned()))?
+            .map_err(TilesError::Stream)?;
         let streamer = Streamer {
             shared,
             thread: Some(thread),
@@ -176,7 +180,7 @@ pub fn select_resident<'t>(
     cam: &Camera,
     o: &SelectOptions,
     cache: &mut TileCache<'_>,
-) -> Result<(Selection<'t>, Vec<&'t Tile>), String> {
+) -> Result<(Selection<'t>, Vec<&'t Tile>), super::TilesError> {
     let mut wanted: Vec<&Tile> = Vec::new();
     let sel = select(ts, cam, o, &mut |t| {
         if t.content.is_empty() {

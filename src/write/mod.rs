@@ -28,7 +28,7 @@ mod splat;
 mod spz;
 pub(crate) use glb_spz::build_glb_spz;
 pub use glb_spz::{to_glb_spz, to_glb_spz_with};
-pub use sog::{SogFiles, to_sog_bundle, to_sog_files};
+pub use sog::{SogFiles, SogWriteError, to_sog_bundle, to_sog_files};
 pub use splat::to_splat;
 pub use spz::{SpzVersion, SpzWriteError, SpzWriteOptions, to_spz, to_spz_with};
 

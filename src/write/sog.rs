@@ -30,9 +30,29 @@ const PALETTE: usize = 65_536;
 /// Lloyd iterations of the codebooks.
 const ITERATIONS: usize = 64;
 
+/// Why a SOG could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum SogWriteError {
+    /// The WebP encoder failed on a texture.
+    #[error("WebP encoder: {0}")]
+    WebP(#[from] image_webp::EncodingError),
+    /// The bundle would be past the 4 GiB a zip without zip64 addresses.
+    #[error("a SOG bundle of {0} bytes is past the zip limit of 4 GiB")]
+    TooLarge(usize),
+    /// `meta.json` could not be written.
+    #[error("meta.json: {0}")]
+    Meta(#[from] serde_json::Error),
+}
+
+impl From<SogWriteError> for String {
+    fn from(e: SogWriteError) -> String {
+        e.to_string()
+    }
+}
+
 /// Encodes `cloud` as the files of an unbundled SOG (`meta.json` and its WebP textures).
 /// `Err` only if the WebP encoder fails.
-pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, String> {
+pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, SogWriteError> {
     let n = cloud.len();
     let width = (((n as f64).sqrt() / 4.0).ceil() as usize * 4).max(4);
     let height = (n.div_ceil(width).div_ceil(4) * 4).max(4);
@@ -43,7 +63,7 @@ pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, String> {
             .collect()
     };
     let mut files: SogFiles = vec![(String::new(), Vec::new())];
-    let mut add = |name: &str, rgba: &[u8], w: usize, h: usize| -> Result<(), String> {
+    let mut add = |name: &str, rgba: &[u8], w: usize, h: usize| -> Result<(), SogWriteError> {
         files.push((name.to_owned(), webp(rgba, w, h)?));
         Ok(())
     };
@@ -123,15 +143,12 @@ pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, String> {
         files.push(("shN_centroids.webp".into(), centroids));
         files.push(("shN_labels.webp".into(), labels));
     }
-    files[0] = (
-        "meta.json".into(),
-        serde_json::to_vec(&meta).map_err(|e| e.to_string())?,
-    );
+    files[0] = ("meta.json".into(), serde_json::to_vec(&meta)?);
     Ok(files)
 }
 
 /// [`to_sog_files`] stored (uncompressed: WebP is compressed already) in one zip, `.sog`.
-pub fn to_sog_bundle(cloud: &SplatCloud) -> Result<Vec<u8>, String> {
+pub fn to_sog_bundle(cloud: &SplatCloud) -> Result<Vec<u8>, SogWriteError> {
     zip_stored(&to_sog_files(cloud)?)
 }
 
@@ -241,7 +258,7 @@ fn palette(
     cloud: &SplatCloud,
     width: usize,
     height: usize,
-) -> Result<(serde_json::Value, Vec<u8>, Vec<u8>), String> {
+) -> Result<(serde_json::Value, Vec<u8>, Vec<u8>), SogWriteError> {
     let n = cloud.len();
     let k = sh_coeff_count(cloud.sh_degree) - 1;
     let rest = |i: usize| cloud.sh_of(i)[1..].iter().flatten().copied();
@@ -338,22 +355,23 @@ fn median_cut(points: &[Vec<f32>]) -> (Vec<Vec<f32>>, Vec<usize>) {
 }
 
 /// A lossless WebP of `rgba` (`w × h` RGBA8 texels).
-fn webp(rgba: &[u8], w: usize, h: usize) -> Result<Vec<u8>, String> {
+fn webp(rgba: &[u8], w: usize, h: usize) -> Result<Vec<u8>, SogWriteError> {
     let mut out = Vec::new();
-    image_webp::WebPEncoder::new(&mut out)
-        .encode(rgba, w as u32, h as u32, image_webp::ColorType::Rgba8)
-        .map_err(|e| format!("WebP encoder: {e}"))?;
+    image_webp::WebPEncoder::new(&mut out).encode(
+        rgba,
+        w as u32,
+        h as u32,
+        image_webp::ColorType::Rgba8,
+    )?;
     Ok(out)
 }
 
 /// A zip of `files`, each stored (method 0) with its CRC-32, dated 1980-01-01. `Err` past
 /// the 4 GiB a zip without zip64 can address.
-fn zip_stored(files: &[(String, Vec<u8>)]) -> Result<Vec<u8>, String> {
+fn zip_stored(files: &[(String, Vec<u8>)]) -> Result<Vec<u8>, SogWriteError> {
     let total: usize = files.iter().map(|(n, d)| 2 * n.len() + d.len() + 128).sum();
     if total > u32::MAX as usize || files.len() > u16::MAX as usize {
-        return Err(format!(
-            "a SOG bundle of {total} bytes is past the zip limit of 4 GiB"
-        ));
+        return Err(SogWriteError::TooLarge(total));
     }
     let (mut out, mut dir) = (Vec::new(), Vec::new());
     for (name, data) in files {

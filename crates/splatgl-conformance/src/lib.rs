@@ -25,8 +25,43 @@ pub mod model;
 pub mod render;
 pub mod report;
 pub mod runner;
+pub mod verdict;
 
 pub use generate::{GenerateError, generate};
+
+/// Why the kit could not read, render or grade a suite.
+#[derive(Debug, thiserror::Error)]
+pub enum KitError {
+    /// `manifest.json` could not be read or breaks its schema (the message names the key).
+    #[error("{0}")]
+    Manifest(String),
+    /// A file the manifest names lies outside the suite's folder or is missing.
+    #[error("{rel}: {source}")]
+    File {
+        /// The name as the manifest writes it.
+        rel: String,
+        /// Why it was refused.
+        source: splatgl::files::Refused,
+    },
+    /// An asset did not load or one of its cameras could not be made.
+    #[error("{0}")]
+    Asset(String),
+    /// The renderer could not be made, take an asset or draw.
+    #[error(transparent)]
+    Engine(#[from] splatgl::engine::EngineError),
+    /// The GL renderer with errata (the erratum proof) failed.
+    #[error("{0}")]
+    Gl(String),
+    /// A reference image or bound could not be read: a broken suite.
+    #[error("{0}")]
+    Reference(String),
+}
+
+impl From<KitError> for String {
+    fn from(e: KitError) -> String {
+        e.to_string()
+    }
+}
 
 /// Image size of every camera of the suite.
 pub const WIDTH: u32 = 128;

@@ -206,7 +206,11 @@ impl Manifest {
     }
 
     /// Parses a manifest; the error names the key.
-    pub fn from_json(v: &Value) -> Result<Manifest, String> {
+    pub fn from_json(v: &Value) -> Result<Manifest, crate::KitError> {
+        Self::parse(v).map_err(crate::KitError::Manifest)
+    }
+
+    fn parse(v: &Value) -> Result<Manifest, String> {
         let mut assets = Vec::new();
         for a in list(v, "assets")? {
             assets.push(asset_from_json(&a)?);
@@ -233,10 +237,11 @@ impl Manifest {
 
     /// Reads `DIR/manifest.json`: a regular file within the default `max_bytes`, nested at
     /// most `max_json_depth` deep (like every file splatgl reads).
-    pub fn read(dir: &std::path::Path) -> Result<Manifest, String> {
+    pub fn read(dir: &std::path::Path) -> Result<Manifest, crate::KitError> {
         let p = dir.join("manifest.json");
         let limits = splatgl::load::Limits::default();
-        let err = |e: &dyn std::fmt::Display| format!("{}: {e}", p.display());
+        let err =
+            |e: &dyn std::fmt::Display| crate::KitError::Manifest(format!("{}: {e}", p.display()));
         let text = splatgl::files::read_bounded(&p, limits.max_bytes, "the manifest")
             .map_err(|e| err(&e))?;
         splatgl::load::check_json(&text, &limits).map_err(|e| err(&e))?;
@@ -248,9 +253,13 @@ impl Manifest {
 /// A file the manifest names (`file`, `reference_pfm`, `bound_pfm`, an `image` under
 /// `--images`), resolved inside `dir` by the containment rule every document's files follow
 /// (`..`, absolute paths and symlinks out of the folder are refused; the file must exist).
-pub fn suite_path(dir: &std::path::Path, rel: &str) -> Result<std::path::PathBuf, String> {
-    splatgl::files::contained_path(dir, std::path::Path::new(rel), false)
-        .map_err(|e| format!("{rel}: {e}"))
+pub fn suite_path(dir: &std::path::Path, rel: &str) -> Result<std::path::PathBuf, crate::KitError> {
+    splatgl::files::contained_path(dir, std::path::Path::new(rel), false).map_err(|source| {
+        crate::KitError::File {
+            rel: rel.to_owned(),
+            source,
+        }
+    })
 }
 
 /// The string at key `k` of `v`.

@@ -1,6 +1,7 @@
 //! Rendering the suite with splatgl's own backends (`conformance run --backend`), and with the
 //! GL backend's erratum switches (the erratum proof).
 
+use super::KitError;
 use super::manifest::Manifest;
 use splatgl::camera::Camera;
 use splatgl::engine::Engine;
@@ -11,10 +12,15 @@ use std::path::Path;
 pub use splatgl::engine::Backend;
 
 /// One asset loaded with its cameras at the manifest's image sizes.
-pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<Camera>), String> {
+pub fn load_asset(
+    dir: &Path,
+    m: &Manifest,
+    asset: usize,
+) -> Result<(Scene, Vec<Camera>), KitError> {
     let a = &m.assets[asset];
     let file = super::manifest::suite_path(dir, &a.file)?;
-    let scene = load_path(file, &LoadOptions::default()).map_err(|e| e.to_string())?;
+    let scene =
+        load_path(file, &LoadOptions::default()).map_err(|e| KitError::Asset(e.to_string()))?;
     let cams = a
         .cameras
         .iter()
@@ -25,7 +31,8 @@ pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<
                 .ok_or_else(|| format!("{}: no camera {}", a.file, c.gltf_camera))?;
             Camera::from_gltf(g, c.width, c.height).map_err(|e| e.to_string())
         })
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(KitError::Asset)?;
     Ok((scene, cams))
 }
 
@@ -33,7 +40,7 @@ pub fn load_asset(dir: &Path, m: &Manifest, asset: usize) -> Result<(Scene, Vec<
 pub type Images = Vec<(String, Image)>;
 
 /// Renders the suite with `backend` (errata off): one [`Engine`] for every asset.
-pub fn render_suite(dir: &Path, m: &Manifest, backend: Backend) -> Result<Images, String> {
+pub fn render_suite(dir: &Path, m: &Manifest, backend: Backend) -> Result<Images, KitError> {
     let mut engine = Engine::new(backend)?;
     let opts = splatgl::reference::RenderOptions {
         background: m.background.map(|v| v as f32),
@@ -59,8 +66,9 @@ pub fn render_suite_gl(
     m: &Manifest,
     errata: splatgl::gl::Errata,
     front_to_back: bool,
-) -> Result<Images, String> {
-    let r = splatgl::headless::HeadlessRenderer::with_errata(errata).map_err(|e| e.to_string())?;
+) -> Result<Images, KitError> {
+    let gl = |e: splatgl::headless::HeadlessError| KitError::Gl(e.to_string());
+    let r = splatgl::headless::HeadlessRenderer::with_errata(errata).map_err(gl)?;
     render_suite_with(dir, m, r, front_to_back)
 }
 
@@ -71,7 +79,8 @@ fn render_suite_with(
     m: &Manifest,
     mut r: splatgl::headless::HeadlessRenderer,
     front_to_back: bool,
-) -> Result<Images, String> {
+) -> Result<Images, KitError> {
+    let gl = |e: splatgl::headless::HeadlessError| KitError::Gl(e.to_string());
     use splatgl::headless::{HeadlessOptions, TargetKind};
     // Blended as `conformance run --backend gl` blends (Engine::gl): in RGBA16F where the
     // context can render to it.
@@ -88,7 +97,7 @@ fn render_suite_with(
     let mut out = Vec::new();
     for (i, a) in m.assets.iter().enumerate() {
         let (scene, cams) = load_asset(dir, m, i)?;
-        r.upload(&scene.cloud).map_err(|e| e.to_string())?;
+        r.upload(&scene.cloud).map_err(gl)?;
         for (c, cam) in a.cameras.iter().zip(&cams) {
             let img = if front_to_back {
                 let mut order = splatgl::sort::Sorter::new()
@@ -99,7 +108,7 @@ fn render_suite_with(
             } else {
                 r.render(cam, &opts)
             };
-            out.push((c.image.clone(), img.map_err(|e| e.to_string())?));
+            out.push((c.image.clone(), img.map_err(gl)?));
         }
     }
     Ok(out)

@@ -30,7 +30,8 @@ fn vec3(name: &str, v: &PyArrayLike1<'_, f64, AllowTypeChange>) -> PyResult<Vec3
 
 /// Checks an image size (the CLI's limit, [`splatgl::camera::MAX_IMAGE_SIDE`] per side).
 fn size(width: u32, height: u32) -> PyResult<()> {
-    splatgl::camera::check_image_size(width, height).map_err(PyValueError::new_err)
+    splatgl::camera::check_image_size(width, height)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 #[pymethods]

@@ -43,7 +43,7 @@ pub fn conformance_run(
         let m = Manifest::read(&dir)?;
         let opts = runner::RunOptions { input };
         let results = runner::run_with(&dir, &m, &opts, |c| {
-            runner::find_image(&images, c).map(|p| Image::read(&p).map_err(|e| e.to_string()))
+            runner::find_image(&images, c).map(Image::read)
         })?;
         let source = images.display().to_string();
         let json = report::to_json(&results, &source);

@@ -48,8 +48,8 @@ pub(crate) fn backend(name: &str) -> PyResult<Option<Backend>> {
 /// The engine of [`backend`]'s answer (needs no GIL).
 pub(crate) fn make_engine(wanted: Option<Backend>) -> Result<Engine, String> {
     match wanted {
-        Some(b) => Engine::new(b),
-        None => Engine::new(Backend::Gl).or_else(|_| Engine::new(Backend::Reference)),
+        Some(b) => Ok(Engine::new(b)?),
+        None => Ok(Engine::new(Backend::Gl).or_else(|_| Engine::new(Backend::Reference))?),
     }
 }
 
@@ -81,7 +81,8 @@ pub(crate) fn sized(camera: &PyCamera, size: Option<(u32, u32)>) -> PyResult<Cam
         }
         _ => camera.inner,
     };
-    splatgl::camera::check_image_size(cam.width, cam.height).map_err(PyValueError::new_err)?;
+    splatgl::camera::check_image_size(cam.width, cam.height)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(cam)
 }
 
@@ -140,7 +141,8 @@ impl Renderer {
         let size = match (width, height) {
             (None, None) => None,
             (Some(w), Some(h)) => {
-                splatgl::camera::check_image_size(w, h).map_err(PyValueError::new_err)?;
+                splatgl::camera::check_image_size(w, h)
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
                 Some((w, h))
             }
             _ => {

@@ -24,7 +24,7 @@ mod header;
 mod stream;
 use binary::{decode_binary, skip_binary};
 use header::{Element, Encoding, Header, Property, Scalar, parse_header};
-pub use stream::PlyRows;
+pub use stream::{PlyRows, StreamError};
 
 /// Which columns feed which output: offsets (binary) or column indices (ASCII) per field.
 struct Layout {

@@ -18,6 +18,52 @@ const MAX_HEADER: usize = 1 << 20;
 /// A chunk's rows take at most this many bytes (fewer rows when they are wide).
 const MAX_CHUNK_BYTES: u64 = 64 << 20;
 
+/// Why a PLY could not be read in chunks ([`PlyRows`]); each names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// The file could not be opened or read.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Its header or rows break the format (the PLY loader's error).
+    #[error("{}: {source}", path.display())]
+    Ply {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        source: PlyError,
+    },
+    /// A PLY that is not read in chunks (ASCII, PlayCanvas compressed, list properties before
+    /// the `vertex` element).
+    #[error("{}: {why}", path.display())]
+    NotStreamable {
+        /// The file.
+        path: PathBuf,
+        /// Why, and what to do.
+        why: String,
+    },
+    /// With `strict`, a row with unusable values.
+    #[error("{}: vertex row {row}: {why}", path.display())]
+    BadRow {
+        /// The file.
+        path: PathBuf,
+        /// The row's index in the file.
+        row: u64,
+        /// What is wrong with it.
+        why: String,
+    },
+}
+
+impl From<StreamError> for String {
+    fn from(e: StreamError) -> String {
+        e.to_string()
+    }
+}
+
 /// A binary PLY's `vertex` rows, read a chunk at a time.
 pub struct PlyRows {
     path: PathBuf,
@@ -39,35 +85,46 @@ impl PlyRows {
     /// Opens `path` and parses its header. Errors: not a PLY, ASCII or compressed PLY, no
     /// `vertex` element, elements before it that are not fixed-size, or a file shorter than
     /// its header says.
-    pub fn open(path: &Path, opts: &LoadOptions) -> Result<Self, String> {
-        let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-        let mut file = File::open(path).map_err(|e| err(&e))?;
+    pub fn open(path: &Path, opts: &LoadOptions) -> Result<Self, StreamError> {
+        let io = |source| StreamError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let ply = |source| StreamError::Ply {
+            path: path.to_owned(),
+            source,
+        };
+        let not = |why: &str| StreamError::NotStreamable {
+            path: path.to_owned(),
+            why: why.to_owned(),
+        };
+        let mut file = File::open(path).map_err(io)?;
         let mut head = Vec::new();
         (&mut file)
             .take(MAX_HEADER as u64)
             .read_to_end(&mut head)
-            .map_err(|e| err(&e))?;
-        let header = parse_header(&head).map_err(|e| err(&e))?;
+            .map_err(io)?;
+        let header = parse_header(&head).map_err(ply)?;
         if header.encoding == Encoding::Ascii {
-            return Err(err(
-                &"ASCII PLY is not read in chunks; convert it to binary first",
+            return Err(not(
+                "ASCII PLY is not read in chunks; convert it to binary first",
             ));
         }
         let vertex = header
             .elements
             .iter()
             .position(|e| e.name == "vertex")
-            .ok_or_else(|| err(&PlyError::NoVertexElement))?;
+            .ok_or_else(|| ply(PlyError::NoVertexElement))?;
         let v = &header.elements[vertex];
         if super::compressed::is_compressed(v) {
-            return Err(err(&"PlayCanvas compressed PLY is not read in chunks"));
+            return Err(not("PlayCanvas compressed PLY is not read in chunks"));
         }
-        let layout = layout(v).map_err(|e| err(&e))?;
+        let layout = layout(v).map_err(ply)?;
         let be = header.encoding == Encoding::Be;
         let mut before = 0u64;
         for e in &header.elements[..vertex] {
             if e.props.iter().any(|p| p.list.is_some()) {
-                return Err(err(&format!(
+                return Err(not(&format!(
                     "element '{}' before 'vertex' has list properties",
                     e.name
                 )));
@@ -76,10 +133,10 @@ impl PlyRows {
             before = before.saturating_add(row.saturating_mul(e.count));
         }
         let start = (header.body as u64).saturating_add(before);
-        let len = file.metadata().map_err(|e| err(&e))?.len();
+        let len = file.metadata().map_err(io)?.len();
         let needed = v.count.saturating_mul(layout.stride as u64);
         if len.saturating_sub(start) < needed || (v.count > 0 && layout.stride == 0) {
-            return Err(err(&PlyError::Truncated {
+            return Err(ply(PlyError::Truncated {
                 element: "vertex".into(),
                 count: v.count,
                 needed,
@@ -134,7 +191,7 @@ impl PlyRows {
     /// The next at most `rows` rows (`None` after the last; fewer when `rows` of them would
     /// take more than 64 MiB). Unusable rows are dropped (and
     /// counted in [`Self::findings`]) or, with `strict`, an error naming the row.
-    pub fn next_chunk(&mut self, rows: usize) -> Option<Result<SplatCloud, String>> {
+    pub fn next_chunk(&mut self, rows: usize) -> Option<Result<SplatCloud, StreamError>> {
         let left = self.len() - self.next;
         if left == 0 {
             return None;
@@ -145,18 +202,27 @@ impl PlyRows {
         Some(self.read(n))
     }
 
-    fn read(&mut self, n: u64) -> Result<SplatCloud, String> {
-        let err = |e: &dyn std::fmt::Display| format!("{}: {e}", self.path.display());
+    fn read(&mut self, n: u64) -> Result<SplatCloud, StreamError> {
+        let path = &self.path;
+        let io = |source| StreamError::Io {
+            path: path.clone(),
+            source,
+        };
         let stride = self.layout.stride as u64;
         let first = self.next;
         self.file
             .seek(SeekFrom::Start(self.start + first * stride))
-            .map_err(|e| err(&e))?;
+            .map_err(io)?;
         let mut bytes = vec![0u8; (n * stride) as usize];
-        self.file.read_exact(&mut bytes).map_err(|e| err(&e))?;
+        self.file.read_exact(&mut bytes).map_err(io)?;
         let props = &self.header.elements[self.vertex].props;
         let (mut cloud, notes, bad) =
-            decode_binary(&self.layout, props, &bytes, self.be).map_err(|e| err(&e))?;
+            decode_binary(&self.layout, props, &bytes, self.be).map_err(|source| {
+                StreamError::Ply {
+                    path: path.clone(),
+                    source,
+                }
+            })?;
         self.next += n;
         let at = |i: usize| first + i as u64;
         if let Some(i) = notes.first_inf {
@@ -174,7 +240,11 @@ impl PlyRows {
         if let Some(&i) = bad.rows.first() {
             if self.strict {
                 let why = bad.first.as_ref().map_or(String::new(), |e| e.to_string());
-                return Err(err(&format!("vertex row {}: {why}", at(i))));
+                return Err(StreamError::BadRow {
+                    path: self.path.clone(),
+                    row: at(i),
+                    why,
+                });
             }
             self.findings.push(
                 Finding::warning(

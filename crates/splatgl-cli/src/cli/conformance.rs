@@ -122,8 +122,9 @@ fn run_images(
         },
     };
     runner::run_with(dir, m, &opts, |c| {
-        runner::find_image(images, c).map(|p| Image::read(&p).map_err(|e| e.to_string()))
+        runner::find_image(images, c).map(Image::read)
     })
+    .map_err(Into::into)
 }
 
 /// Renders the suite with `--backend`'s renderer, keeps the images under `out/images`, and

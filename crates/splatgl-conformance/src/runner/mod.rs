@@ -9,13 +9,13 @@ mod judge;
 pub use explain::diagnosis;
 
 use super::diagnosis::{Closest, Explanation};
-use super::generate::{clamped, measure, over_bound};
 use super::manifest::{AssetEntry, CameraEntry, Manifest, suite_path};
 use super::render;
+use super::verdict::{clamped, measure, over_bound};
 use explain::{Budget, MAX_EXPLAINED, allow_or_explain, name_causes, second_look};
 use judge::reference_and_bound;
 use splatgl::compare::Comparison;
-use splatgl::image::Image;
+use splatgl::image::{Image, ImageError};
 use std::path::Path;
 
 /// The outcome of one camera.
@@ -123,8 +123,8 @@ struct ModelInput {
 pub fn run(
     dir: &Path,
     m: &Manifest,
-    get: impl FnMut(&CameraEntry) -> Option<Result<Image, String>>,
-) -> Result<Vec<AssetResult>, String> {
+    get: impl FnMut(&CameraEntry) -> Option<Result<Image, ImageError>>,
+) -> Result<Vec<AssetResult>, crate::KitError> {
     run_with(dir, m, &RunOptions::default(), get)
 }
 
@@ -133,7 +133,16 @@ pub fn run_with(
     dir: &Path,
     m: &Manifest,
     opts: &RunOptions,
-    mut get: impl FnMut(&CameraEntry) -> Option<Result<Image, String>>,
+    get: impl FnMut(&CameraEntry) -> Option<Result<Image, ImageError>>,
+) -> Result<Vec<AssetResult>, crate::KitError> {
+    grade(dir, m, opts, get).map_err(crate::KitError::Reference)
+}
+
+fn grade(
+    dir: &Path,
+    m: &Manifest,
+    opts: &RunOptions,
+    mut get: impl FnMut(&CameraEntry) -> Option<Result<Image, ImageError>>,
 ) -> Result<Vec<AssetResult>, String> {
     let mut results = Vec::new();
     let mut budget = Budget {
@@ -144,7 +153,7 @@ pub fn run_with(
         let mut cams = Vec::new();
         let mut loaded = Loaded::default();
         for (ci, c) in a.cameras.iter().enumerate() {
-            let got = get(c);
+            let got = get(c).map(|r| r.map_err(|e| e.to_string()));
             cams.push(camera_result(
                 dir,
                 m,
