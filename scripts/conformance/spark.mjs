@@ -17,7 +17,7 @@
 // target/debug/splatgl and .npm-tools/; default: the checkout this script is in). For
 // experiments only (the test renders Spark's defaults): SPARK_RENDERER='{"maxStdDev":3}' and
 // SPARK_MESH='{"extSplats":true}', JSON objects merged into the SparkRenderer and SplatMesh
-// options (docs/conformance.md, "Spark 2.2", lists what they showed).
+// options (docs/conformance-engines.md, "Spark 2.2", lists what they showed).
 import { renderSuite } from './common.mjs';
 
 const json = (name) => {

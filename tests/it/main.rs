@@ -27,6 +27,7 @@ mod common {
 #[cfg(feature = "gl")]
 mod antialiased;
 mod camera;
+mod docs_paths;
 mod docs_snippets;
 mod format_roundtrip;
 mod formats;

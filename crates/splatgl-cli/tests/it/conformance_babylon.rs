@@ -3,7 +3,7 @@
 //! tuned: each asset's `.glb` / `.gltf` is appended to a scene as an application does
 //! (`scripts/conformance/babylon.mjs`, no conversion) and rendered from every camera in headless
 //! Chromium. What its source shows (paths under `node_modules/@babylonjs/`, cited in
-//! docs/conformance.md, "Babylon.js 9") is what the verdicts must show.
+//! docs/conformance-engines.md, "Babylon.js 9") is what the verdicts must show.
 //!
 //! Needs node, chromium and the npm tools (`.ci/run` and `scripts/test.sh` install them);
 //! without them the test is skipped, which fails under `SPLATGL_REQUIRE=all`.

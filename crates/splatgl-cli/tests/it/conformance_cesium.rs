@@ -2,7 +2,7 @@
 //! SPZ-compressed glTF (`splatgl convert --spz-compress`, the only splat form CesiumJS 1.145
 //! draws), is the one content of a 3D Tiles tileset that `scripts/conformance/cesium.mjs`
 //! renders in headless Chromium, and `splatgl conformance run` grades the images. What its
-//! shipped source says it does (docs/conformance.md, "Independent renderers", "CesiumJS",
+//! shipped source says it does (docs/conformance-engines.md, "CesiumJS",
 //! cites the lines) is what the verdicts must show: it never reads `colorSpace`, so the linear
 //! asset fails by far; its vertex shader drops splats whose centre is outside 1.2× the clip
 //! box (the off-screen profile asset differs) and splats whose quad is under a pixel (the

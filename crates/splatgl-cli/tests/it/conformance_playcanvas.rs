@@ -3,7 +3,7 @@
 //! `.glb` / `.gltf` is loaded as an application loads it (`scripts/conformance/playcanvas.mjs`,
 //! no conversion) and rendered from every camera in headless Chromium. What its source shows
 //! (paths under `node_modules/playcanvas/build/playcanvas/src/`, cited in
-//! docs/conformance.md, "PlayCanvas 2.23") is what the verdicts must show.
+//! docs/conformance-engines.md, "PlayCanvas 2.23") is what the verdicts must show.
 //!
 //! Needs node, chromium and the npm tools (`.ci/run` and `scripts/test.sh` install them);
 //! without them the test is skipped, which fails under `SPLATGL_REQUIRE=all`.

@@ -1,6 +1,6 @@
 //! The conformance kit grading renderers splatgl did not write, each rendering the suite in
 //! headless Chromium and graded by `splatgl conformance run`; what their source says they do
-//! (docs/conformance.md, "Independent renderers", cites the lines) is what the verdicts must
+//! (docs/conformance-engines.md cites the lines) is what the verdicts must
 //! show.
 //!
 //! GaussianSplats3D 0.4.7 (npm `@mkkellogg/gaussian-splats-3d`, with three 0.170.0, through
@@ -159,7 +159,7 @@ fn spark_is_graded_by_the_rules_its_source_breaks() {
     // the emulation of its packing does not reproduce), not a stock hint — but the linear
     // colour-space asset, which the adapter cannot give it (PLY has no colour space).
     // (`erratum_i`, no dilation, is the model's stand-in for the compensation where it dims
-    // small footprints: the misattribution docs/conformance.md lists for Spark.)
+    // small footprints: the misattribution docs/conformance-engines.md lists for Spark.)
     let own = [
         "packed_splat_precision",
         "antialiasing_compensation",

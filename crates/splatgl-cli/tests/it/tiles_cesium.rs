@@ -12,7 +12,7 @@
 //!   16 px is far from that (the coarse, merged tiles are what it drew);
 //! - splatgl's image is within CesiumJS's renderer deviations of CesiumJS's, for the leaves
 //!   and for the coarse tiles (its 2.83σ square, near-zero dilation and view-depth order:
-//!   docs/conformance.md, "CesiumJS"), and much closer than to splatgl's image mirrored.
+//!   docs/conformance-engines.md, "CesiumJS"), and much closer than to splatgl's image mirrored.
 //!
 //! Needs node, chromium, the npm tools and the real data; without them the test is skipped,
 //! which fails under `SPLATGL_REQUIRE=all`.
