@@ -1,5 +1,6 @@
 //! [`SplatRenderer`]: uploads clouds and draws them into the host's framebuffer. Its
-//! [`DrawSettings`] are in `settings.rs`, the draw calls themselves in `draw.rs`.
+//! [`DrawSettings`] are in `settings.rs`, the draw calls themselves in `draw.rs`, the paged
+//! storage of streamed tilesets in `renderer/paged.rs`.
 
 use crate::gl::bound::Bound;
 use std::cell::Cell;
@@ -21,6 +22,7 @@ use super::state::{Bindings, StateCalls};
 use super::uniforms::{Models, Uniforms};
 use crate::cloud::{ColorSpace, SplatCloud};
 
+mod paged;
 /// The splat renderer. It borrows the host's GL context in every call and never owns it; see
 /// [`super::state`] for the GL state each call changes in each mode. All methods must be
 /// called with the same context current. One renderer draws one cloud; a [`SplatScene`](super::SplatScene)
@@ -294,89 +296,6 @@ impl SplatRenderer {
         self.order_capacity = n;
         self.host_sort = None;
         Ok(())
-    }
-
-    /// Allocates paged storage: `pages` pages of [`PAGE_SPLATS`] splat slots each, for clouds
-    /// of SH degree up to `sh_degree`, drawn in `color_space` (replaces any cloud or pages;
-    /// the slots' contents are undefined until written). For streamed tilesets: each tile
-    /// goes into pages of its own ([`SplatRenderer::write_page`]), loading or evicting one never
-    /// re-uploads the others, and [`SplatRenderer::set_order`] takes slot indices
-    /// (`page · PAGE_SPLATS + i`). GL state as [`SplatRenderer::upload`]; on failure the previous
-    /// storage stays.
-    pub fn allocate_pages(
-        &mut self,
-        gl: &glow::Context,
-        pages: usize,
-        sh_degree: u8,
-        color_space: ColorSpace,
-    ) -> Result<(), GlError> {
-        self.owned.check()?;
-        let n = pages.saturating_mul(PAGE_SPLATS);
-        let errors = ErrorScope::begin(gl)?;
-        let host = Bindings::for_upload(gl, self.ctx);
-        let mut textures = SplatTextures::allocate(gl, n, sh_degree.min(3), &self.layout)?;
-        drop(host);
-        if let Err(e) = errors.end("allocating splat pages") {
-            textures.destroy(gl);
-            return Err(e);
-        }
-        self.replace_textures(gl, textures, color_space)?;
-        self.models = Models::IDENTITY;
-        self.paged = true;
-        Ok(())
-    }
-
-    /// Writes splats `first .. first + PAGE_SPLATS` of `cloud` (fewer at its end) into page
-    /// `page` of the storage [`SplatRenderer::allocate_pages`] made. Errors: no pages
-    /// ([`GlError::NotUploaded`]), a page or range outside them or a cloud of a higher SH
-    /// degree than the storage ([`GlError::Upload`]), GL errors. GL state as
-    /// [`SplatRenderer::upload`].
-    pub fn write_page(
-        &mut self,
-        gl: &glow::Context,
-        page: usize,
-        cloud: &SplatCloud,
-        first: usize,
-    ) -> Result<(), GlError> {
-        self.owned.check()?;
-        let Some(textures) = &self.textures else {
-            return Err(GlError::NotUploaded);
-        };
-        let count = cloud.len().saturating_sub(first).min(PAGE_SPLATS);
-        if (page + 1).saturating_mul(PAGE_SPLATS) > textures.len || first > cloud.len() {
-            return Err(GlError::Upload(format!(
-                "page {page} (splats {first}.. of {}) is outside the {} pages allocated",
-                cloud.len(),
-                textures.len / PAGE_SPLATS
-            )));
-        }
-        if cloud.sh_degree > textures.sh_degree {
-            return Err(GlError::Upload(format!(
-                "a cloud of SH degree {} does not fit pages of degree {}",
-                cloud.sh_degree, textures.sh_degree
-            )));
-        }
-        let clouds = [cloud];
-        let set = CloudSet::new(&clouds)?;
-        let errors = ErrorScope::begin(gl)?;
-        let host = Bindings::for_upload(gl, self.ctx);
-        textures.write(
-            gl,
-            &self.layout,
-            page * PAGE_SPLATS,
-            &set,
-            first..first + count,
-        );
-        drop(host);
-        errors.end("writing a splat page")
-    }
-
-    /// Pages allocated by [`SplatRenderer::allocate_pages`] (0 after a plain upload).
-    pub fn pages(&self) -> usize {
-        match &self.textures {
-            Some(t) if self.paged => t.len / PAGE_SPLATS,
-            _ => 0,
-        }
     }
 
     /// Reallocates the order buffer for `n` indices. On failure its contents and size are
