@@ -39,6 +39,22 @@ struct Part<'a> {
     splats: Vec<u32>,
 }
 
+/// Each leaf's parts, by level: `parts[leaf][level]`.
+type Parts<'a> = HashMap<&'a str, Vec<Option<Part<'a>>>>;
+
+/// Units per level, and each leaf's `(file, offset, count)` per level.
+type Units<'a> = (Vec<(String, SplatCloud)>, HashMap<&'a str, Map<String, Value>>, Vec<u64>);
+
+/// The content of tile `name`, or the error naming it.
+fn content_of<'c>(
+    contents: &'c HashMap<String, SplatCloud>,
+    name: &str,
+) -> Result<&'c SplatCloud, super::TilesError> {
+    contents
+        .get(name)
+        .ok_or_else(|| super::TilesError::Build(format!("tile {name}: no content")))
+}
+
 /// Lays out `root`'s tree (each tile's content in `contents`, by name) as a streamed SOG with
 /// units of about `unit_splats`. `Err` when a tile's content is missing.
 pub fn layout(
@@ -46,17 +62,50 @@ pub fn layout(
     contents: &HashMap<String, SplatCloud>,
     unit_splats: usize,
 ) -> Result<LodMetaLayout, super::TilesError> {
-    let content = |name: &str| {
-        contents
-            .get(name)
-            .ok_or_else(|| super::TilesError::Build(format!("tile {name}: no content")))
-    };
     let leaves = leaves_below(root);
+    let parts = leaf_parts(root, &leaves, contents)?;
+    let levels = parts.values().map(Vec::len).max().unwrap_or(1);
+    let (units, mut refs, counts) = pack_units(&leaves, &parts, contents, levels, unit_splats)?;
+    let bounds = |leaf: &str| -> Extent {
+        let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for part in parts[leaf].iter().flatten() {
+            let c = &contents[part.tile];
+            for &i in &part.splats {
+                for a in 0..3 {
+                    let x = c.positions[i as usize][a] as f64;
+                    b.0[a] = b.0[a].min(x);
+                    b.1[a] = b.1[a].max(x);
+                }
+            }
+        }
+        b
+    };
+    let errors = leaf_errors(root, levels);
+    let (tree, _) = node(root, &mut refs, &errors, &bounds);
+    let filenames: Vec<&str> = units.iter().map(|(n, _)| n.as_str()).collect();
+    let manifest = json!({
+        "version": 1,
+        "asset": {"generator": concat!("splatgl ", env!("CARGO_PKG_VERSION"))},
+        "count": counts.iter().sum::<u64>(),
+        "counts": counts,
+        "lodLevels": levels,
+        "filenames": filenames,
+        "tree": tree,
+    });
+    Ok(LodMetaLayout { manifest, units })
+}
+
+/// Each leaf's parts by level: its own splats at level 0, then at each ancestor's level the
+/// ancestor's splats that descend to it.
+fn leaf_parts<'a>(
+    root: &'a BuiltTile,
+    leaves: &[&'a BuiltTile],
+    contents: &HashMap<String, SplatCloud>,
+) -> Result<Parts<'a>, super::TilesError> {
     let depth = |t: &BuiltTile| t.name.len() - 1;
-    // parts[leaf][level]
-    let mut parts: HashMap<&str, Vec<Option<Part>>> = HashMap::new();
-    for l in &leaves {
-        let all = (0..content(&l.name)?.len() as u32).collect();
+    let mut parts: Parts = HashMap::new();
+    for l in leaves {
+        let all = (0..content_of(contents, &l.name)?.len() as u32).collect();
         parts.insert(
             &l.name,
             vec![Some(Part {
@@ -66,7 +115,7 @@ pub fn layout(
         );
     }
     for t in root.walk().into_iter().filter(|t| !t.children.is_empty()) {
-        let c = content(&t.name)?;
+        let c = content_of(contents, &t.name)?;
         let mut by_leaf: HashMap<&str, Vec<u32>> = HashMap::new();
         for (i, p) in c.positions.iter().enumerate() {
             let leaf = descend(t, *p);
@@ -84,20 +133,28 @@ pub fn layout(
             });
         }
     }
-    let levels = parts.values().map(Vec::len).max().unwrap_or(1);
+    Ok(parts)
+}
 
-    // Units per level, leaves in tree order; refs[leaf][level] = (file, offset, count).
+/// Units per level, leaves in tree order, each of about `unit_splats`.
+fn pack_units<'a>(
+    leaves: &[&'a BuiltTile],
+    parts: &Parts<'a>,
+    contents: &HashMap<String, SplatCloud>,
+    levels: usize,
+    unit_splats: usize,
+) -> Result<Units<'a>, super::TilesError> {
     let mut units: Vec<(String, SplatCloud)> = Vec::new();
     let mut refs: HashMap<&str, Map<String, Value>> = HashMap::new();
     let mut counts = vec![0u64; levels];
     for (level, count) in counts.iter_mut().enumerate() {
         let mut current: Option<usize> = None;
         let mut k = 0;
-        for l in &leaves {
+        for l in leaves {
             let Some(Some(part)) = parts[l.name.as_str()].get(level) else {
                 continue;
             };
-            let cloud = content(part.tile)?.select(&part.splats);
+            let cloud = content_of(contents, part.tile)?.select(&part.splats);
             let full = current.is_some_and(|u| units[u].1.len() + cloud.len() > unit_splats);
             if current.is_none() || full && !units[current.unwrap()].1.is_empty() {
                 units.push((format!("{level}_{k}/meta.json"), SplatCloud::default()));
@@ -118,22 +175,12 @@ pub fn layout(
             }
         }
     }
-    let bounds = |leaf: &str| -> Extent {
-        let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for part in parts[leaf].iter().flatten() {
-            let c = &contents[part.tile];
-            for &i in &part.splats {
-                for a in 0..3 {
-                    let x = c.positions[i as usize][a] as f64;
-                    b.0[a] = b.0[a].min(x);
-                    b.1[a] = b.1[a].max(x);
-                }
-            }
-        }
-        b
-    };
-    // Each leaf's error per level: 0 for its own splats, then each ancestor's geometric error
-    // (levels a leaf lacks take its next finer one's).
+    Ok((units, refs, counts))
+}
+
+/// Each leaf's error per level: 0 for its own splats, then each ancestor's geometric error
+/// (levels a leaf lacks take its next finer one's).
+fn leaf_errors(root: &BuiltTile, levels: usize) -> HashMap<&str, Vec<f64>> {
     let mut errors: HashMap<&str, Vec<f64>> = HashMap::new();
     for t in root.walk() {
         for l in leaves_below(t) {
@@ -150,18 +197,7 @@ pub fn layout(
             }
         }
     }
-    let (tree, _) = node(root, &mut refs, &errors, &bounds);
-    let filenames: Vec<&str> = units.iter().map(|(n, _)| n.as_str()).collect();
-    let manifest = json!({
-        "version": 1,
-        "asset": {"generator": concat!("splatgl ", env!("CARGO_PKG_VERSION"))},
-        "count": counts.iter().sum::<u64>(),
-        "counts": counts,
-        "lodLevels": levels,
-        "filenames": filenames,
-        "tree": tree,
-    });
-    Ok(LodMetaLayout { manifest, units })
+    errors
 }
 
 /// The leaf below `t` that a splat at `p` goes to: at each tile, the child whose box is

@@ -50,25 +50,91 @@ impl From<SogWriteError> for String {
     }
 }
 
+/// The textures' layout: `width × height` texels (multiples of 4), splat `i` at texel `i`.
+struct Grid {
+    n: usize,
+    width: usize,
+    height: usize,
+}
+
+impl Grid {
+    fn for_splats(n: usize) -> Self {
+        let width = (((n as f64).sqrt() / 4.0).ceil() as usize * 4).max(4);
+        let height = (n.div_ceil(width).div_ceil(4) * 4).max(4);
+        Grid { n, width, height }
+    }
+
+    /// The lossless WebP of the texels `f(i)` (zero past the splats), added to `files`.
+    fn add(
+        &self,
+        files: &mut SogFiles,
+        name: &str,
+        f: &dyn Fn(usize) -> [u8; 4],
+    ) -> Result<(), SogWriteError> {
+        let rgba: Vec<u8> = (0..self.width * self.height)
+            .flat_map(|i| if i < self.n { f(i) } else { [0; 4] })
+            .collect();
+        files.push((name.to_owned(), webp(&rgba, self.width, self.height)?));
+        Ok(())
+    }
+}
+
 /// Encodes `cloud` as the files of an unbundled SOG (`meta.json` and its WebP textures).
 /// `Err` only if the WebP encoder fails.
 pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, SogWriteError> {
     let n = cloud.len();
-    let width = (((n as f64).sqrt() / 4.0).ceil() as usize * 4).max(4);
-    let height = (n.div_ceil(width).div_ceil(4) * 4).max(4);
-    let texels = width * height;
-    let tex = |f: &dyn Fn(usize) -> [u8; 4]| -> Vec<u8> {
-        (0..texels)
-            .flat_map(|i| if i < n { f(i) } else { [0; 4] })
-            .collect()
-    };
+    let g = Grid::for_splats(n);
     let mut files: SogFiles = vec![(String::new(), Vec::new())];
-    let mut add = |name: &str, rgba: &[u8], w: usize, h: usize| -> Result<(), SogWriteError> {
-        files.push((name.to_owned(), webp(rgba, w, h)?));
-        Ok(())
-    };
+    let (mins, maxs) = add_means(&mut files, cloud, &g)?;
+    g.add(&mut files, "quats.webp", &|i| quat_texel(cloud.rotations[i]))?;
 
-    // Means: log-transformed, 16 bits in the range.
+    // Scales: a codebook of ln(scale), shared by the three axes.
+    let ln_scales: Vec<f32> = cloud
+        .scales
+        .iter()
+        .flat_map(|s| s.map(|v| v.max(1e-12).ln()))
+        .collect();
+    let scales = Codebook::fit(&ln_scales);
+    g.add(&mut files, "scales.webp", &|i| {
+        let b = |a: usize| scales.index(ln_scales[3 * i + a]);
+        [b(0), b(1), b(2), 255]
+    })?;
+
+    // DC colour and opacity.
+    let dc: Vec<f32> = (0..n).flat_map(|i| cloud.sh_of(i)[0]).collect();
+    let sh0 = Codebook::fit(&dc);
+    g.add(&mut files, "sh0.webp", &|i| {
+        let b = |c: usize| sh0.index(dc[3 * i + c]);
+        let alpha = (cloud.opacities[i] * 255.0).round().clamp(0.0, 255.0) as u8;
+        [b(0), b(1), b(2), alpha]
+    })?;
+
+    let mut meta = json!({
+        "version": 2,
+        "asset": {"generator": concat!("splatgl ", env!("CARGO_PKG_VERSION"))},
+        "count": n,
+        "means": {"mins": mins, "maxs": maxs, "files": ["means_l.webp", "means_u.webp"]},
+        "scales": {"codebook": scales.values, "files": ["scales.webp"]},
+        "quats": {"files": ["quats.webp"]},
+        "sh0": {"codebook": sh0.values, "files": ["sh0.webp"]},
+    });
+    if cloud.sh_degree > 0 && n > 0 {
+        let (sh_n, centroids, labels) = palette(cloud, g.width, g.height)?;
+        meta["shN"] = sh_n;
+        files.push(("shN_centroids.webp".into(), centroids));
+        files.push(("shN_labels.webp".into(), labels));
+    }
+    files[0] = ("meta.json".into(), serde_json::to_vec(&meta)?);
+    Ok(files)
+}
+
+/// Means: log-transformed, 16 bits in the range of each axis (low and high bytes in two
+/// textures); returns the range.
+fn add_means(
+    files: &mut SogFiles,
+    cloud: &SplatCloud,
+    g: &Grid,
+) -> Result<([f64; 3], [f64; 3]), SogWriteError> {
     let logs: Vec<[f64; 3]> = cloud
         .positions
         .iter()
@@ -96,55 +162,9 @@ pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, SogWriteError> {
         let b = |a| (step(i, a) >> if high { 8 } else { 0 }) as u8;
         [b(0), b(1), b(2), 255]
     };
-    add("means_l.webp", &tex(&|i| byte_of(i, false)), width, height)?;
-    add("means_u.webp", &tex(&|i| byte_of(i, true)), width, height)?;
-    add(
-        "quats.webp",
-        &tex(&|i| quat_texel(cloud.rotations[i])),
-        width,
-        height,
-    )?;
-
-    // Scales: a codebook of ln(scale), shared by the three axes.
-    let ln_scales: Vec<f32> = cloud
-        .scales
-        .iter()
-        .flat_map(|s| s.map(|v| v.max(1e-12).ln()))
-        .collect();
-    let scales = Codebook::fit(&ln_scales);
-    let sc = |i: usize| {
-        let b = |a: usize| scales.index(ln_scales[3 * i + a]);
-        [b(0), b(1), b(2), 255]
-    };
-    add("scales.webp", &tex(&sc), width, height)?;
-
-    // DC colour and opacity.
-    let dc: Vec<f32> = (0..n).flat_map(|i| cloud.sh_of(i)[0]).collect();
-    let sh0 = Codebook::fit(&dc);
-    let c0 = |i: usize| {
-        let b = |c: usize| sh0.index(dc[3 * i + c]);
-        let alpha = (cloud.opacities[i] * 255.0).round().clamp(0.0, 255.0) as u8;
-        [b(0), b(1), b(2), alpha]
-    };
-    add("sh0.webp", &tex(&c0), width, height)?;
-
-    let mut meta = json!({
-        "version": 2,
-        "asset": {"generator": concat!("splatgl ", env!("CARGO_PKG_VERSION"))},
-        "count": n,
-        "means": {"mins": mins, "maxs": maxs, "files": ["means_l.webp", "means_u.webp"]},
-        "scales": {"codebook": scales.values, "files": ["scales.webp"]},
-        "quats": {"files": ["quats.webp"]},
-        "sh0": {"codebook": sh0.values, "files": ["sh0.webp"]},
-    });
-    if cloud.sh_degree > 0 && n > 0 {
-        let (sh_n, centroids, labels) = palette(cloud, width, height)?;
-        meta["shN"] = sh_n;
-        files.push(("shN_centroids.webp".into(), centroids));
-        files.push(("shN_labels.webp".into(), labels));
-    }
-    files[0] = ("meta.json".into(), serde_json::to_vec(&meta)?);
-    Ok(files)
+    g.add(files, "means_l.webp", &|i| byte_of(i, false))?;
+    g.add(files, "means_u.webp", &|i| byte_of(i, true))?;
+    Ok((mins, maxs))
 }
 
 /// [`to_sog_files`] stored (uncompressed: WebP is compressed already) in one zip, `.sog`.
