@@ -154,15 +154,7 @@ impl FrameTargets {
         // EXT_sRGB_write_control) the sRGB target encodes only with it on: the clear needs it
         // as the draw does (which sets it itself from the colour space).
         let switch = srgb && renderer.srgb_write_switch();
-        // SAFETY: capability switches and a clear of the framebuffer bound just above.
-        unsafe {
-            gl.disable(glow::SCISSOR_TEST);
-            if switch {
-                gl.enable(glow::FRAMEBUFFER_SRGB);
-            }
-            gl.clear_color(bg[0], bg[1], bg[2], alpha);
-            gl.clear(glow::COLOR_BUFFER_BIT);
-        }
+        clear_bound(gl, [bg[0], bg[1], bg[2], alpha], switch);
         // Where the float target resolves into: the staging target, else the window.
         let into = self
             .staging
@@ -184,21 +176,7 @@ impl FrameTargets {
         }
         drawn?;
         let staging = self.staging.as_ref().filter(|_| staged);
-        let result = match (output, staging) {
-            (Output::Image, Some(t)) => {
-                super::check_error(gl, during)?;
-                Some(t.read_image(gl)?)
-            }
-            (Output::Window(w, h), Some(t)) => {
-                blit_to_window(gl, t, size, (w, h));
-                None
-            }
-            _ => None,
-        };
-        // SAFETY: back to the default framebuffer.
-        unsafe { gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
-        super::check_error(gl, during)?;
-        Ok(result)
+        deliver(gl, output, staging, size, during)
     }
 
     /// Deletes the targets (context current).
@@ -242,4 +220,44 @@ fn blit_to_window(gl: &glow::Context, t: &ReadbackTarget, (w, h): (u32, u32), wi
             filter,
         );
     }
+}
+
+/// Clears the bound framebuffer to `rgba` with the scissor test off, leaving
+/// `GL_FRAMEBUFFER_SRGB` on when `srgb_switch` (the draw that follows needs it on).
+fn clear_bound(gl: &glow::Context, rgba: [f32; 4], srgb_switch: bool) {
+    // SAFETY: capability switches and a clear of the bound framebuffer.
+    unsafe {
+        gl.disable(glow::SCISSOR_TEST);
+        if srgb_switch {
+            gl.enable(glow::FRAMEBUFFER_SRGB);
+        }
+        gl.clear_color(rgba[0], rgba[1], rgba[2], rgba[3]);
+        gl.clear(glow::COLOR_BUFFER_BIT);
+    }
+}
+
+/// Hands the drawn frame over: read back from `staging` for an image, blitted from it to the
+/// window, or (drawn in the window) nothing; then the default framebuffer is bound again.
+fn deliver(
+    gl: &glow::Context,
+    output: Output,
+    staging: Option<&ReadbackTarget>,
+    size: (u32, u32),
+    during: &'static str,
+) -> Result<Option<Image>, GlError> {
+    let result = match (output, staging) {
+        (Output::Image, Some(t)) => {
+            super::check_error(gl, during)?;
+            Some(t.read_image(gl)?)
+        }
+        (Output::Window(w, h), Some(t)) => {
+            blit_to_window(gl, t, size, (w, h));
+            None
+        }
+        _ => None,
+    };
+    // SAFETY: back to the default framebuffer.
+    unsafe { gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
+    super::check_error(gl, during)?;
+    Ok(result)
 }

@@ -43,7 +43,11 @@ struct Part<'a> {
 type Parts<'a> = HashMap<&'a str, Vec<Option<Part<'a>>>>;
 
 /// Units per level, and each leaf's `(file, offset, count)` per level.
-type Units<'a> = (Vec<(String, SplatCloud)>, HashMap<&'a str, Map<String, Value>>, Vec<u64>);
+type Units<'a> = (
+    Vec<(String, SplatCloud)>,
+    HashMap<&'a str, Map<String, Value>>,
+    Vec<u64>,
+);
 
 /// The content of tile `name`, or the error naming it.
 fn content_of<'c>(

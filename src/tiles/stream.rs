@@ -226,22 +226,9 @@ fn run(
     let (mut seen, mut pending, mut first_camera) = (0u64, 0usize, true);
     let root = [&ts.root];
     loop {
-        let cam = {
-            let (m, cv) = &**shared;
-            let mut w = m.lock().unwrap_or_else(|p| p.into_inner());
-            while !w.stop && (w.camera.is_none() || (w.generation == seen && pending == 0)) {
-                w = cv.wait(w).unwrap_or_else(|p| p.into_inner());
-            }
-            if w.stop {
-                return;
-            }
-            // The wait above ends with a camera unless stopping.
-            let Some(cam) = w.camera else { continue };
-            let new_camera = w.generation != seen;
-            seen = w.generation;
-            (cam, new_camera)
+        let Some((cam, new_camera)) = next_camera(shared, &mut seen, pending) else {
+            return;
         };
-        let (cam, new_camera) = cam;
         // A new frame (what earlier cameras used may be evicted) only when the camera moved:
         // while one camera's tiles load, none of them is evicted, so loading converges.
         if new_camera {
@@ -281,6 +268,27 @@ fn run(
         first_camera = false;
         wanted.truncate(LOAD_BATCH);
         cache.load_all(&wanted);
+    }
+}
+
+/// Waits for a camera to select for: a new one, or the same while tiles are pending. `None`
+/// when stopping; else the camera and whether it is new since generation `seen`.
+fn next_camera(shared: &Shared, seen: &mut u64, pending: usize) -> Option<(Camera, bool)> {
+    let (m, cv) = &**shared;
+    let mut w = m.lock().unwrap_or_else(|p| p.into_inner());
+    loop {
+        while !w.stop && (w.camera.is_none() || (w.generation == *seen && pending == 0)) {
+            w = cv.wait(w).unwrap_or_else(|p| p.into_inner());
+        }
+        if w.stop {
+            return None;
+        }
+        // The wait above ends with a camera unless stopping.
+        if let Some(cam) = w.camera {
+            let new_camera = w.generation != *seen;
+            *seen = w.generation;
+            return Some((cam, new_camera));
+        }
     }
 }
 

@@ -86,7 +86,9 @@ pub fn to_sog_files(cloud: &SplatCloud) -> Result<SogFiles, SogWriteError> {
     let g = Grid::for_splats(n);
     let mut files: SogFiles = vec![(String::new(), Vec::new())];
     let (mins, maxs) = add_means(&mut files, cloud, &g)?;
-    g.add(&mut files, "quats.webp", &|i| quat_texel(cloud.rotations[i]))?;
+    g.add(&mut files, "quats.webp", &|i| {
+        quat_texel(cloud.rotations[i])
+    })?;
 
     // Scales: a codebook of ln(scale), shared by the three axes.
     let ln_scales: Vec<f32> = cloud
