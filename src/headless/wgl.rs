@@ -251,27 +251,7 @@ impl HeadlessContext {
                 return Err(e);
             }
             let create = proc_address(c"wglCreateContextAttribsARB");
-            let extensions = proc_address(c"wglGetExtensionsStringARB");
-            let has_es = !extensions.is_null() && {
-                let get: GetExtensionsString = std::mem::transmute(extensions);
-                let s = get(window.hdc);
-                !s.is_null()
-                    && CStr::from_ptr(s)
-                        .to_string_lossy()
-                        .split(' ')
-                        .any(|e| e == "WGL_EXT_create_context_es2_profile")
-            };
-            let mut tries = vec![(api, version, "")];
-            if api == GlApi::Gles3 {
-                if !has_es {
-                    tries.clear();
-                }
-                tries.push((
-                    GlApi::DesktopCore33,
-                    (3, 3),
-                    "desktop 3.3 core for GLES 3 (no WGL_EXT_create_context_es2_profile)",
-                ));
-            }
+            let tries = context_tries(api, version, has_es_profile(window.hdc));
             let mut made = None;
             if !create.is_null() {
                 let create: CreateContextAttribs = std::mem::transmute(create);
@@ -377,6 +357,47 @@ impl Drop for HeadlessContext {
                 wglMakeCurrent(std::ptr::null_mut(), std::ptr::null_mut());
             }
             wglDeleteContext(self.context);
+        }
+    }
+}
+
+/// The contexts to ask for, in order: `api` at `version`, and for GLES 3 a desktop 3.3 core
+/// context (the only one where the driver has no ES profile), with the note that says so.
+fn context_tries(
+    api: GlApi,
+    version: (i32, i32),
+    has_es: bool,
+) -> Vec<(GlApi, (i32, i32), &'static str)> {
+    let mut tries = vec![(api, version, "")];
+    if api == GlApi::Gles3 {
+        if !has_es {
+            tries.clear();
+        }
+        tries.push((
+            GlApi::DesktopCore33,
+            (3, 3),
+            "desktop 3.3 core for GLES 3 (no WGL_EXT_create_context_es2_profile)",
+        ));
+    }
+    tries
+}
+
+/// Whether the driver offers `WGL_EXT_create_context_es2_profile`.
+///
+/// # Safety
+/// A context is current on `hdc`.
+unsafe fn has_es_profile(hdc: HDC) -> bool {
+    // SAFETY: the caller's contract; the extension string is NUL-terminated, owned by WGL.
+    unsafe {
+        let extensions = proc_address(c"wglGetExtensionsStringARB");
+        !extensions.is_null() && {
+            let get: GetExtensionsString = std::mem::transmute(extensions);
+            let s = get(hdc);
+            !s.is_null()
+                && CStr::from_ptr(s)
+                    .to_string_lossy()
+                    .split(' ')
+                    .any(|e| e == "WGL_EXT_create_context_es2_profile")
         }
     }
 }
