@@ -248,48 +248,7 @@ fn go(a: &Args) -> Result<(), String> {
     let t0 = Instant::now();
     let tree = super::convert_lod::tree_output(&a.output);
     let tileset = tree.is_some();
-    let format = if let Some(kind) = tree {
-        super::convert_lod::check_args(a)?;
-        match kind {
-            TreeOutput::Tiles3d => OutputFormat::Glb,
-            TreeOutput::LodMeta if a.scratch_dir.is_some() => {
-                return Err(format!(
-                    "{}: a streamed SOG is built in memory; --scratch-dir builds 3D Tiles \
-                     tilesets (e.g. out/tileset.json) only",
-                    a.output.display()
-                ));
-            }
-            TreeOutput::LodMeta => OutputFormat::Sog,
-        }
-    } else {
-        OutputFormat::from_path(&a.output).ok_or_else(|| {
-            let exts: Vec<&str> = convert::OUTPUTS.iter().map(|(e, _)| *e).collect();
-            format!(
-                "{}: output must end in .{}",
-                a.output.display(),
-                exts.join(", .")
-            )
-        })?
-    };
-    let o = options(a)?;
-    if o.quantize.any() && (!format.is_gltf() || o.spz_compress) {
-        return Err("--quantize applies to uncompressed .glb/.gltf outputs only".into());
-    }
-    if o.spz_compress && format != OutputFormat::Glb {
-        return Err("--spz-compress applies to .glb outputs only".into());
-    }
-    if (a.chunk_splats.is_some() || a.scratch_dir.is_some()) && !tileset {
-        return Err(
-            "--chunk-splats and --scratch-dir apply to tileset outputs (OUT ending in .json) only"
-                .into(),
-        );
-    }
-    if a.spz_version.is_some() && format != OutputFormat::Spz {
-        return Err("--spz-version applies to .spz outputs only".into());
-    }
-    if a.camera.is_some() && !format.is_gltf() {
-        return Err("--camera applies to .glb/.gltf outputs only (camera nodes)".into());
-    }
+    let (format, o) = output_and_options(a, tree)?;
     check_output(&a.output, &a.input, a.force)?;
     if let (true, Some(dir)) = (tileset, &a.scratch_dir) {
         return super::convert_lod::write_tileset_streamed(a, &o, dir, t0);
@@ -350,6 +309,58 @@ fn go(a: &Args) -> Result<(), String> {
         t0.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// The output format OUT asks for and the conversion options, checked against each other
+/// (an option that does not apply to that output is an error naming it).
+fn output_and_options(
+    a: &Args,
+    tree: Option<TreeOutput>,
+) -> Result<(OutputFormat, ConvertOptions), String> {
+    let tileset = tree.is_some();
+    let format = if let Some(kind) = tree {
+        super::convert_lod::check_args(a)?;
+        match kind {
+            TreeOutput::Tiles3d => OutputFormat::Glb,
+            TreeOutput::LodMeta if a.scratch_dir.is_some() => {
+                return Err(format!(
+                    "{}: a streamed SOG is built in memory; --scratch-dir builds 3D Tiles \
+                     tilesets (e.g. out/tileset.json) only",
+                    a.output.display()
+                ));
+            }
+            TreeOutput::LodMeta => OutputFormat::Sog,
+        }
+    } else {
+        OutputFormat::from_path(&a.output).ok_or_else(|| {
+            let exts: Vec<&str> = convert::OUTPUTS.iter().map(|(e, _)| *e).collect();
+            format!(
+                "{}: output must end in .{}",
+                a.output.display(),
+                exts.join(", .")
+            )
+        })?
+    };
+    let o = options(a)?;
+    if o.quantize.any() && (!format.is_gltf() || o.spz_compress) {
+        return Err("--quantize applies to uncompressed .glb/.gltf outputs only".into());
+    }
+    if o.spz_compress && format != OutputFormat::Glb {
+        return Err("--spz-compress applies to .glb outputs only".into());
+    }
+    if (a.chunk_splats.is_some() || a.scratch_dir.is_some()) && !tileset {
+        return Err(
+            "--chunk-splats and --scratch-dir apply to tileset outputs (OUT ending in .json) only"
+                .into(),
+        );
+    }
+    if a.spz_version.is_some() && format != OutputFormat::Spz {
+        return Err("--spz-version applies to .spz outputs only".into());
+    }
+    if a.camera.is_some() && !format.is_gltf() {
+        return Err("--camera applies to .glb/.gltf outputs only (camera nodes)".into());
+    }
+    Ok((format, o))
 }
 
 /// `-v`'s line: the matrix from the input's coordinates to the output's — the up-axis and
