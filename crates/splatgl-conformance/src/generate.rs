@@ -199,6 +199,68 @@ fn catches_of(
     Ok(caught)
 }
 
+/// The camera's judged region, refused when two overlapping splats tie in distance (their
+/// order would be f32 rounding's) or when less than 5 % of its pixels are judged.
+fn judged_of(
+    spec: &AssetSpec,
+    spec_cam: &CameraSpec,
+    cloud: &splatgl::SplatCloud,
+    cam: &Camera,
+) -> Result<Vec<bool>, GenerateError> {
+    if let Some((i, j, d)) = judge::sort_tie(cloud, cam) {
+        return Err(design_error(
+            spec,
+            format!(
+                "camera {}: splats {i} and {j} overlap with distances {d:.1e} apart \
+                 (a sort tie: their order is f32 rounding's)",
+                spec_cam.name
+            ),
+        ));
+    }
+    let judged = judge::judged_region(cloud, cam, spec.tested());
+    let share = judged.iter().filter(|&&j| j).count() as f64 / judged.len().max(1) as f64;
+    if share < 0.05 {
+        return Err(design_error(
+            spec,
+            format!(
+                "camera {}: only {:.0} % of its pixels are judged (rims and overlaps whose \
+                 order a renderer may choose cover the rest)",
+                spec_cam.name,
+                100.0 * share
+            ),
+        ));
+    }
+    Ok(judged)
+}
+
+/// Writes the camera's bound (`.bound.pfm`, in alpha) and judged region (`.judge.png`, white
+/// where judged); returns the bound's image (f32, as the runner reads it back).
+fn write_bound_and_mask(
+    dir: &Path,
+    spec: &AssetSpec,
+    (bound_pfm, judge_mask): (&str, &str),
+    exact: &model::ModelImage,
+    judged: &[bool],
+) -> Result<Image, GenerateError> {
+    let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
+    let mut mask_img = Image::filled(WIDTH, HEIGHT, [0.0, 0.0, 0.0, 1.0]);
+    for ((p, m), (b, j)) in bound_img
+        .pixels
+        .iter_mut()
+        .zip(&mut mask_img.pixels)
+        .zip(exact.bound.iter().zip(judged))
+    {
+        p[3] = *b as f32;
+        let v = if *j { 1.0 } else { 0.0 };
+        *m = [v, v, v, 1.0];
+    }
+    write(&dir.join(bound_pfm), &bound_img.encode_pfm_alpha())?;
+    let mask_png = mask_img.encode_png(PngDepth::Eight, false);
+    let mask_png = mask_png.map_err(|e| design_error(spec, e.to_string()))?;
+    write(&dir.join(judge_mask), &mask_png)?;
+    Ok(bound_img)
+}
+
 /// One camera: writes its reference (PNG, PFM) and bound, derives its tolerance and what it
 /// catches; returns the manifest entry, its `cameras.json` entry and the errata caught.
 fn camera_entry(
@@ -227,43 +289,10 @@ fn camera_entry(
     write(&dir.join(&pfm), &reference.encode_pfm())?;
     let mut exact = model::render(cloud, &cam, &[]);
     admit(&mut exact, spec, cloud, &cam);
-    if let Some((i, j, d)) = judge::sort_tie(cloud, &cam) {
-        return Err(design(format!(
-            "camera {}: splats {i} and {j} overlap with distances {d:.1e} apart \
-             (a sort tie: their order is f32 rounding's)",
-            spec_cam.name
-        )));
-    }
-    let judged = judge::judged_region(cloud, &cam, spec.tested());
-    let share = judged.iter().filter(|&&j| j).count() as f64 / judged.len().max(1) as f64;
-    if share < 0.05 {
-        return Err(design(format!(
-            "camera {}: only {:.0} % of its pixels are judged (rims and overlaps whose order \
-             a renderer may choose cover the rest)",
-            spec_cam.name,
-            100.0 * share
-        )));
-    }
+    let judged = judged_of(spec, spec_cam, cloud, &cam)?;
     let bound_pfm = format!("reference/{image}.bound.pfm");
     let judge_mask = format!("reference/{image}.judge.png");
-    let mut bound_img = Image::filled(WIDTH, HEIGHT, [0.0; 4]);
-    let mut mask_img = Image::filled(WIDTH, HEIGHT, [0.0, 0.0, 0.0, 1.0]);
-    for ((p, m), (b, j)) in bound_img
-        .pixels
-        .iter_mut()
-        .zip(&mut mask_img.pixels)
-        .zip(exact.bound.iter().zip(&judged))
-    {
-        p[3] = *b as f32;
-        let v = if *j { 1.0 } else { 0.0 };
-        *m = [v, v, v, 1.0];
-    }
-    write(&dir.join(&bound_pfm), &bound_img.encode_pfm_alpha())?;
-    let mask_png = mask_img.encode_png(PngDepth::Eight, false);
-    write(
-        &dir.join(&judge_mask),
-        &mask_png.map_err(|e| design(e.to_string()))?,
-    )?;
+    let bound_img = write_bound_and_mask(dir, spec, (&bound_pfm, &judge_mask), &exact, &judged)?;
     judge::apply(&mut exact.bound, &judged);
     let tolerance = tolerance(&exact);
     // The bound as the runner reads it back (f32), outside the judged region infinite.
