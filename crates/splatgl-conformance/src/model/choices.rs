@@ -117,93 +117,25 @@ impl Choices {
     /// Each choice's admitted alternatives, one at a time (the rows of the docs' table), by
     /// name.
     pub fn rows() -> Vec<(&'static str, Choices)> {
-        let p = Choices::PROFILE;
+        let row = |name, set: fn(&mut Choices)| {
+            let mut c = Choices::PROFILE;
+            set(&mut c);
+            (name, c)
+        };
         vec![
-            (
-                "alpha_cap_0.999",
-                Choices {
-                    alpha_cap: 0.999,
-                    ..p
-                },
-            ),
-            (
-                "alpha_cap_1",
-                Choices {
-                    alpha_cap: 1.0,
-                    ..p
-                },
-            ),
-            (
-                "no_1_255_skip",
-                Choices {
-                    skip_below_1_255: false,
-                    ..p
-                },
-            ),
-            (
-                "early_stop",
-                Choices {
-                    early_stop: true,
-                    ..p
-                },
-            ),
-            (
-                "extent_axis_box",
-                Choices {
-                    extent: Extent::AxisBox,
-                    ..p
-                },
-            ),
-            (
-                "extent_square",
-                Choices {
-                    extent: Extent::Square,
-                    ..p
-                },
-            ),
-            (
-                "extent_tiles",
-                Choices {
-                    extent: Extent::Tiles,
-                    ..p
-                },
-            ),
-            (
-                "view_depth_order",
-                Choices {
-                    view_depth_order: true,
-                    ..p
-                },
-            ),
-            ("dilation_0.1", Choices { dilation: 0.1, ..p }),
-            (
-                "colour_opacity_8bit",
-                Choices {
-                    colour_8bit: true,
-                    ..p
-                },
-            ),
-            (
-                "covariance_f16",
-                Choices {
-                    covariance_f16: true,
-                    ..p
-                },
-            ),
-            (
-                "blending_8bit",
-                Choices {
-                    blending_8bit: true,
-                    ..p
-                },
-            ),
-            (
-                "colour_clamped_per_splat",
-                Choices {
-                    colour_clamp: true,
-                    ..p
-                },
-            ),
+            row("alpha_cap_0.999", |c| c.alpha_cap = 0.999),
+            row("alpha_cap_1", |c| c.alpha_cap = 1.0),
+            row("no_1_255_skip", |c| c.skip_below_1_255 = false),
+            row("early_stop", |c| c.early_stop = true),
+            row("extent_axis_box", |c| c.extent = Extent::AxisBox),
+            row("extent_square", |c| c.extent = Extent::Square),
+            row("extent_tiles", |c| c.extent = Extent::Tiles),
+            row("view_depth_order", |c| c.view_depth_order = true),
+            row("dilation_0.1", |c| c.dilation = 0.1),
+            row("colour_opacity_8bit", |c| c.colour_8bit = true),
+            row("covariance_f16", |c| c.covariance_f16 = true),
+            row("blending_8bit", |c| c.blending_8bit = true),
+            row("colour_clamped_per_splat", |c| c.colour_clamp = true),
         ]
     }
 
