@@ -101,32 +101,11 @@ impl App {
             Err(e) => return self.load_failed(el, format!("{name}: sorter thread: {e}")),
         };
         orders.set_crop(self.crop);
-        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
-            return;
+        let paged = match self.upload_loaded(&l) {
+            Ok(Some(p)) => p,
+            Ok(None) => return,
+            Err(e) => return self.load_failed(el, format!("{name}: {e}")),
         };
-        let mut paged = None;
-        if l.tiles.is_empty() {
-            if let Err(e) = renderer.upload(&win.gl, &l.cloud) {
-                return self.load_failed(el, format!("{name}: {e}"));
-            }
-            self.live.tiles = None;
-        } else {
-            let budget = self.opts.tiles.select.splat_budget;
-            match paging::place(renderer, &win.gl, &mut paged, &l.tiles, budget) {
-                Ok(p) => {
-                    println!("{}", p.summary());
-                    self.live.tiles = Some(TileCounts {
-                        selected: l.tiles.len(),
-                        splats: l.cloud.len() as u64,
-                        budget,
-                        pages_used: p.used,
-                        pages: p.pages,
-                        ..Default::default()
-                    });
-                }
-                Err(e) => return self.load_failed(el, format!("{name}: {e}")),
-            }
-        }
         for w in &l.warnings {
             eprintln!("warning: {w}");
         }
@@ -182,6 +161,35 @@ impl App {
         }
         self.update_title(true);
         self.request_redraw();
+    }
+
+    /// Uploads what was loaded: the cloud, or a tileset's first selection into GPU pages
+    /// (its counts shown). `Ok(None)` without a window or renderer; `Ok(Some(pages))` else
+    /// (`None` pages for a plain cloud).
+    fn upload_loaded(&mut self, l: &Loaded) -> Result<Option<Option<paging::Paged>>, String> {
+        let (Some(win), Some(renderer)) = (&self.win, &mut self.renderer) else {
+            return Ok(None);
+        };
+        let mut paged = None;
+        if l.tiles.is_empty() {
+            renderer
+                .upload(&win.gl, &l.cloud)
+                .map_err(|e| e.to_string())?;
+            self.live.tiles = None;
+            return Ok(Some(paged));
+        }
+        let budget = self.opts.tiles.select.splat_budget;
+        let p = paging::place(renderer, &win.gl, &mut paged, &l.tiles, budget)?;
+        println!("{}", p.summary());
+        self.live.tiles = Some(TileCounts {
+            selected: l.tiles.len(),
+            splats: l.cloud.len() as u64,
+            budget,
+            pages_used: p.used,
+            pages: p.pages,
+            ..Default::default()
+        });
+        Ok(Some(paged))
     }
 
     /// A tileset's new selection: its new tiles written into GPU pages (the others stay where
