@@ -76,6 +76,62 @@ impl Cloud {
 }
 
 /// A [`SplatCloud`] from array views, checked (see [`Cloud::to_splat_cloud`]).
+/// The default metadata with `color_space` (`None`: the default one); `Err` for a name that
+/// is not one of the two.
+fn meta_with(color_space: Option<&str>) -> PyResult<SplatMeta> {
+    let mut meta = SplatMeta::default();
+    if let Some(cs) = color_space {
+        meta.color_space = match ColorSpace::parse(cs) {
+            Known::Known(c) => Known::Known(c),
+            Known::Unknown(_) => {
+                return Err(PyValueError::new_err(format!(
+                    "color_space {cs:?}: expected \"srgb_rec709_display\" or \"lin_rec709_display\""
+                )));
+            }
+        };
+    }
+    Ok(meta)
+}
+
+/// `Err` naming row `i` of `name` when a value of `v` is not finite.
+fn finite(i: usize, name: &str, v: &[f32]) -> PyResult<()> {
+    match v.iter().all(|x| x.is_finite()) {
+        true => Ok(()),
+        false => Err(PyValueError::new_err(format!(
+            "{name}[{i}]: {v:?} is not finite"
+        ))),
+    }
+}
+
+/// Checks row `i` as a loaded file's splat is checked; returns the quaternion's norm.
+fn check_row(i: usize, pos: [f32; 3], scale: [f32; 3], q: [f32; 4], a: f32) -> PyResult<f32> {
+    finite(i, "positions", &pos)?;
+    finite(i, "scales", &scale)?;
+    finite(i, "rotations", &q)?;
+    if scale.iter().any(|x| *x < 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "scales[{i}]: {scale:?}: scales are linear standard deviations, ≥ 0 (log scales: pass numpy.exp of them)"
+        )));
+    }
+    if scale.iter().any(|x| !(x * x).is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "scales[{i}]: {scale:?}: a scale whose square overflows f32 (the covariance)"
+        )));
+    }
+    let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
+    if norm == 0.0 || !norm.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "rotations[{i}]: the zero quaternion has no rotation"
+        )));
+    }
+    if !(0.0..=1.0).contains(&a) {
+        return Err(PyValueError::new_err(format!(
+            "opacities[{i}]: {a} is outside [0, 1] (logits: pass 1 / (1 + numpy.exp(-x)))"
+        )));
+    }
+    Ok(norm)
+}
+
 fn build(
     (p, s, r): (
         numpy::ndarray::ArrayView2<'_, f32>,
@@ -120,42 +176,11 @@ fn build(
         let pos = [p[[i, 0]], p[[i, 1]], p[[i, 2]]];
         let scale = [s[[i, 0]], s[[i, 1]], s[[i, 2]]];
         let q = [r[[i, 0]], r[[i, 1]], r[[i, 2]], r[[i, 3]]];
-        let finite = |name: &str, v: &[f32]| -> PyResult<()> {
-            match v.iter().all(|x| x.is_finite()) {
-                true => Ok(()),
-                false => Err(PyValueError::new_err(format!(
-                    "{name}[{i}]: {v:?} is not finite"
-                ))),
-            }
-        };
-        finite("positions", &pos)?;
-        finite("scales", &scale)?;
-        finite("rotations", &q)?;
-        if scale.iter().any(|x| *x < 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "scales[{i}]: {scale:?}: scales are linear standard deviations, ≥ 0 (log scales: pass numpy.exp of them)"
-            )));
-        }
-        if scale.iter().any(|x| !(x * x).is_finite()) {
-            return Err(PyValueError::new_err(format!(
-                "scales[{i}]: {scale:?}: a scale whose square overflows f32 (the covariance)"
-            )));
-        }
-        let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
-        if norm == 0.0 || !norm.is_finite() {
-            return Err(PyValueError::new_err(format!(
-                "rotations[{i}]: the zero quaternion has no rotation"
-            )));
-        }
         let a = o[i];
-        if !(0.0..=1.0).contains(&a) {
-            return Err(PyValueError::new_err(format!(
-                "opacities[{i}]: {a} is outside [0, 1] (logits: pass 1 / (1 + numpy.exp(-x)))"
-            )));
-        }
+        let norm = check_row(i, pos, scale, q, a)?;
         for (j, cf) in coeffs.iter_mut().enumerate() {
             *cf = [sh[[i, j, 0]], sh[[i, j, 1]], sh[[i, j, 2]]];
-            finite("sh", cf)?;
+            finite(i, "sh", cf)?;
         }
         // Unit already (as loaded) within f32 rounding: kept bit for bit.
         let q = if (norm - 1.0).abs() > 4.0 * f32::EPSILON {
@@ -234,17 +259,7 @@ impl Cloud {
             sh.map(|a| a.extract()).transpose()?;
         let colors: Option<PyArrayLike2<'_, f32, AllowTypeChange>> =
             colors.map(|a| a.extract()).transpose()?;
-        let mut meta = SplatMeta::default();
-        if let Some(cs) = color_space {
-            meta.color_space = match ColorSpace::parse(cs) {
-                Known::Known(c) => Known::Known(c),
-                Known::Unknown(_) => {
-                    return Err(PyValueError::new_err(format!(
-                        "color_space {cs:?}: expected \"srgb_rec709_display\" or \"lin_rec709_display\""
-                    )));
-                }
-            };
-        }
+        let meta = meta_with(color_space)?;
         let n = positions.as_array().nrows();
         let from_colors;
         let sh_view = match (&sh, &colors) {
