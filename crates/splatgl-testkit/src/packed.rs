@@ -95,16 +95,8 @@ fn sog_version(c: &SplatCloud, v1: bool) -> Vec<(String, Vec<u8>)> {
             maxs[a] = maxs[a].max(log_t(p[a]));
         }
     }
-    let range = |f: &dyn Fn(usize) -> Vec<f32>| {
-        let all: Vec<f32> = (0..n).flat_map(f).collect();
-        let lo = all.iter().copied().fold(f32::MAX, f32::min);
-        (
-            lo,
-            all.iter().copied().fold(f32::MIN, f32::max).max(lo + 1e-6),
-        )
-    };
-    let (slo, shi) = range(&|i| c.scales[i].map(f32::ln).to_vec());
-    let (clo, chi) = range(&|i| c.sh_of(i)[0].to_vec());
+    let (slo, shi) = value_range(n, &|i| c.scales[i].map(f32::ln).to_vec());
+    let (clo, chi) = value_range(n, &|i| c.sh_of(i)[0].to_vec());
     let (sbook, cbook) = (book(slo, shi), book(clo, chi));
     for i in 0..n {
         let o = 4 * i;
@@ -117,17 +109,7 @@ fn sog_version(c: &SplatCloud, v1: bool) -> Vec<(String, Vec<u8>)> {
             tex[3][o + a] = nearest(&sbook, c.scales[i][a].ln());
             tex[4][o + a] = nearest(&cbook, c.sh_of(i)[0][a]);
         }
-        let [x, y, z, qw] = c.rotations[i];
-        let q = [qw, x, y, z];
-        let big = (0..4)
-            .max_by(|&a, &b| q[a].abs().total_cmp(&q[b].abs()))
-            .unwrap();
-        let s = if q[big] < 0.0 { -1.0 } else { 1.0 };
-        let others = q.iter().enumerate().filter(|(j, _)| *j != big);
-        for (k, (_, v)) in others.enumerate() {
-            tex[2][o + k] = ((v * s * std::f32::consts::SQRT_2 * 0.5 + 0.5) * 255.0).round() as u8;
-        }
-        tex[2][o + 3] = 252 + big as u8;
+        tex[2][o..o + 4].copy_from_slice(&quat_bytes(c.rotations[i]));
         tex[0][o + 3] = 255;
         tex[1][o + 3] = 255;
         tex[3][o + 3] = 255;
@@ -160,34 +142,7 @@ fn sog_version(c: &SplatCloud, v1: bool) -> Vec<(String, Vec<u8>)> {
         "sh0": {"codebook": cbook, "files": ["sh0.webp"]},
     });
     if c.sh_degree > 0 {
-        let k = c.coeffs_per_splat() - 1;
-        let (lo, hi) = range(&|i| c.sh_of(i)[1..].iter().flatten().copied().collect());
-        let shbook = book(lo, hi);
-        let rows = n.div_ceil(64).max(1);
-        let mut cent = vec![255u8; 4 * 64 * k * rows];
-        let mut labels = vec![255u8; 4 * texels];
-        for i in 0..n {
-            for j in 0..k {
-                let t = 4 * ((i / 64) * 64 * k + (i % 64) * k + j);
-                for ch in 0..3 {
-                    cent[t + ch] = nearest(&shbook, c.sh_of(i)[1 + j][ch]);
-                }
-            }
-            labels[4 * i] = i as u8;
-            labels[4 * i + 1] = (i >> 8) as u8;
-            labels[4 * i + 2] = 0;
-        }
-        files.push((
-            "shN_centroids.webp".into(),
-            webp(&cent, 64 * k as u32, rows as u32),
-        ));
-        files.push(("shN_labels.webp".into(), webp(&labels, w, h)));
-        meta["shN"] = serde_json::json!({"count": n, "bands": c.sh_degree, "codebook": shbook,
-            "files": ["shN_centroids.webp", "shN_labels.webp"]});
-        if v1 {
-            meta["shN"] = serde_json::json!({"mins": lo, "maxs": hi,
-                "files": ["shN_centroids.webp", "shN_labels.webp"]});
-        }
+        meta["shN"] = sh_rest(c, (w, h), v1, &mut files);
     }
     if v1 {
         let m = meta.as_object_mut().unwrap();
@@ -200,6 +155,73 @@ fn sog_version(c: &SplatCloud, v1: bool) -> Vec<(String, Vec<u8>)> {
     }
     files.push(("meta.json".into(), meta.to_string().into_bytes()));
     files
+}
+
+/// The smallest and largest of the values `f(i)` gives for `i < n` (the largest at least
+/// 10⁻⁶ above the smallest).
+fn value_range(n: usize, f: &dyn Fn(usize) -> Vec<f32>) -> (f32, f32) {
+    let all: Vec<f32> = (0..n).flat_map(f).collect();
+    let lo = all.iter().copied().fold(f32::MAX, f32::min);
+    (
+        lo,
+        all.iter().copied().fold(f32::MIN, f32::max).max(lo + 1e-6),
+    )
+}
+
+/// A SOG quats texel: the three smallest of (w, x, y, z), signed by the largest, and the
+/// largest's index in alpha (252 + index).
+fn quat_bytes([x, y, z, qw]: [f32; 4]) -> [u8; 4] {
+    let q = [qw, x, y, z];
+    let big = (0..4)
+        .max_by(|&a, &b| q[a].abs().total_cmp(&q[b].abs()))
+        .unwrap();
+    let s = if q[big] < 0.0 { -1.0 } else { 1.0 };
+    let mut out = [0u8; 4];
+    let others = q.iter().enumerate().filter(|(j, _)| *j != big);
+    for (k, (_, v)) in others.enumerate() {
+        out[k] = ((v * s * std::f32::consts::SQRT_2 * 0.5 + 0.5) * 255.0).round() as u8;
+    }
+    out[3] = 252 + big as u8;
+    out
+}
+
+/// The higher SH bands as a palette of one entry per splat (centroids and labels textures,
+/// added to `files`); returns `meta.shN` (v1's form with `v1`).
+fn sh_rest(
+    c: &SplatCloud,
+    (w, h): (u32, u32),
+    v1: bool,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> serde_json::Value {
+    let n = c.len();
+    let k = c.coeffs_per_splat() - 1;
+    let (lo, hi) = value_range(n, &|i| c.sh_of(i)[1..].iter().flatten().copied().collect());
+    let shbook = book(lo, hi);
+    let rows = n.div_ceil(64).max(1);
+    let mut cent = vec![255u8; 4 * 64 * k * rows];
+    let mut labels = vec![255u8; 4 * (w * h) as usize];
+    for i in 0..n {
+        for j in 0..k {
+            let t = 4 * ((i / 64) * 64 * k + (i % 64) * k + j);
+            for ch in 0..3 {
+                cent[t + ch] = nearest(&shbook, c.sh_of(i)[1 + j][ch]);
+            }
+        }
+        labels[4 * i] = i as u8;
+        labels[4 * i + 1] = (i >> 8) as u8;
+        labels[4 * i + 2] = 0;
+    }
+    files.push((
+        "shN_centroids.webp".into(),
+        webp(&cent, 64 * k as u32, rows as u32),
+    ));
+    files.push(("shN_labels.webp".into(), webp(&labels, w, h)));
+    if v1 {
+        return serde_json::json!({"mins": lo, "maxs": hi,
+            "files": ["shN_centroids.webp", "shN_labels.webp"]});
+    }
+    serde_json::json!({"count": n, "bands": c.sh_degree, "codebook": shbook,
+        "files": ["shN_centroids.webp", "shN_labels.webp"]})
 }
 
 /// A bundled `.sog` of `c`.
