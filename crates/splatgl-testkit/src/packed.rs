@@ -244,7 +244,6 @@ fn f16(v: f32) -> [u8; 2] {
 pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> {
     let n = c.len();
     let degree = c.sh_degree.min(2);
-    let sh_vals = ((degree as usize + 1).pow(2) - 1) * 3;
     let (full, partial) = (n / bucket, usize::from(!n.is_multiple_of(bucket)));
     let buckets = if level == 0 { 0 } else { full + partial };
     let mut out = vec![0u8; 4096 + 1024];
@@ -281,51 +280,64 @@ pub fn ksplat(c: &SplatCloud, level: u16, bucket: usize, block: f32) -> Vec<u8> 
         }
     }
     for i in 0..n {
-        let [x, y, z, w] = c.rotations[i];
-        if level == 0 {
-            for v in c.positions[i]
-                .iter()
-                .chain(&c.scales[i])
-                .chain(&[w, x, y, z])
-            {
-                out.extend_from_slice(&v.to_le_bytes());
-            }
-        } else {
-            let centre = c.positions[(i / bucket) * bucket];
-            let f = 32767.0 / (0.5 * block);
-            for (p, c) in c.positions[i].iter().zip(centre) {
-                let v = ((p - c) * f).round() + 32767.0;
-                out.extend_from_slice(&(v.clamp(0.0, 65535.0) as u16).to_le_bytes());
-            }
-            for v in c.scales[i].iter().chain(&[w, x, y, z]) {
-                out.extend_from_slice(&f16(*v));
-            }
+        ksplat_row(&mut out, c, i, (level, bucket, block), degree);
+    }
+    out
+}
+
+/// Splat `i` of a `.ksplat` section at compression `level` (buckets of `bucket` splats,
+/// block size `block`), SH up to `degree`, appended to `out`.
+fn ksplat_row(
+    out: &mut Vec<u8>,
+    c: &SplatCloud,
+    i: usize,
+    (level, bucket, block): (u16, usize, f32),
+    degree: u8,
+) {
+    let sh_vals = ((degree as usize + 1).pow(2) - 1) * 3;
+    let [x, y, z, w] = c.rotations[i];
+    if level == 0 {
+        for v in c.positions[i]
+            .iter()
+            .chain(&c.scales[i])
+            .chain(&[w, x, y, z])
+        {
+            out.extend_from_slice(&v.to_le_bytes());
         }
+    } else {
+        let centre = c.positions[(i / bucket) * bucket];
+        let f = 32767.0 / (0.5 * block);
+        for (p, c) in c.positions[i].iter().zip(centre) {
+            let v = ((p - c) * f).round() + 32767.0;
+            out.extend_from_slice(&(v.clamp(0.0, 65535.0) as u16).to_le_bytes());
+        }
+        for v in c.scales[i].iter().chain(&[w, x, y, z]) {
+            out.extend_from_slice(&f16(*v));
+        }
+    }
+    for ch in 0..3 {
+        out.push(
+            (splatgl::sh::color_from_dc(c.sh_of(i)[0][ch]) as f32 * 255.0)
+                .clamp(0.0, 255.0)
+                .floor() as u8,
+        );
+    }
+    out.push((c.opacities[i] * 255.0).floor() as u8);
+    let mut vals = Vec::with_capacity(sh_vals);
+    for l in 1..=degree as usize {
         for ch in 0..3 {
-            out.push(
-                (splatgl::sh::color_from_dc(c.sh_of(i)[0][ch]) as f32 * 255.0)
-                    .clamp(0.0, 255.0)
-                    .floor() as u8,
-            );
-        }
-        out.push((c.opacities[i] * 255.0).floor() as u8);
-        let mut vals = Vec::with_capacity(sh_vals);
-        for l in 1..=degree as usize {
-            for ch in 0..3 {
-                for j in 0..2 * l + 1 {
-                    vals.push(c.sh_of(i)[l * l + j][ch]);
-                }
-            }
-        }
-        for v in vals {
-            match level {
-                0 => out.extend_from_slice(&v.to_le_bytes()),
-                1 => out.extend_from_slice(&f16(v)),
-                _ => out.push((((v + 2.0) / 4.0 * 255.0).floor()).clamp(0.0, 255.0) as u8),
+            for j in 0..2 * l + 1 {
+                vals.push(c.sh_of(i)[l * l + j][ch]);
             }
         }
     }
-    out
+    for v in vals {
+        match level {
+            0 => out.extend_from_slice(&v.to_le_bytes()),
+            1 => out.extend_from_slice(&f16(v)),
+            _ => out.push((((v + 2.0) / 4.0 * 255.0).floor()).clamp(0.0, 255.0) as u8),
+        }
+    }
 }
 
 /// An SPZ file read from memory with its numbers taken to be in `axes`.
