@@ -9,7 +9,7 @@
 # (an allocation over 1 GiB is a failure), debug assertions and overflow checks on, no sanitizer
 # (the loaders are safe Rust; a sanitizer only slows the search on a 2-core machine).
 # Seeds are regenerated every run into fuzz/seeds/TARGET from the test writers and the small
-# real files (examples/fuzz_seeds.rs); what the fuzzer finds grows fuzz/corpus/TARGET. Neither
+# real files (crates/splatgl-testkit/src/bin/fuzz_seeds.rs); what the fuzzer finds grows fuzz/corpus/TARGET. Neither
 # is committed. A crash, contract violation, hang or blow-up leaves its input in
 # fuzz/artifacts/TARGET/ and makes this script fail; turn it into a test in tests/.
 # Uses the nightly toolchain when installed, else stable with RUSTC_BOOTSTRAP=1; installs
@@ -38,7 +38,7 @@ else
   fuzz=(cargo fuzz)
 fi
 rm -rf fuzz/seeds
-cargo run --quiet --example fuzz_seeds -- fuzz/seeds "$root/../shared/data/real"
+cargo run --quiet -p splatgl-testkit --bin fuzz_seeds -- fuzz/seeds "$root/../shared/data/real"
 "${fuzz[@]}" build "${build[@]}"
 for t in "${targets[@]}"; do
   mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"

@@ -169,7 +169,7 @@ impl Workspace {
                 _ => {}
             }
         }
-        for sub in ["benches", "tests", "examples"] {
+        for sub in ["benches", "tests", "examples", "src/bin"] {
             let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
                 continue;
             };

@@ -447,7 +447,7 @@ impl Renderer {
 
 /// Milliseconds per sort of `n` random splats by camera distance (the renderer's radix sort,
 /// on this thread: wasm has no rayon threads), averaged over `reps` sorts after one warm-up.
-/// `examples/sort_time.rs` measures the same natively.
+/// `crates/splatgl-testkit/src/bin/sort_time.rs` measures the same natively.
 #[wasm_bindgen]
 pub fn sort_ms(n: usize, reps: u32) -> f64 {
     let cloud = splatgl::synthetic::random_cloud(n, 0, 5.0, 7);

@@ -1,4 +1,4 @@
-//! Prints every splat of a file (debug aid): `cargo run --example dump -- FILE`.
+//! Prints every splat of a file (debug aid): `cargo run -p splatgl-testkit --bin dump -- FILE`.
 fn main() {
     let Some(path) = std::env::args().nth(1) else {
         eprintln!("usage: dump FILE");

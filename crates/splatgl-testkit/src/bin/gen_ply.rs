@@ -1,5 +1,5 @@
 //! Writes a random cloud of N splats with SH degree 3 (benchmark input) as INRIA PLY (or GLB /
-//! glTF by the extension): `cargo run --release --example gen_ply -- OUT.ply [N] [--normals]`.
+//! glTF by the extension): `cargo run --release -p splatgl-testkit --bin gen_ply -- OUT.ply [N] [--normals]`.
 //! With `--normals` (PLY only) the rows carry `nx ny nz` (zero) after `x y z`, as the INRIA
 //! trainer writes them: 248 bytes a splat (a 248 MB file for 1M splats) instead of 236.
 fn main() {

@@ -1,5 +1,5 @@
 //! Writes the fuzz targets' seed corpora (`scripts/fuzz.sh` runs it; nothing is committed):
-//! `cargo run --example fuzz_seeds -- fuzz/corpus [shared/data/real]`.
+//! `cargo run -p splatgl-testkit --bin fuzz_seeds -- fuzz/corpus [shared/data/real]`.
 //!
 //! Small synthetic files covering what the tests cover — every PLY variant (binary little and
 //! big endian, ASCII, colours instead of SH, lists before `vertex`, PlayCanvas compressed with

@@ -1,5 +1,5 @@
 //! Parses a PLY file N times and prints the throughput (profiling aid):
-//! `cargo run --release --example ply_parse -- FILE [N]`.
+//! `cargo run --release -p splatgl-testkit --bin ply_parse -- FILE [N]`.
 fn main() {
     let mut args = std::env::args().skip(1);
     let Some(path) = args.next() else {
