@@ -404,32 +404,10 @@ fn main() {
             "10,100,1000,10000,100000".to_owned(),
         )
     };
-    // A desktop context where it counts fragment-shader invocations; else ES.
-    let desktop = HeadlessContext::with_api(GlApi::DesktopCore33).ok();
-    let stats = desktop.as_ref().is_some_and(|c| {
-        c.gl()
-            .supported_extensions()
-            .contains("GL_ARB_pipeline_statistics_query")
-    });
-    let (ctx, counter) = match desktop {
-        Some(c) if stats => (c, Counter::Invocations),
-        Some(c) => (c, Counter::SamplesPassed),
-        None => match or_skip(HeadlessContext::new(), "headless context") {
-            Some(c) => (c, Counter::None),
-            None => return,
-        },
+    let Some((ctx, counter)) = counting_context() else {
+        return;
     };
     let gl = ctx.gl();
-    println!("context: {}", ctx.describe());
-    println!(
-        "fragments counted by: {}",
-        match counter {
-            Counter::Invocations =>
-                "GL_FRAGMENT_SHADER_INVOCATIONS (ARB_pipeline_statistics_query)",
-            Counter::SamplesPassed => "GL_SAMPLES_PASSED (no pipeline statistics here)",
-            Counter::None => "nothing (ES context)",
-        }
-    );
     println!("framebuffer {w}×{h} RGBA8, {frames} frames (median) after a warm-up\n");
     let mut frame = ReadbackTarget::new(gl, w, h, ColorFormat::Rgba8, None).unwrap();
     frame.bind(gl).unwrap();
@@ -446,19 +424,7 @@ fn main() {
         frames,
         size: (w, h),
     };
-    println!(
-        "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8} | {:>9} | {:>11} | {:>9} | {:>7} | pre-pass | GPU ms: pre-pass / copy / quads",
-        "scene",
-        "view",
-        "path",
-        "drawn",
-        "fragments",
-        "sort ms",
-        "draw ms",
-        "draw CPU ms",
-        "frame ms",
-        "frame/s",
-    );
+    print_header();
     let mut summary = Vec::new();
     for name in scenes.split(',').map(str::trim) {
         let Some((cloud, cam, target)) = scene(name, w, h, scale) else {
@@ -476,21 +442,7 @@ fn main() {
                     continue;
                 }
                 let r = b.run(&cloud, &bounds, &c, target, path);
-                println!(
-                    "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8.2} | {:>9.1} | {:>11.1} | {:>9.1} | {:>7.2} | {:>8} | {}",
-                    name,
-                    view,
-                    path.name(),
-                    r.drawn,
-                    r.fragments.map_or("-".into(), |f| f.to_string()),
-                    r.sort,
-                    r.draw,
-                    r.draw_cpu,
-                    r.frame(),
-                    1e3 / r.frame(),
-                    if r.prepass { "yes" } else { "no" },
-                    stage_cells(r.stages)
-                );
+                print_row(name, view, path, &r);
                 rows.push(r);
             }
             summary.push((name.to_owned(), view, cloud.len(), rows));
@@ -504,6 +456,72 @@ fn main() {
     b.renderer.destroy(gl);
     b.former.destroy(gl);
     frame.destroy(gl);
+}
+
+/// A desktop context where it counts fragment-shader invocations (else samples passed); else
+/// ES, counting nothing. `None` (a skip, said) without headless GL. Prints what it got.
+fn counting_context() -> Option<(HeadlessContext, Counter)> {
+    let desktop = HeadlessContext::with_api(GlApi::DesktopCore33).ok();
+    let stats = desktop.as_ref().is_some_and(|c| {
+        c.gl()
+            .supported_extensions()
+            .contains("GL_ARB_pipeline_statistics_query")
+    });
+    let (ctx, counter) = match desktop {
+        Some(c) if stats => (c, Counter::Invocations),
+        Some(c) => (c, Counter::SamplesPassed),
+        None => (
+            or_skip(HeadlessContext::new(), "headless context")?,
+            Counter::None,
+        ),
+    };
+    println!("context: {}", ctx.describe());
+    println!(
+        "fragments counted by: {}",
+        match counter {
+            Counter::Invocations =>
+                "GL_FRAGMENT_SHADER_INVOCATIONS (ARB_pipeline_statistics_query)",
+            Counter::SamplesPassed => "GL_SAMPLES_PASSED (no pipeline statistics here)",
+            Counter::None => "nothing (ES context)",
+        }
+    );
+    Some((ctx, counter))
+}
+
+/// The table's header.
+fn print_header() {
+    println!(
+        "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8} | {:>9} | {:>11} | {:>9} | {:>7} | pre-pass | GPU ms: pre-pass / copy / quads",
+        "scene",
+        "view",
+        "path",
+        "drawn",
+        "fragments",
+        "sort ms",
+        "draw ms",
+        "draw CPU ms",
+        "frame ms",
+        "frame/s",
+    );
+}
+
+/// One row of the table.
+fn print_row(name: &str, view: &str, path: PathKind, r: &Row) {
+    println!(
+        "{:>7} | {:>4} | {:>6} | {:>9} | {:>13} | {:>8.2} | {:>9.1} | {:>11.1} | {:>9.1} | {:>7.2} | {:>8} | {}",
+        name,
+        view,
+        path.name(),
+        r.drawn,
+        r.fragments.map_or("-".into(), |f| f.to_string()),
+        r.sort,
+        r.draw,
+        r.draw_cpu,
+        r.frame(),
+        1e3 / r.frame(),
+        if r.prepass { "yes" } else { "no" },
+        stage_cells(r.stages)
+    );
 }
 
 /// Speed-ups of the new path over the former one, split into its steps.
