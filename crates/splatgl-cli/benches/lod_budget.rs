@@ -57,21 +57,9 @@ fn layout(n: u64) -> (f32, Vec<Building>) {
     (side, b)
 }
 
-/// Writes the city of `n` splats: a third on the ground, the rest on the buildings' walls and
-/// roofs in proportion to their areas; flat splats about as large as their spacing.
-fn write_city(path: &Path, n: u64) -> f32 {
-    let (side, buildings) = layout(n);
-    let f = std::fs::File::create(path).unwrap();
-    let mut w = std::io::BufWriter::with_capacity(1 << 22, f);
-    let mut h = format!("ply\nformat binary_little_endian 1.0\nelement vertex {n}\n");
-    for p in [
-        "x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
-        "rot_0", "rot_1", "rot_2", "rot_3",
-    ] {
-        h += &format!("property float {p}\n");
-    }
-    w.write_all(format!("{h}end_header\n").as_bytes()).unwrap();
-    // Each building's surfaces: 4 walls and the roof, with their areas.
+/// Each building's surfaces (building, face: 4 walls then the roof, area), and their
+/// cumulative share of the total area (to pick one in proportion to its area).
+fn surfaces(buildings: &[Building]) -> (Vec<(usize, usize, f32)>, Vec<f32>) {
     let faces: Vec<(usize, usize, f32)> = buildings
         .iter()
         .enumerate()
@@ -97,6 +85,24 @@ fn write_city(path: &Path, n: u64) -> f32 {
         acc += f.2 / total;
         cumulative.push(acc);
     }
+    (faces, cumulative)
+}
+
+/// Writes the city of `n` splats: a third on the ground, the rest on the buildings' walls and
+/// roofs in proportion to their areas; flat splats about as large as their spacing.
+fn write_city(path: &Path, n: u64) -> f32 {
+    let (side, buildings) = layout(n);
+    let f = std::fs::File::create(path).unwrap();
+    let mut w = std::io::BufWriter::with_capacity(1 << 22, f);
+    let mut h = format!("ply\nformat binary_little_endian 1.0\nelement vertex {n}\n");
+    for p in [
+        "x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+        "rot_0", "rot_1", "rot_2", "rot_3",
+    ] {
+        h += &format!("property float {p}\n");
+    }
+    w.write_all(format!("{h}end_header\n").as_bytes()).unwrap();
+    let (faces, cumulative) = surfaces(&buildings);
     let spacing = (1.0 / DENSITY).sqrt() * 2.0;
     let mut rng = Rng::new(42);
     let dc = |rgb: [f32; 3]| rgb.map(|c| (c - 0.5) / 0.282_094_8);
@@ -224,6 +230,62 @@ struct Row {
     at_16px: (u64, f64, u64),
 }
 
+/// The splats a `render -v` of a tileset selected (its `tiles:` line; 0 if none).
+fn selected_splats(log: &str) -> u64 {
+    log.lines()
+        .find(|l| l.starts_with("tiles:"))
+        .and_then(|l| {
+            l.split(" selected, ")
+                .nth(1)?
+                .split_whitespace()
+                .next()?
+                .parse()
+                .ok()
+        })
+        .unwrap_or(0)
+}
+
+/// `splatgl compare`'s PSNR of two images (infinite when identical).
+fn psnr_between(a: &Path, b: &Path) -> f64 {
+    let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
+        .args([
+            "compare",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    json["psnr"].as_f64().unwrap_or(f64::INFINITY)
+}
+
+/// The options of every render: 1280 × 720, GL, overwrite, verbose.
+const COMMON: [&str; 8] = [
+    "--width",
+    "1280",
+    "--height",
+    "720",
+    "--backend",
+    "gl",
+    "-f",
+    "-v",
+];
+
+/// The three cameras over a city of side `side`: (name, eye, target).
+fn cameras(side: f64) -> [(&'static str, [f64; 3], [f64; 3]); 3] {
+    let c = [side / 2.0, side / 2.0, 0.0];
+    [
+        ("far", [-0.4 * side, -0.4 * side, 0.9 * side], c),
+        ("middle", [0.15 * side, 0.2 * side, 0.25 * side], c),
+        (
+            "near",
+            [0.42 * side, 0.3 * side, 0.03 * side],
+            [c[0], c[1], 0.03 * side],
+        ),
+    ]
+}
+
 /// One city: a row per camera.
 fn measure(dir: &Path, n: u64, budget: u64) -> Vec<Row> {
     let ply = dir.join(format!("city-{n}.ply"));
@@ -242,40 +304,15 @@ fn measure(dir: &Path, n: u64, budget: u64) -> Vec<Row> {
     }
     let (_, log) = splatgl(&args);
     let m = printed_transform(&log);
-    let c = [side / 2.0, side / 2.0, 0.0];
-    let cams: [(&str, [f64; 3], [f64; 3]); 3] = [
-        ("far", [-0.4 * side, -0.4 * side, 0.9 * side], c),
-        ("middle", [0.15 * side, 0.2 * side, 0.25 * side], c),
-        (
-            "near",
-            [0.42 * side, 0.3 * side, 0.03 * side],
-            [c[0], c[1], 0.03 * side],
-        ),
-    ];
     let mut rows = Vec::new();
-    for (name, eye, target) in cams {
+    for (name, eye, target) in cameras(side) {
         let up = [0.0, 0.0, 1.0];
         let whole = dir.join(format!("{n}-{name}-whole.png"));
         let part = dir.join(format!("{n}-{name}-budget.png"));
-        let common = [
-            "--width",
-            "1280",
-            "--height",
-            "720",
-            "--backend",
-            "gl",
-            "-f",
-            "-v",
-        ];
+        let common = COMMON;
         let look = look_text(eye, target, up);
-        let mut args = vec![
-            ply.to_str().unwrap(),
-            "--look-at",
-            &look,
-            "-o",
-            whole.to_str().unwrap(),
-        ];
-        args.splice(0..0, ["render"]);
+        let mut args = vec!["render", ply.to_str().unwrap(), "--look-at", &look];
+        args.extend(["-o", whole.to_str().unwrap()]);
         args.extend(common);
         splatgl(&args);
         let tlook = look_text(
@@ -302,29 +339,8 @@ fn measure(dir: &Path, n: u64, budget: u64) -> Vec<Row> {
             }
             args.extend(common);
             let (peak, log) = splatgl(&args);
-            let selected: u64 = log
-                .lines()
-                .find(|l| l.starts_with("tiles:"))
-                .and_then(|l| {
-                    l.split(" selected, ")
-                        .nth(1)?
-                        .split_whitespace()
-                        .next()?
-                        .parse()
-                        .ok()
-                })
-                .unwrap_or(0);
-            let out = Command::new(env!("CARGO_BIN_EXE_splatgl"))
-                .args([
-                    "compare",
-                    whole.to_str().unwrap(),
-                    part.to_str().unwrap(),
-                    "--json",
-                ])
-                .output()
-                .unwrap();
-            let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-            let psnr = json["psnr"].as_f64().unwrap_or(f64::INFINITY);
+            let selected = selected_splats(&log);
+            let psnr = psnr_between(&whole, &part);
             assert!(
                 selected <= budget,
                 "{name}: {selected} over the budget {budget}"
