@@ -79,6 +79,56 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
+/// What is timed: `splatgl info` with and without the memory map, `cat` of the file, and
+/// plyfile + NumPy where Python has them.
+fn variants<'a>(exe: &'a str, file: &'a Path) -> Vec<(&'static str, MakeCommand<'a>)> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/plyfile_load.py");
+    let have_plyfile = Command::new("python3")
+        .args(["-c", "import plyfile, numpy"])
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut variants: Vec<(&str, MakeCommand<'a>)> = vec![
+        (
+            "mmap",
+            Box::new(move || {
+                let mut c = Command::new(exe);
+                c.arg("info").arg(file).env_remove("SPLATGL_NO_MMAP");
+                c
+            }),
+        ),
+        (
+            "read",
+            Box::new(move || {
+                let mut c = Command::new(exe);
+                c.arg("info").arg(file).env("SPLATGL_NO_MMAP", "1");
+                c
+            }),
+        ),
+        (
+            "cat",
+            Box::new(move || {
+                let mut c = Command::new("cat");
+                c.arg(file);
+                c
+            }),
+        ),
+    ];
+    if have_plyfile {
+        variants.push((
+            "plyfile+numpy",
+            Box::new(move || {
+                let mut c = Command::new("python3");
+                c.arg(&script).arg(file);
+                c
+            }),
+        ));
+    } else {
+        println!("plyfile+numpy: skipped (python3 -c \"import plyfile, numpy\" fails)");
+    }
+    variants
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.iter().any(|a| a == "--list") {
@@ -104,50 +154,7 @@ fn main() {
         .expect("splatgl info");
     let json: serde_json::Value = serde_json::from_slice(&info.stdout).expect("info --json");
     let cloud_bytes = json["memory_bytes"].as_u64().expect("memory_bytes");
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/plyfile_load.py");
-    let have_plyfile = Command::new("python3")
-        .args(["-c", "import plyfile, numpy"])
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    let mut variants: Vec<(&str, MakeCommand)> = vec![
-        (
-            "mmap",
-            Box::new(|| {
-                let mut c = Command::new(exe);
-                c.arg("info").arg(&file).env_remove("SPLATGL_NO_MMAP");
-                c
-            }),
-        ),
-        (
-            "read",
-            Box::new(|| {
-                let mut c = Command::new(exe);
-                c.arg("info").arg(&file).env("SPLATGL_NO_MMAP", "1");
-                c
-            }),
-        ),
-        (
-            "cat",
-            Box::new(|| {
-                let mut c = Command::new("cat");
-                c.arg(&file);
-                c
-            }),
-        ),
-    ];
-    if have_plyfile {
-        variants.push((
-            "plyfile+numpy",
-            Box::new(|| {
-                let mut c = Command::new("python3");
-                c.arg(&script).arg(&file);
-                c
-            }),
-        ));
-    } else {
-        println!("plyfile+numpy: skipped (python3 -c \"import plyfile, numpy\" fails)");
-    }
+    let variants = variants(exe, &file);
     let mut times = vec![Vec::new(); variants.len()];
     let mut peaks = vec![0u64; variants.len()];
     for _ in 0..ROUNDS {
