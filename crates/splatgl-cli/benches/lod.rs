@@ -171,6 +171,46 @@ fn view_tileset(ts: &Path, look: &str) -> Option<(f64, f64, u64)> {
     ))
 }
 
+/// Per frame along the 24-frame flight, tiles already loaded (a first pass loads them): the
+/// selection's and the assembly's milliseconds, and the splats selected, on average.
+fn flight_costs(ts: &splatgl::tiles::Tileset) -> (f64, f64, u64) {
+    // Per frame along the flight, tiles already loaded (a first pass loads them).
+    let mut cache = TileCache::new(ts, &Default::default());
+    let opts = SelectOptions::default();
+    let frames = 24;
+    let cam = |i: usize| {
+        let (e, t, u) = flight(ts, i as f64 / frames as f64);
+        Camera::look_at(
+            e.as_vec3(),
+            t.as_vec3(),
+            u.as_vec3(),
+            50f32.to_radians(),
+            1280,
+            720,
+        )
+    };
+    for i in 0..frames {
+        let s = splatgl::tiles::select(ts, &cam(i), &opts, &mut |t| cache.splats(t)).unwrap();
+        let _ = cache.merged(&s.tiles);
+    }
+    let (mut select_s, mut assemble_s, mut selected) = (0.0, 0.0, 0);
+    for i in 0..frames {
+        let c = cam(i);
+        let t = Instant::now();
+        let s = splatgl::tiles::select(ts, &c, &opts, &mut |t| cache.splats(t)).unwrap();
+        select_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let cloud = cache.merged(&s.tiles);
+        assemble_s += t.elapsed().as_secs_f64();
+        selected += cloud.len() as u64;
+    }
+    (
+        select_s * 1e3 / frames as f64,
+        assemble_s * 1e3 / frames as f64,
+        selected / frames as u64,
+    )
+}
+
 fn measure(dir: &Path, n: u64, view: bool) -> Row {
     let ply = dir.join(format!("terrain-{n}.ply"));
     let t = Instant::now();
@@ -221,36 +261,7 @@ fn measure(dir: &Path, n: u64, view: bool) -> Row {
             .collect::<Vec<_>>()
             .join(" | ")
     );
-    // Per frame along the flight, tiles already loaded (a first pass loads them).
-    let mut cache = TileCache::new(&ts, &Default::default());
-    let opts = SelectOptions::default();
-    let frames = 24;
-    let cam = |i: usize| {
-        let (e, t, u) = flight(&ts, i as f64 / frames as f64);
-        Camera::look_at(
-            e.as_vec3(),
-            t.as_vec3(),
-            u.as_vec3(),
-            50f32.to_radians(),
-            1280,
-            720,
-        )
-    };
-    for i in 0..frames {
-        let s = splatgl::tiles::select(&ts, &cam(i), &opts, &mut |t| cache.splats(t)).unwrap();
-        let _ = cache.merged(&s.tiles);
-    }
-    let (mut select_s, mut assemble_s, mut selected) = (0.0, 0.0, 0);
-    for i in 0..frames {
-        let c = cam(i);
-        let t = Instant::now();
-        let s = splatgl::tiles::select(&ts, &c, &opts, &mut |t| cache.splats(t)).unwrap();
-        select_s += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let cloud = cache.merged(&s.tiles);
-        assemble_s += t.elapsed().as_secs_f64();
-        selected += cloud.len() as u64;
-    }
+    let (select_ms, assemble_ms, selected) = flight_costs(&ts);
     let viewed = if view {
         view_tileset(&ts_path, &look)
     } else {
@@ -265,9 +276,9 @@ fn measure(dir: &Path, n: u64, view: bool) -> Row {
         build_mb: build_mb.unwrap_or(0),
         first_frame_s,
         render_mb: render_mb.unwrap_or(0),
-        select_ms: select_s * 1e3 / frames as f64,
-        assemble_ms: assemble_s * 1e3 / frames as f64,
-        selected: selected / frames as u64,
+        select_ms,
+        assemble_ms,
+        selected,
         viewed,
     }
 }
