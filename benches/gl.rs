@@ -257,23 +257,28 @@ impl Bench<'_> {
             renderer.set_stage_timing(gl, false).unwrap();
             t
         });
-        let pick = |f: fn(&Row) -> f64| median(&mut rows.iter().map(f).collect::<Vec<_>>());
-        Row {
-            drawn: pick(|r| r.drawn as f64) as usize,
-            fragments: rows[0].fragments.map(|_| {
-                median(
-                    &mut rows
-                        .iter()
-                        .map(|r| r.fragments.unwrap())
-                        .collect::<Vec<_>>(),
-                )
-            }),
-            sort: pick(|r| r.sort),
-            draw: pick(|r| r.draw),
-            draw_cpu: pick(|r| r.draw_cpu),
-            prepass: rows[0].prepass,
-            stages,
-        }
+        medians(&rows, stages)
+    }
+}
+
+/// The frames' medians, one row, with the stage times of the extra frame.
+fn medians(rows: &[Row], stages: Option<splatgl::gl::StageTimes>) -> Row {
+    let pick = |f: fn(&Row) -> f64| median(&mut rows.iter().map(f).collect::<Vec<_>>());
+    Row {
+        drawn: pick(|r| r.drawn as f64) as usize,
+        fragments: rows[0].fragments.map(|_| {
+            median(
+                &mut rows
+                    .iter()
+                    .map(|r| r.fragments.unwrap())
+                    .collect::<Vec<_>>(),
+            )
+        }),
+        sort: pick(|r| r.sort),
+        draw: pick(|r| r.draw),
+        draw_cpu: pick(|r| r.draw_cpu),
+        prepass: rows[0].prepass,
+        stages,
     }
 }
 
@@ -384,11 +389,7 @@ fn main() {
     } else {
         env("SPLATGL_BENCH_FRAMES", 5usize).max(1)
     };
-    let size: String = env("SPLATGL_BENCH_SIZE", "1280x720".to_owned());
-    let (w, h) = size
-        .split_once('x')
-        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
-        .unwrap_or((1280u32, 720u32));
+    let (w, h) = bench_size();
     let scale: f32 = env("SPLATGL_BENCH_SCALE", 1.0);
     let paths: String = env("SPLATGL_BENCH_PATHS", "former,cull,extent,new".to_owned());
     let scenes: String = if smoke {
@@ -456,6 +457,14 @@ fn main() {
     b.renderer.destroy(gl);
     b.former.destroy(gl);
     frame.destroy(gl);
+}
+
+/// `SPLATGL_BENCH_SIZE` (`WxH`, default 1280x720).
+fn bench_size() -> (u32, u32) {
+    let size: String = env("SPLATGL_BENCH_SIZE", "1280x720".to_owned());
+    size.split_once('x')
+        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
+        .unwrap_or((1280, 720))
 }
 
 /// A desktop context where it counts fragment-shader invocations (else samples passed); else
