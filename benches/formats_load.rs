@@ -18,12 +18,9 @@ use std::io::Read;
 
 const N: usize = 1_000_000;
 
-/// PlayCanvas compressed PLY (the layout `load::ply` documents): chunks of 256 splats with
-/// position and log-scale ranges, colours in [0, 1], 8-bit SH.
-fn compressed_ply(c: &SplatCloud) -> Vec<u8> {
-    let n = c.len();
-    let chunks = n.div_ceil(256);
-    let k = c.coeffs_per_splat() - 1;
+/// The header of a PlayCanvas compressed PLY of `n` splats in `chunks` chunks, `k` higher SH
+/// coefficients per colour channel.
+fn compressed_header(n: usize, chunks: usize, k: usize) -> String {
     let mut h = format!(
         "ply\nformat binary_little_endian 1.0\nelement chunk {chunks}\n{}element vertex {n}\n",
         ["min_x", "min_y", "min_z", "max_x", "max_y", "max_z"]
@@ -40,8 +37,32 @@ fn compressed_ply(c: &SplatCloud) -> Vec<u8> {
     for j in 0..3 * k {
         h += &format!("property uchar f_rest_{j}\n");
     }
-    h += "end_header\n";
-    let mut out = h.into_bytes();
+    h + "end_header\n"
+}
+
+/// `packed_rotation`: the largest component's index in the top 2 bits, the other three in 10
+/// bits each, signed by the largest.
+fn packed_rotation([x, y, z, w]: [f32; 4]) -> u32 {
+    let unorm = |v: f32| (v.clamp(0.0, 1.0) * 1023.0).round() as u32;
+    let q = [w, x, y, z];
+    let l = (0..4)
+        .max_by(|&a, &b| q[a].abs().total_cmp(&q[b].abs()))
+        .unwrap_or(0);
+    let sign = if q[l] < 0.0 { -1.0 } else { 1.0 };
+    let mut pr = l as u32;
+    for (_, v) in q.iter().enumerate().filter(|(j, _)| *j != l) {
+        pr = pr << 10 | unorm(sign * v / std::f32::consts::SQRT_2 + 0.5);
+    }
+    pr
+}
+
+/// PlayCanvas compressed PLY (the layout `load::ply` documents): chunks of 256 splats with
+/// position and log-scale ranges, colours in [0, 1], 8-bit SH.
+fn compressed_ply(c: &SplatCloud) -> Vec<u8> {
+    let n = c.len();
+    let chunks = n.div_ceil(256);
+    let k = c.coeffs_per_splat() - 1;
+    let mut out = compressed_header(n, chunks, k).into_bytes();
     let unorm = |v: f32, bits: u32| {
         let max = ((1u32 << bits) - 1) as f32;
         (v.clamp(0.0, 1.0) * max).round() as u32
@@ -74,16 +95,7 @@ fn compressed_ply(c: &SplatCloud) -> Vec<u8> {
         let t = |a: usize, v: f32| (v - lo[a]) / (hi[a] - lo[a]).max(1e-20);
         let p = c.positions[i];
         let pp = unorm(t(0, p[0]), 11) << 21 | unorm(t(1, p[1]), 10) << 11 | unorm(t(2, p[2]), 11);
-        let [x, y, z, w] = c.rotations[i];
-        let q = [w, x, y, z];
-        let l = (0..4)
-            .max_by(|&a, &b| q[a].abs().total_cmp(&q[b].abs()))
-            .unwrap_or(0);
-        let sign = if q[l] < 0.0 { -1.0 } else { 1.0 };
-        let mut pr = l as u32;
-        for (_, v) in q.iter().enumerate().filter(|(j, _)| *j != l) {
-            pr = pr << 10 | unorm(sign * v / std::f32::consts::SQRT_2 + 0.5, 10);
-        }
+        let pr = packed_rotation(c.rotations[i]);
         let s = c.scales[i].map(f32::ln);
         let ps = unorm(t(3, s[0]), 11) << 21 | unorm(t(4, s[1]), 10) << 11 | unorm(t(5, s[2]), 11);
         let dc = c.sh_of(i)[0].map(|d| splatgl::sh::color_from_dc(d) as f32);
