@@ -19,7 +19,7 @@ use glam::Vec3;
 use glow::HasContext;
 use splatgl::gl::{ColorFormat, ReadbackTarget, SplatRenderer};
 use splatgl::headless::HeadlessContext;
-use splatgl::synthetic;
+use splatgl::{SplatCloud, synthetic};
 use splatgl_capi::*;
 
 type Egl = khronos_egl::DynamicInstance<khronos_egl::EGL1_4>;
@@ -38,6 +38,36 @@ unsafe extern "C" fn loader(name: *const c_char, _user: *mut c_void) -> *mut c_v
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// Uploads `cloud` through the C API: `splatgl_cloud_from_arrays` of its arrays (SH degree
+/// 0), then `splatgl_renderer_upload`.
+///
+/// # Safety
+/// `c` is a live renderer made on this thread, its context current.
+unsafe fn upload_through_c(c: *mut SplatglRenderer, cloud: &SplatCloud) {
+    let mut c_cloud = std::ptr::null_mut();
+    let arrays: Vec<f32> = cloud.positions.iter().flatten().copied().collect();
+    let scales: Vec<f32> = cloud.scales.iter().flatten().copied().collect();
+    let rots: Vec<f32> = cloud.rotations.iter().flatten().copied().collect();
+    let sh: Vec<f32> = cloud.sh.iter().flatten().copied().collect();
+    // SAFETY: the arrays hold the cloud's splats each, as the call is told; `out` is
+    // writable; `c` as the caller promises.
+    unsafe {
+        let code = splatgl_cloud_from_arrays(
+            cloud.len(),
+            arrays.as_ptr(),
+            scales.as_ptr(),
+            rots.as_ptr(),
+            cloud.opacities.as_ptr(),
+            0,
+            sh.as_ptr(),
+            &mut c_cloud,
+        );
+        assert_eq!(code, SPLATGL_OK);
+        assert_eq!(splatgl_renderer_upload(c, c_cloud), SPLATGL_OK);
+        splatgl_cloud_free(c_cloud);
+    }
 }
 
 fn main() {
@@ -73,27 +103,8 @@ fn main() {
         let cam = common::look_at_fov_deg(eye, target_point, 60.0, w, h);
         let (view, proj) = (cam.gl_view(), cam.gl_projection());
         let (v, p) = (view.to_cols_array(), proj.to_cols_array());
-        let mut c_cloud = std::ptr::null_mut();
-        let arrays: Vec<f32> = cloud.positions.iter().flatten().copied().collect();
-        let scales: Vec<f32> = cloud.scales.iter().flatten().copied().collect();
-        let rots: Vec<f32> = cloud.rotations.iter().flatten().copied().collect();
-        let sh: Vec<f32> = cloud.sh.iter().flatten().copied().collect();
-        // SAFETY: the arrays hold n splats each, as the call is told; `out` is writable.
-        unsafe {
-            let code = splatgl_cloud_from_arrays(
-                n,
-                arrays.as_ptr(),
-                scales.as_ptr(),
-                rots.as_ptr(),
-                cloud.opacities.as_ptr(),
-                0,
-                sh.as_ptr(),
-                &mut c_cloud,
-            );
-            assert_eq!(code, SPLATGL_OK);
-            assert_eq!(splatgl_renderer_upload(c, c_cloud), SPLATGL_OK);
-            splatgl_cloud_free(c_cloud);
-        }
+        // SAFETY: `c` is a live renderer on this thread, its context current.
+        unsafe { upload_through_c(c, &cloud) };
         let (mut t_rust, mut t_c) = (Vec::new(), Vec::new());
         for k in 0..draws + 2 {
             let t0 = Instant::now();
