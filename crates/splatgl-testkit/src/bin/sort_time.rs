@@ -2,7 +2,7 @@
 //! the web build's `sort_ms` (crates/splatgl-web), for docs/web.md's table. Same cloud, same
 //! eyes, one warm-up; THREADS=1 (RAYON_NUM_THREADS=1) matches the web's single thread.
 //!
-//!   cargo run --release -p splatgl-testkit --bin sort_time -- [N] [REPS]
+//! `cargo run --release -p splatgl-testkit --bin sort_time -- [N] [REPS]`
 use std::time::Instant;
 
 fn main() {
