@@ -31,8 +31,17 @@ const OURS: &[&str] = &[
     "html", "txt", "yml", "css",
 ];
 
-/// Built outputs a doc may name (they exist after a build, not in a clone).
-const BUILT: &[&str] = &["web/dist", "target/"];
+/// Built or generated outputs a doc may name (they exist after a build or a fuzz run, not in
+/// a clone: the folders `.gitignore` and `fuzz/.gitignore` name).
+const BUILT: &[&str] = &[
+    "web/dist",
+    "target/",
+    "fuzz/target",
+    "fuzz/corpus",
+    "fuzz/artifacts",
+    "fuzz/coverage",
+    "fuzz/seeds",
+];
 
 fn docs(root: &Path) -> Vec<PathBuf> {
     let mut out = vec![root.join("README.md"), root.join("ARCHITECTURE.md")];
