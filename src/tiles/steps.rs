@@ -340,7 +340,7 @@ impl TileFiles {
     }
 }
 
-/// Reads bucket `b`'s part files (all ranges, in row order); `None` if any is missing.
+/// Reads bucket `b`'s part files (all ranges, in row order); an error if any is missing.
 fn read_parts(plan: &BuildPlan, b: usize) -> Result<SplatCloud, StepError> {
     let row = row_bytes(plan.sh_degree);
     let mut c = SplatCloud::with_capacity(plan.sh_degree, 0);

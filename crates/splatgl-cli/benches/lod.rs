@@ -30,14 +30,7 @@ const SPACING: f32 = 0.1;
 fn write_terrain(path: &Path, n: u64) {
     let f = std::fs::File::create(path).unwrap();
     let mut w = std::io::BufWriter::with_capacity(1 << 22, f);
-    let mut h = format!("ply\nformat binary_little_endian 1.0\nelement vertex {n}\n");
-    for p in [
-        "x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
-        "rot_0", "rot_1", "rot_2", "rot_3",
-    ] {
-        h += &format!("property float {p}\n");
-    }
-    h += "end_header\n";
+    let h = splatgl_testkit::packed::ply_header_sh0(n);
     w.write_all(h.as_bytes()).unwrap();
     let side = (n as f32).sqrt() * SPACING;
     let mut rng = Rng::new(42);

@@ -4,6 +4,19 @@
 
 use splatgl::SplatCloud;
 
+/// The header of a binary little-endian INRIA PLY of `n` splats at SH degree 0 (14 floats a
+/// row: position, `f_dc`, opacity logit, log scales, quaternion w x y z), for generators that
+/// write the rows themselves.
+pub fn ply_header_sh0(n: u64) -> String {
+    let mut h = format!("ply\nformat binary_little_endian 1.0\nelement vertex {n}\n");
+    for p in [
+        "x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+        "rot_0", "rot_1", "rot_2", "rot_3",
+    ] {
+        h += &format!("property float {p}\n");
+    }
+    h + "end_header\n"
+}
 /// A zip with stored (method 0) members.
 pub fn zip_stored(members: &[(&str, &[u8])]) -> Vec<u8> {
     let (mut out, mut central) = (Vec::new(), Vec::new());
